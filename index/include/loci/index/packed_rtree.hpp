@@ -1,0 +1,417 @@
+// PackedRTree<D, NodeSize>: a static R-tree bulk-loaded from a known set of boxes.
+//
+// Packing. The boxes are ordered once, either along a Hilbert curve through their centres
+// (Kamel and Faloutsos, "On Packing R-trees", CIKM 1993; the order flatbush uses) or by
+// Sort-Tile-Recursive tiling applied from the root down (Leutenegger et al., ICDE 1997), and
+// then cut into nodes of exactly NodeSize entries. Every node is full except the last one of
+// each level.
+//
+// Layout. The tree is implicit, as in flatbush: level 0 holds the entries in packed order,
+// level l+1 holds one box per node of level l, and entry e of level l is the bounding box of
+// node e of level l-1. No child links are stored; entry e of level l covers the contiguous
+// run of items [e * NodeSize^l, (e+1) * NodeSize^l), which is what lets a window query report
+// a node that lies entirely inside the window without testing its entries. Nodes are stored
+// as SoaBoxes blocks (structure of arrays, unused slots empty) so a node's test is a few
+// vector instructions. Item i of the builder is reported with id i. Memory: one block of
+// 2 * D * NodeSize doubles per node plus a 32-bit item index per slot of level 0, about
+// 36 * (1 + 1/(NodeSize-1)) bytes per 2D box.
+//
+// Invariants (checked by validate()): every entry of level l+1 is exactly the union of its
+// node's entries; unused slots are empty; level 0 holds a permutation of 0..size()-1.
+//
+// Complexity: build O(n log n); window query O(log n + hits) on well-spread data; nearest-n
+// best first. Thread-safety: a finished tree is immutable and may be queried from any number
+// of threads at once.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "loci/geom/box.hpp"
+#include "loci/geom/error.hpp"
+#include "loci/index/detail/best_first.hpp"
+#include "loci/index/detail/hilbert.hpp"
+#include "loci/index/detail/scratch.hpp"
+#include "loci/index/detail/soa_boxes.hpp"
+#include "loci/index/detail/str_partition.hpp"
+#include "loci/index/query.hpp"
+
+namespace loci {
+
+enum class Packing : std::uint8_t { hilbert = 0, str = 1 };
+
+template <int D, int NodeSize = 16>
+class PackedRTree {
+ public:
+  using Block = detail::SoaBoxes<D, NodeSize>;
+  static constexpr int dimension = D;
+  static constexpr int node_size = NodeSize;
+
+  // Collects boxes, then finish() packs them. Throws InvalidGeometry on a NaN, infinite or
+  // inverted box, naming its index.
+  class Builder {
+   public:
+    explicit Builder(std::size_t expected = 0) { boxes_.reserve(expected); }
+    std::uint32_t add(const Box<D>& b) {
+      check_box(b, ("box " + std::to_string(boxes_.size())).c_str());
+      if (boxes_.size() >= std::numeric_limits<std::uint32_t>::max())
+        throw InvalidArgument("PackedRTree holds at most 2^32 - 2 boxes");
+      boxes_.push_back(b);
+      return static_cast<std::uint32_t>(boxes_.size() - 1);
+    }
+    std::size_t size() const { return boxes_.size(); }
+    PackedRTree finish(Packing packing = Packing::hilbert) && {
+      return PackedRTree(std::move(boxes_), packing);
+    }
+
+   private:
+    std::vector<Box<D>> boxes_;
+  };
+
+  PackedRTree() = default;
+  PackedRTree(PackedRTree&&) noexcept = default;
+  PackedRTree& operator=(PackedRTree&&) noexcept = default;
+  PackedRTree(const PackedRTree&) = delete;
+  PackedRTree& operator=(const PackedRTree&) = delete;
+
+  // Builds from boxes; box i gets id i. Throws InvalidGeometry on a bad box.
+  static PackedRTree build(std::span<const Box<D>> boxes, Packing packing = Packing::hilbert) {
+    Builder b(boxes.size());
+    for (const auto& box : boxes)
+      b.add(box);
+    return std::move(b).finish(packing);
+  }
+
+  // Wraps arrays laid out as blocks() and item_indices() return them (for instance from a
+  // memory-mapped file). `keep_alive` owns the memory. The arrays are trusted to be a valid
+  // tree of `size` items; call validate() when they come from an untrusted source.
+  static PackedRTree adopt(std::size_t size, Packing packing, std::span<const Block> blocks,
+                           std::span<const std::uint32_t> item_indices,
+                           std::shared_ptr<const void> keep_alive) {
+    PackedRTree t;
+    t.size_ = size;
+    t.packing_ = packing;
+    t.compute_levels();
+    if (blocks.size() != t.total_blocks() || item_indices.size() != t.level_blocks(0) * NodeSize)
+      throw Error("packed R-tree arrays do not match its item count");
+    t.blocks_ = blocks.data();
+    t.items_ = item_indices.data();
+    t.keep_alive_ = std::move(keep_alive);
+    return t;
+  }
+
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  Packing packing() const { return packing_; }
+  int levels() const { return static_cast<int>(level_count_.size()); }
+  Box<D> bounds() const {
+    return empty() ? Box<D>::empty() : root_block().bounds(int(level_count_.back()));
+  }
+  // Box of item id (its builder index).
+  Box<D> item_box(Id id) const;
+
+  std::span<const Block> blocks() const { return {blocks_, total_blocks()}; }
+  std::span<const std::uint32_t> item_indices() const {
+    return {items_, empty() ? 0 : level_blocks(0) * NodeSize};
+  }
+  std::size_t memory_bytes() const {
+    return total_blocks() * sizeof(Block) + item_indices().size() * sizeof(std::uint32_t);
+  }
+
+  // Calls visit(id, box) for each item in relation `rel` with `window`; stops when it returns
+  // false. Throws InvalidGeometry on a bad window.
+  template <WindowVisitor<D> Visit>
+  QueryStats query(const Box<D>& window, Visit&& visit, Relation rel = Relation::intersects) const;
+  std::vector<Id> query(const Box<D>& window, Relation rel = Relation::intersects) const {
+    std::vector<Id> out;
+    query(
+        window, [&](Id id, const Box<D>&) { return out.push_back(id), true; }, rel);
+    return out;
+  }
+
+  // Calls visit(id, box, distance) for the k items nearest to p, nearest first; stops when it
+  // returns false. Throws InvalidArgument for k = 0, InvalidGeometry for a bad point.
+  template <NearestVisitor<D> Visit>
+  QueryStats nearest(const Point<D>& p, std::size_t k, Visit&& visit) const;
+  std::vector<Neighbor> nearest(const Point<D>& p, std::size_t k) const {
+    std::vector<Neighbor> out;
+    nearest(p, k, [&](Id id, const Box<D>&, double d) { return out.push_back({id, d}), true; });
+    return out;
+  }
+
+  // Throws loci::Error describing the first broken invariant.
+  void validate() const;
+
+ private:
+  PackedRTree(std::vector<Box<D>>&& boxes, Packing packing);
+
+  struct Item {
+    Point<D> c;
+    std::uint32_t index;
+  };
+
+  void compute_levels();
+  std::size_t level_blocks(int l) const { return (level_count_[l] + NodeSize - 1) / NodeSize; }
+  std::size_t total_blocks() const { return level_offset_.empty() ? 0 : level_offset_.back(); }
+  const Block& block(int level, std::size_t b) const { return blocks_[level_offset_[level] + b]; }
+  const Block& root_block() const { return blocks_[total_blocks() - 1]; }
+  Box<D> leaf_box(std::size_t pos) const {
+    return block(0, pos / NodeSize).box(int(pos % NodeSize));
+  }
+
+  void order_hilbert(std::vector<Item>& items) const;
+  void order_str(std::vector<Item>& items) const;
+  void tile(Item* base, std::size_t first, std::size_t count, std::size_t cap) const;
+
+  template <class Visit>
+  bool report_run(std::size_t first, std::size_t last, Visit& visit, QueryStats& s) const;
+
+  std::size_t size_ = 0;
+  Packing packing_ = Packing::hilbert;
+  std::vector<std::size_t> level_count_;   // entries per level, level 0 = items
+  std::vector<std::size_t> level_offset_;  // first block of each level; last = total blocks
+  std::vector<std::size_t> span_;          // NodeSize^l: items covered by an entry of level l
+  const Block* blocks_ = nullptr;
+  const std::uint32_t* items_ = nullptr;
+  std::vector<Block> own_blocks_;
+  std::vector<std::uint32_t> own_items_;
+  std::shared_ptr<const void> keep_alive_;
+};
+
+template <int D, int NodeSize>
+void PackedRTree<D, NodeSize>::compute_levels() {
+  level_count_.clear();
+  level_offset_.clear();
+  span_.clear();
+  if (size_ == 0) return;
+  std::size_t count = size_, offset = 0, span = 1;
+  for (;;) {
+    level_count_.push_back(count);
+    level_offset_.push_back(offset);
+    span_.push_back(span);
+    const std::size_t nblocks = (count + NodeSize - 1) / NodeSize;
+    offset += nblocks;
+    if (nblocks == 1) break;
+    count = nblocks;
+    span *= NodeSize;
+  }
+  level_offset_.push_back(offset);
+}
+
+template <int D, int NodeSize>
+PackedRTree<D, NodeSize>::PackedRTree(std::vector<Box<D>>&& boxes, Packing packing)
+    : size_(boxes.size()), packing_(packing) {
+  compute_levels();
+  if (size_ == 0) return;
+
+  std::vector<Item> items(size_);
+  for (std::size_t i = 0; i < size_; ++i)
+    items[i] = {boxes[i].center(), std::uint32_t(i)};
+  if (packing == Packing::hilbert)
+    order_hilbert(items);
+  else
+    order_str(items);
+
+  own_blocks_.resize(total_blocks());
+  own_items_.assign(level_blocks(0) * NodeSize, std::numeric_limits<std::uint32_t>::max());
+  for (auto& b : own_blocks_)
+    b.clear();
+  for (std::size_t pos = 0; pos < size_; ++pos) {
+    own_items_[pos] = items[pos].index;
+    own_blocks_[pos / NodeSize].set(int(pos % NodeSize), boxes[items[pos].index]);
+  }
+  for (int l = 1; l < levels(); ++l) {
+    const std::size_t below = level_offset_[l - 1];
+    for (std::size_t e = 0; e < level_count_[l]; ++e) {
+      const int used = int(std::min<std::size_t>(NodeSize, level_count_[l - 1] - e * NodeSize));
+      own_blocks_[level_offset_[l] + e / NodeSize].set(int(e % NodeSize),
+                                                       own_blocks_[below + e].bounds(used));
+    }
+  }
+  blocks_ = own_blocks_.data();
+  items_ = own_items_.data();
+}
+
+template <int D, int NodeSize>
+void PackedRTree<D, NodeSize>::order_hilbert(std::vector<Item>& items) const {
+  Box<D> extent = Box<D>::empty();
+  for (const auto& it : items)
+    extent.expand(it.c);
+  constexpr double kMax = double((1u << detail::hilbert_bits<D>()) - 1);
+  double scale[D];
+  for (int a = 0; a < D; ++a)
+    scale[a] = extent.extent(a) > 0 ? kMax / extent.extent(a) : 0.0;
+
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(items.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    std::uint32_t x[D];
+    for (int a = 0; a < D; ++a)
+      x[a] = static_cast<std::uint32_t>((items[i].c[a] - extent.min[a]) * scale[a]);
+    keyed[i] = {detail::hilbert_key<D>(x), std::uint32_t(i)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<Item> sorted(items.size());
+  for (std::size_t i = 0; i < items.size(); ++i)
+    sorted[i] = items[keyed[i].second];
+  items.swap(sorted);
+}
+
+template <int D, int NodeSize>
+void PackedRTree<D, NodeSize>::order_str(std::vector<Item>& items) const {
+  tile(items.data(), 0, items.size(), span_.back());
+}
+
+// Orders items[first, first + count) into groups of `cap` items (the last may be short), then
+// each group into groups of cap / NodeSize, down to leaf nodes.
+template <int D, int NodeSize>
+void PackedRTree<D, NodeSize>::tile(Item* base, std::size_t first, std::size_t count,
+                                    std::size_t cap) const {
+  if (cap <= 1 || count <= 1) return;
+  std::size_t cuts[NodeSize + 1];
+  const std::size_t groups = (count + cap - 1) / cap;
+  for (std::size_t g = 0; g < groups; ++g)
+    cuts[g] = first + g * cap;
+  cuts[groups] = first + count;
+  detail::str_tile<D>(base, std::span<const std::size_t>(cuts, groups + 1),
+                      [](const Item& it, int axis) { return it.c[axis]; });
+  for (std::size_t g = 0; g < groups; ++g)
+    tile(base, cuts[g], cuts[g + 1] - cuts[g], cap / NodeSize);
+}
+
+template <int D, int NodeSize>
+Box<D> PackedRTree<D, NodeSize>::item_box(Id id) const {
+  for (std::size_t pos = 0; pos < size_; ++pos)
+    if (items_[pos] == id) return leaf_box(pos);
+  throw InvalidArgument("no item with id " + std::to_string(id));
+}
+
+template <int D, int NodeSize>
+template <class Visit>
+bool PackedRTree<D, NodeSize>::report_run(std::size_t first, std::size_t last, Visit& visit,
+                                          QueryStats& s) const {
+  last = std::min(last, size_);
+  for (std::size_t pos = first; pos < last; ++pos) {
+    ++s.results;
+    if (!visit(Id(items_[pos]), leaf_box(pos))) return false;
+  }
+  return true;
+}
+
+template <int D, int NodeSize>
+template <WindowVisitor<D> Visit>
+QueryStats PackedRTree<D, NodeSize>::query(const Box<D>& window, Visit&& visit,
+                                           Relation rel) const {
+  check_box(window, "query window");
+  QueryStats s;
+  if (empty()) return s;
+  detail::Scratch<std::uint64_t> scratch;
+  auto& stack = *scratch;
+  stack.push_back(std::uint64_t(levels() - 1) << 32);
+  while (!stack.empty()) {
+    const std::uint64_t top = stack.back();
+    stack.pop_back();
+    const int level = int(top >> 32);
+    const std::size_t b = std::size_t(top & 0xffffffffu);
+    const Block& node = block(level, b);
+    ++s.nodes_visited;
+    s.entries_tested += NodeSize;
+    auto hits = rel == Relation::contains ? node.containing(window) : node.intersecting(window);
+    if (!hits) continue;
+    const std::size_t base = b * NodeSize;
+    if (level == 0) {
+      if (rel == Relation::within) hits &= node.inside(window);
+      while (hits) {
+        const int i = detail::pop_lowest(hits);
+        ++s.results;
+        if (!visit(Id(items_[base + i]), node.box(i))) return s;
+      }
+      continue;
+    }
+    auto inside = rel == Relation::contains ? decltype(hits)(0) : node.inside(window) & hits;
+    hits &= ~inside;
+    while (inside) {
+      const std::size_t e = base + detail::pop_lowest(inside);
+      if (!report_run(e * span_[level], (e + 1) * span_[level], visit, s)) return s;
+    }
+    while (hits) {
+      const std::size_t e = base + detail::pop_lowest(hits);
+      stack.push_back((std::uint64_t(level - 1) << 32) | e);
+    }
+  }
+  return s;
+}
+
+template <int D, int NodeSize>
+template <NearestVisitor<D> Visit>
+QueryStats PackedRTree<D, NodeSize>::nearest(const Point<D>& p, std::size_t k,
+                                             Visit&& visit) const {
+  check_point(p, "query point");
+  if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
+  if (empty()) return {};
+  auto expand = [&](std::uint64_t ref, detail::BestFirstQueue& q) -> std::size_t {
+    const int level = int(ref >> 32);
+    const std::size_t b = std::size_t(ref & 0xffffffffu);
+    const Block& node = block(level, b);
+    const std::size_t base = b * NodeSize;
+    const int used = int(std::min<std::size_t>(NodeSize, level_count_[level] - base));
+    for (int i = 0; i < used; ++i) {
+      const double d2 = node.squared_distance(i, p);
+      if (level == 0)
+        q.push_entry(d2, base + i, Id(items_[base + i]));
+      else
+        q.push_subtree(d2, (std::uint64_t(level - 1) << 32) | (base + i));
+    }
+    return std::size_t(used);
+  };
+  auto report = [&](Id id, std::uint64_t pos, double d) { return visit(id, leaf_box(pos), d); };
+  return detail::best_first(std::uint64_t(levels() - 1) << 32, k, expand, report);
+}
+
+template <int D, int NodeSize>
+void PackedRTree<D, NodeSize>::validate() const {
+  auto fail = [](const std::string& what) { throw Error("PackedRTree invalid: " + what); };
+  if (empty()) {
+    if (total_blocks() != 0) fail("empty tree with nodes");
+    return;
+  }
+  if (level_count_.back() > std::size_t(NodeSize)) fail("root level has more than one node");
+  for (int l = 0; l < levels(); ++l) {
+    for (std::size_t b = 0; b < level_blocks(l); ++b) {
+      const Block& node = block(l, b);
+      for (int i = 0; i < NodeSize; ++i) {
+        const std::size_t e = b * NodeSize + i;
+        const Box<D> box = node.box(i);
+        if (e >= level_count_[l]) {
+          if (!(box == Box<D>::empty()))
+            fail("unused slot is not empty at level " + std::to_string(l));
+          continue;
+        }
+        if (box.is_empty())
+          fail("empty entry " + std::to_string(e) + " at level " + std::to_string(l));
+        if (l > 0) {
+          const int used = int(std::min<std::size_t>(NodeSize, level_count_[l - 1] - e * NodeSize));
+          if (!(block(l - 1, e).bounds(used) == box))
+            fail("entry " + std::to_string(e) + " at level " + std::to_string(l) +
+                 " is not the union of its node");
+        }
+      }
+    }
+  }
+  std::vector<bool> seen(size_, false);
+  for (std::size_t pos = 0; pos < size_; ++pos) {
+    const std::uint32_t id = items_[pos];
+    if (id >= size_ || seen[id]) fail("item indices are not a permutation");
+    seen[id] = true;
+  }
+}
+
+using PackedRTree2 = PackedRTree<2>;
+using PackedRTree3 = PackedRTree<3>;
+
+}  // namespace loci
