@@ -37,6 +37,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/best_first.hpp"
 #include "loci/index/detail/hilbert.hpp"
+#include "loci/index/detail/radix_sort.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/detail/soa_boxes.hpp"
 #include "loci/index/detail/str_partition.hpp"
@@ -59,7 +60,7 @@ class PackedRTree {
    public:
     explicit Builder(std::size_t expected = 0) { boxes_.reserve(expected); }
     std::uint32_t add(const Box<D>& b) {
-      check_box(b, ("box " + std::to_string(boxes_.size())).c_str());
+      if (!is_valid(b)) check_box(b, ("box " + std::to_string(boxes_.size())).c_str());
       if (boxes_.size() >= std::numeric_limits<std::uint32_t>::max())
         throw InvalidArgument("PackedRTree holds at most 2^32 - 2 boxes");
       boxes_.push_back(b);
@@ -67,7 +68,9 @@ class PackedRTree {
     }
     std::size_t size() const { return boxes_.size(); }
     PackedRTree finish(Packing packing = Packing::hilbert) && {
-      return PackedRTree(std::move(boxes_), packing);
+      PackedRTree t(boxes_, packing);
+      boxes_ = {};
+      return t;
     }
 
    private:
@@ -149,7 +152,7 @@ class PackedRTree {
   void validate() const;
 
  private:
-  PackedRTree(std::vector<Box<D>>&& boxes, Packing packing);
+  PackedRTree(std::span<const Box<D>> boxes, Packing packing);
 
   struct Item {
     Point<D> c;
@@ -205,7 +208,7 @@ void PackedRTree<D, NodeSize>::compute_levels() {
 }
 
 template <int D, int NodeSize>
-PackedRTree<D, NodeSize>::PackedRTree(std::vector<Box<D>>&& boxes, Packing packing)
+PackedRTree<D, NodeSize>::PackedRTree(std::span<const Box<D>> boxes, Packing packing)
     : size_(boxes.size()), packing_(packing) {
   compute_levels();
   if (size_ == 0) return;
@@ -248,17 +251,16 @@ void PackedRTree<D, NodeSize>::order_hilbert(std::vector<Item>& items) const {
   for (int a = 0; a < D; ++a)
     scale[a] = extent.extent(a) > 0 ? kMax / extent.extent(a) : 0.0;
 
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(items.size());
+  std::vector<detail::KeyedIndex> keyed(items.size());
   for (std::size_t i = 0; i < items.size(); ++i) {
     std::uint32_t x[D];
     for (int a = 0; a < D; ++a)
       x[a] = static_cast<std::uint32_t>((items[i].c[a] - extent.min[a]) * scale[a]);
     keyed[i] = {detail::hilbert_key<D>(x), std::uint32_t(i)};
   }
-  std::sort(keyed.begin(), keyed.end());
+  detail::radix_sort(keyed, D * detail::hilbert_bits<D>());
   std::vector<Item> sorted(items.size());
-  for (std::size_t i = 0; i < items.size(); ++i)
-    sorted[i] = items[keyed[i].second];
+  for (std::size_t i = 0; i < items.size(); ++i) sorted[i] = items[keyed[i].index];
   items.swap(sorted);
 }
 
@@ -354,18 +356,18 @@ QueryStats PackedRTree<D, NodeSize>::nearest(const Point<D>& p, std::size_t k,
   check_point(p, "query point");
   if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
   if (empty()) return {};
-  auto expand = [&](std::uint64_t ref, detail::BestFirstQueue& q) -> std::size_t {
+  auto expand = [&](std::uint64_t ref, detail::BestFirstSink& sink) -> std::size_t {
     const int level = int(ref >> 32);
     const std::size_t b = std::size_t(ref & 0xffffffffu);
-    const Block& node = block(level, b);
     const std::size_t base = b * NodeSize;
     const int used = int(std::min<std::size_t>(NodeSize, level_count_[level] - base));
+    double d2[NodeSize];
+    block(level, b).squared_distances(p, d2);
     for (int i = 0; i < used; ++i) {
-      const double d2 = node.squared_distance(i, p);
       if (level == 0)
-        q.push_entry(d2, base + i, Id(items_[base + i]));
+        sink.push_entry(d2[i], base + i, Id(items_[base + i]));
       else
-        q.push_subtree(d2, (std::uint64_t(level - 1) << 32) | (base + i));
+        sink.push_subtree(d2[i], (std::uint64_t(level - 1) << 32) | (base + i));
     }
     return std::size_t(used);
   };

@@ -3,15 +3,21 @@
 //
 // A layer is read either as one envelope per feature or as the segments of its linework (every
 // segment of every line string and of every polygon ring, with the feature's FID and the part
-// number). Coordinates are the layer's own; only x and y are kept.
+// number). Coordinates are the layer's own; only x and y are kept. read_items() is what an
+// index is built from: one box and one ItemRecord per entry, in either granularity.
+//
+// GDAL's GeoJSON driver refuses single objects above 200 MB unless told otherwise; Natural
+// Earth's 10 m countries exceed it, so the limit is lifted unless the user set it.
 #pragma once
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
 #include "loci/geom/segment.hpp"
+#include "loci/io/progress.hpp"
 
 namespace loci::io {
 
@@ -30,5 +36,54 @@ struct FeatureRecord {
 // geometry column, or a coordinate is NaN or infinite (naming the feature).
 std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer = {});
 std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::string& layer = {});
+
+// What one index entry stands for. 16 bytes, trivially copyable: stored as is in sidecars.
+struct ItemRecord {
+  std::int64_t fid;    // the feature id GDAL reports
+  std::int32_t part;   // per segment: the line or ring within the feature; per feature: 0
+  std::uint32_t flags;  // ItemFlags
+};
+static_assert(sizeof(ItemRecord) == 16);
+
+enum ItemFlags : std::uint32_t {
+  item_ring = 1u,           // the segment lies on a polygon ring
+  item_antidiagonal = 2u,   // the segment runs from (min x, max y) to (max x, min y) of its box
+};
+
+// The segment an entry of a per-segment index stands for, recovered from its box and flags.
+inline Segment2 segment_of(const Box2& box, std::uint32_t flags) {
+  if (flags & item_antidiagonal) return {{box.min[0], box.max[1]}, {box.max[0], box.min[1]}};
+  return {box.min, box.max};
+}
+
+enum class Per : std::uint8_t { feature = 0, segment = 1 };
+
+struct LayerItems {
+  Per per = Per::feature;
+  std::string layer_name;  // the layer actually read
+  bool has_polygons = false;
+  std::vector<Box2> boxes;
+  std::vector<ItemRecord> records;  // records[i] describes boxes[i]
+};
+
+// Throws like read_segments; features with an empty or missing geometry are skipped.
+LayerItems read_items(const std::string& path, const std::string& layer, Per per,
+                      const Progress& progress = {});
+
+struct LayerSummary {
+  std::string path;
+  std::string driver;
+  std::string layer_name;
+  std::vector<std::string> layer_names;  // every layer of the dataset
+  std::int64_t feature_count = 0;
+  std::vector<std::pair<std::string, std::int64_t>> geometry_types;  // name, count
+  Box2 extent = Box2::empty();
+  std::string crs;  // a short name of the layer's coordinate system, or empty
+  std::vector<std::pair<std::string, std::string>> fields;  // name, type
+};
+
+// Reads every feature to count geometry types. Throws like read_segments.
+LayerSummary summarize_layer(const std::string& path, const std::string& layer,
+                             const Progress& progress = {});
 
 }  // namespace loci::io

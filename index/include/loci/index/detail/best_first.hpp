@@ -1,11 +1,14 @@
 // Best-first nearest-neighbour traversal (Hjaltason and Samet, "Distance Browsing in Spatial
 // Databases", TODS 1999), shared by every tree.
 //
-// One priority queue holds both subtrees and entries, keyed by the squared distance from the
-// query point to their boxes. Popping an entry reports it: no entry still queued or below a
-// queued subtree can be nearer, so results come out nearest first and the traversal stops as
-// soon as the visitor has what it wants. The tree supplies `expand(ref, push)`, which pushes
-// the children of the subtree `ref`, and `entry_box(ref)`.
+// Subtrees wait in a priority queue keyed by the squared distance from the query point to
+// their boxes and are expanded nearest first. Entries do not enter that queue: they go to a
+// bounded max-heap of the k best seen so far, and once it is full a subtree or entry farther
+// than its worst member is dropped at once. The traversal ends when the nearest waiting
+// subtree is farther than the k-th best entry, so no entry that could rank among the first k
+// is missed; the k entries are then reported nearest first. Keeping entries out of the queue
+// makes the queue NodeSize times smaller than a queue of everything. The tree supplies
+// `expand(ref, sink)`, which hands the children of subtree `ref` to the sink.
 #pragma once
 
 #include <algorithm>
@@ -21,25 +24,43 @@ struct QueueItem {
   double d2;
   std::uint64_t ref;  // the tree's handle of a subtree or an entry
   Id id;              // the entry's id; unused for subtrees
-  bool is_entry;
-  // std heaps are max-heaps: the nearest item must compare greatest.
-  friend bool operator<(const QueueItem& a, const QueueItem& b) { return a.d2 > b.d2; }
 };
 
-class BestFirstQueue {
+struct NearerFirst {
+  bool operator()(const QueueItem& a, const QueueItem& b) const { return a.d2 > b.d2; }
+};
+struct FartherFirst {
+  bool operator()(const QueueItem& a, const QueueItem& b) const { return a.d2 < b.d2; }
+};
+
+class BestFirstSink {
  public:
-  explicit BestFirstQueue(std::vector<QueueItem>& heap) : heap_(heap) {}
+  BestFirstSink(std::vector<QueueItem>& subtrees, std::vector<QueueItem>& best, std::size_t k)
+      : subtrees_(subtrees), best_(best), k_(k) {}
+
+  // Squared distance beyond which nothing can enter the result.
+  double bound() const { return best_.size() < k_ ? INFINITY : best_.front().d2; }
+
   void push_subtree(double d2, std::uint64_t ref) {
-    heap_.push_back({d2, ref, 0, false});
-    std::push_heap(heap_.begin(), heap_.end());
+    if (d2 > bound()) return;
+    subtrees_.push_back({d2, ref, 0});
+    std::push_heap(subtrees_.begin(), subtrees_.end(), NearerFirst{});
   }
   void push_entry(double d2, std::uint64_t ref, Id id) {
-    heap_.push_back({d2, ref, id, true});
-    std::push_heap(heap_.begin(), heap_.end());
+    if (best_.size() < k_) {
+      best_.push_back({d2, ref, id});
+      std::push_heap(best_.begin(), best_.end(), FartherFirst{});
+    } else if (d2 < best_.front().d2) {
+      std::pop_heap(best_.begin(), best_.end(), FartherFirst{});
+      best_.back() = {d2, ref, id};
+      std::push_heap(best_.begin(), best_.end(), FartherFirst{});
+    }
   }
 
  private:
-  std::vector<QueueItem>& heap_;
+  std::vector<QueueItem>& subtrees_;
+  std::vector<QueueItem>& best_;
+  std::size_t k_;
 };
 
 // Runs the traversal from `root_ref`; `visit(id, ref, distance)` returns false to stop.
@@ -47,21 +68,23 @@ template <class Expand, class Visit>
 QueryStats best_first(std::uint64_t root_ref, std::size_t k, Expand&& expand, Visit&& visit) {
   QueryStats stats;
   if (k == 0) return stats;
-  Scratch<QueueItem> scratch;
-  auto& heap = *scratch;
-  BestFirstQueue queue(heap);
-  queue.push_subtree(0.0, root_ref);
-  while (!heap.empty()) {
-    std::pop_heap(heap.begin(), heap.end());
-    const QueueItem top = heap.back();
-    heap.pop_back();
-    if (top.is_entry) {
-      ++stats.results;
-      if (!visit(top.id, top.ref, std::sqrt(top.d2)) || stats.results == k) break;
-    } else {
-      ++stats.nodes_visited;
-      stats.entries_tested += expand(top.ref, queue);
-    }
+  Scratch<QueueItem> subtree_scratch, best_scratch;
+  auto& subtrees = *subtree_scratch;
+  auto& best = *best_scratch;
+  BestFirstSink sink(subtrees, best, k);
+  subtrees.push_back({0.0, root_ref, 0});
+  while (!subtrees.empty()) {
+    std::pop_heap(subtrees.begin(), subtrees.end(), NearerFirst{});
+    const QueueItem top = subtrees.back();
+    subtrees.pop_back();
+    if (top.d2 > sink.bound()) break;
+    ++stats.nodes_visited;
+    stats.entries_tested += expand(top.ref, sink);
+  }
+  std::sort_heap(best.begin(), best.end(), FartherFirst{});
+  for (const QueueItem& e : best) {
+    ++stats.results;
+    if (!visit(e.id, e.ref, std::sqrt(e.d2))) break;
   }
   return stats;
 }

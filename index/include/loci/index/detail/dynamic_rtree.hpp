@@ -428,14 +428,15 @@ QueryStats DynamicRTree<D, M, P>::nearest(const Point<D>& p, std::size_t k, Visi
   check_point(p, "query point");
   if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
   if (empty()) return {};
-  auto expand = [&](std::uint64_t ref, BestFirstQueue& q) -> std::size_t {
+  auto expand = [&](std::uint64_t ref, BestFirstSink& sink) -> std::size_t {
     const Node& nd = node(std::uint32_t(ref));
+    double d2[M];
+    nd.boxes.squared_distances(p, d2);
     for (int i = 0; i < nd.count; ++i) {
-      const double d2 = nd.boxes.squared_distance(i, p);
       if (nd.level == 0)
-        q.push_entry(d2, ref * M + i, Id(nd.slot[i]));
+        sink.push_entry(d2[i], ref * M + i, Id(nd.slot[i]));
       else
-        q.push_subtree(d2, nd.slot[i]);
+        sink.push_subtree(d2[i], nd.slot[i]);
     }
     return std::size_t(nd.count);
   };

@@ -12,6 +12,10 @@
 #include <limits>
 #include <type_traits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "loci/geom/box.hpp"
 
 namespace loci::detail {
@@ -68,38 +72,33 @@ struct SoaBoxes {
 
   // Bit i set when child i meets w.
   Mask intersecting(const Box<D>& w) const {
-    Mask m = 0;
-    for (int i = 0; i < N; ++i) {
-      bool hit = true;
-      for (int a = 0; a < D; ++a)
-        hit &= (lo[a][i] <= w.max[a]) & (hi[a][i] >= w.min[a]);
-      m |= Mask(hit) << i;
-    }
-    return m;
+    return mask([](auto lo_v, auto hi_v, auto wmin, auto wmax) {
+      return both(less_equal(lo_v, wmax), less_equal(wmin, hi_v));
+    }, w);
   }
 
   // Bit i set when child i lies inside w.
   Mask inside(const Box<D>& w) const {
-    Mask m = 0;
-    for (int i = 0; i < N; ++i) {
-      bool in = true;
-      for (int a = 0; a < D; ++a)
-        in &= (lo[a][i] >= w.min[a]) & (hi[a][i] <= w.max[a]);
-      m |= Mask(in) << i;
-    }
-    return m;
+    return mask([](auto lo_v, auto hi_v, auto wmin, auto wmax) {
+      return both(less_equal(wmin, lo_v), less_equal(hi_v, wmax));
+    }, w);
   }
 
   // Bit i set when child i contains w.
   Mask containing(const Box<D>& w) const {
-    Mask m = 0;
-    for (int i = 0; i < N; ++i) {
-      bool c = true;
-      for (int a = 0; a < D; ++a)
-        c &= (lo[a][i] <= w.min[a]) & (hi[a][i] >= w.max[a]);
-      m |= Mask(c) << i;
-    }
-    return m;
+    return mask([](auto lo_v, auto hi_v, auto wmin, auto wmax) {
+      return both(less_equal(lo_v, wmin), less_equal(wmax, hi_v));
+    }, w);
+  }
+
+  // out[i] = squared distance from p to child i, for all N slots (empty slots give +inf).
+  void squared_distances(const Point<D>& p, double* out) const {
+    for (int i = 0; i < N; ++i) out[i] = 0;
+    for (int a = 0; a < D; ++a)
+      for (int i = 0; i < N; ++i) {
+        const double d = std::max(std::max(lo[a][i] - p[a], p[a] - hi[a][i]), 0.0);
+        out[i] += d * d;
+      }
   }
 
   double squared_distance(int i, const Point<D>& p) const {
@@ -111,6 +110,41 @@ struct SoaBoxes {
       s += d * d;
     }
     return s;
+  }
+
+ private:
+  // One comparison step on two lanes (SSE2) or one lane (portable); `Test` combines the four
+  // operands of an axis into a lane mask, and the axes are and-ed together.
+#if defined(__SSE2__)
+  using Lane = __m128d;
+  static constexpr int kLanes = 2;
+  static Lane load(const double* p) { return _mm_loadu_pd(p); }
+  static Lane splat(double v) { return _mm_set1_pd(v); }
+  static Lane less_equal(Lane a, Lane b) { return _mm_cmple_pd(a, b); }
+  static Lane both(Lane a, Lane b) { return _mm_and_pd(a, b); }
+  static unsigned bits(Lane a) { return unsigned(_mm_movemask_pd(a)); }
+#else
+  using Lane = bool;
+  static constexpr int kLanes = 1;
+  static double load(const double* p) { return *p; }
+  static double splat(double v) { return v; }
+  static Lane less_equal(double a, double b) { return a <= b; }
+  static Lane both(Lane a, Lane b) { return a && b; }
+  static unsigned bits(Lane a) { return unsigned(a); }
+#endif
+
+  template <class Test>
+  Mask mask(Test test, const Box<D>& w) const {
+    static_assert(N % kLanes == 0);
+    decltype(splat(0.0)) wmin[D], wmax[D];
+    for (int a = 0; a < D; ++a) wmin[a] = splat(w.min[a]), wmax[a] = splat(w.max[a]);
+    Mask m = 0;
+    for (int i = 0; i < N; i += kLanes) {
+      auto acc = test(load(&lo[0][i]), load(&hi[0][i]), wmin[0], wmax[0]);
+      for (int a = 1; a < D; ++a) acc = both(acc, test(load(&lo[a][i]), load(&hi[a][i]), wmin[a], wmax[a]));
+      m |= Mask(bits(acc)) << i;
+    }
+    return m;
   }
 };
 

@@ -1,0 +1,347 @@
+// loci: the command-line face of the library (DESIGN.md section 6).
+//
+// This file only parses arguments, draws progress and prints; the work is done by the
+// functions of loci/io/commands.hpp, one per sub-command. Every command's flags are declared
+// once, in the table at the bottom, and that table is also what `--help` prints, so the help
+// cannot drift from what is accepted. Failures print one line `loci: error: ...` and exit 1.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "loci/geom/error.hpp"
+#include "loci/io/bench.hpp"
+#include "loci/io/commands.hpp"
+
+namespace {
+
+using namespace loci;
+using namespace loci::io;
+
+struct Flag {
+  const char* name;   // "--bbox"
+  const char* alias;  // "-b" or nullptr
+  const char* value;  // "XMIN,YMIN,XMAX,YMAX", nullptr for a switch
+  const char* help;
+};
+
+struct Args {
+  std::vector<std::string> positional;
+  std::map<std::string, std::string> values;  // by long name
+  bool has(const char* name) const { return values.count(name) != 0; }
+  std::string get(const char* name, const std::string& fallback = {}) const {
+    auto it = values.find(name);
+    return it == values.end() ? fallback : it->second;
+  }
+};
+
+struct Command {
+  const char* name;
+  const char* usage;
+  const char* summary;
+  std::vector<Flag> flags;
+  const char* examples;
+  int (*run)(const Args&);
+};
+
+const std::vector<Command>& commands();
+
+class UsageError : public loci::Error {
+ public:
+  using Error::Error;
+};
+
+// Progress on stderr, only on a terminal and without -q.
+Progress progress_bar(const Args& a, const char* what) {
+  if (a.has("--quiet") || !::isatty(STDERR_FILENO)) return {};
+  return [what](double f) {
+    const int width = 30, filled = int(f * width + 0.5);
+    std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", what, filled, "==============================",
+                 width - filled, "", int(f * 100 + 0.5));
+    if (f >= 1.0) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+}
+
+const std::string& layer_arg(const Args& a, const char* command) {
+  if (a.positional.size() != 1)
+    throw UsageError(std::string("loci ") + command + " needs exactly one LAYER (see loci " +
+                     command + " --help)");
+  return a.positional[0];
+}
+
+std::size_t parse_k(const std::string& text) {
+  char* end = nullptr;
+  errno = 0;
+  const long long k = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || errno != 0) throw UsageError("bad -k '" + text + "': expected a whole number");
+  if (k <= 0) throw UsageError("-k must be >= 1 (got " + text + ")");
+  return std::size_t(k);
+}
+
+LoadOptions load_options(const Args& a, const std::string& layer) {
+  LoadOptions o;
+  o.layer_path = layer;
+  o.layer_name = a.get("--layer");
+  o.index_path = a.get("--index");
+  if (a.has("--structure")) o.structure = parse_structure(a.get("--structure"));
+  if (a.has("--per")) {
+    const std::string per = a.get("--per");
+    if (per != "feature" && per != "segment")
+      throw UsageError("bad --per '" + per + "' (choose feature or segment)");
+    o.per = per == "segment" ? Per::segment : Per::feature;
+  }
+  o.progress = progress_bar(a, "indexing");
+  return o;
+}
+
+int run_info(const Args& a) {
+  const std::string& layer = layer_arg(a, "info");
+  std::fputs(describe_layer(layer, a.get("--layer"), progress_bar(a, "reading")).c_str(), stdout);
+  return 0;
+}
+
+int run_index(const Args& a) {
+  IndexOptions o;
+  o.layer_path = layer_arg(a, "index");
+  o.layer_name = a.get("--layer");
+  o.out_path = a.get("--output");
+  if (a.has("--structure")) o.structure = parse_structure(a.get("--structure"));
+  const LoadOptions lo = load_options(a, o.layer_path);
+  o.per = lo.per.value_or(Per::feature);
+  o.progress = progress_bar(a, "indexing");
+  const IndexReport r = index_layer(o);
+  if (!a.has("--quiet"))
+    std::fprintf(stderr, "loci: indexed %zu %s of layer '%s' into %s (%llu bytes, %.2f s)\n",
+                 r.items, o.per == Per::segment ? "segments" : "features", r.layer_name.c_str(),
+                 r.path.c_str(), static_cast<unsigned long long>(r.bytes), r.seconds);
+  return 0;
+}
+
+int run_query(const Args& a) {
+  QueryOptions o;
+  const std::string& layer = layer_arg(a, "query");
+  o.load = load_options(a, layer);
+  const char* kinds[] = {"--bbox", "--bbox-file", "--nearest", "--nearest-file", "--within",
+                         "--segment", "--point"};
+  int given = 0;
+  for (const char* k : kinds) given += a.has(k);
+  if (given != 1)
+    throw UsageError("loci query needs exactly one of --bbox, --bbox-file, --nearest, "
+                     "--nearest-file, --within, --segment, --point");
+  const std::size_t k = a.has("-k") ? parse_k(a.get("-k")) : 1;
+  Query q;
+  q.k = k;
+  if (a.has("--bbox")) {
+    q.kind = Query::Kind::bbox;
+    q.box = parse_bbox(a.get("--bbox"));
+  } else if (a.has("--nearest")) {
+    q.kind = Query::Kind::nearest;
+    q.point = parse_point(a.get("--nearest"));
+  } else if (a.has("--within")) {
+    q = parse_within(a.get("--within"));
+  } else if (a.has("--segment")) {
+    q.kind = Query::Kind::segment;
+    q.segment = parse_segment(a.get("--segment"));
+  } else if (a.has("--point")) {
+    q.kind = Query::Kind::point;
+    q.point = parse_point(a.get("--point"));
+  }
+  if (a.has("--bbox-file")) {
+    o.queries = read_query_file(a.get("--bbox-file"), Query::Kind::bbox, k);
+    o.numbered = true;
+  } else if (a.has("--nearest-file")) {
+    o.queries = read_query_file(a.get("--nearest-file"), Query::Kind::nearest, k);
+    o.numbered = true;
+  } else {
+    o.queries.emplace_back(1, q);
+  }
+  o.candidates = a.has("--candidates");
+  o.format = parse_format(a.get("--format", "ids"));
+  o.out_path = a.get("--output");
+  o.progress = progress_bar(a, "querying");
+  query_layer(o, stdout);
+  return 0;
+}
+
+int run_clip(const Args& a) {
+  ClipOptions o;
+  o.load = load_options(a, layer_arg(a, "clip"));
+  if (!a.has("--bbox")) throw UsageError("loci clip needs --bbox XMIN,YMIN,XMAX,YMAX");
+  if (!a.has("--output")) throw UsageError("loci clip needs -o OUT");
+  o.window = parse_bbox(a.get("--bbox"));
+  o.out_path = a.get("--output");
+  const std::size_t n = clip_layer(o);
+  if (!a.has("--quiet")) std::fprintf(stderr, "loci: %zu features clipped into %s\n", n, o.out_path.c_str());
+  return 0;
+}
+
+int run_draw(const Args& a) {
+  DrawOptions o;
+  o.path = layer_arg(a, "draw");
+  o.layer_name = a.get("--layer");
+  if (!a.has("--output")) throw UsageError("loci draw needs -o OUT.svg");
+  o.out_path = a.get("--output");
+  if (a.has("--levels")) o.max_levels = int(parse_k(a.get("--levels")));
+  if (a.has("--width")) o.width = int(parse_k(a.get("--width")));
+  o.progress = progress_bar(a, "indexing");
+  const std::size_t n = draw_index(o);
+  if (!a.has("--quiet")) std::fprintf(stderr, "loci: %zu nodes drawn into %s\n", n, o.out_path.c_str());
+  return 0;
+}
+
+int run_bench(const Args& a) {
+  BenchOptions o;
+  o.layer_path = layer_arg(a, "bench");
+  o.layer_name = a.get("--layer");
+  const LoadOptions lo = load_options(a, o.layer_path);
+  o.per = lo.per.value_or(Per::segment);
+  if (a.has("--queries")) o.queries = parse_k(a.get("--queries"));
+  if (a.has("-k")) o.k = parse_k(a.get("-k"));
+  o.progress = progress_bar(a, "reading");
+  std::fputs(bench_layer(o).c_str(), stdout);
+  return 0;
+}
+
+const Flag kLayer{"--layer", nullptr, "NAME", "layer of a multi-layer dataset (default: the first)"};
+const Flag kQuiet{"--quiet", "-q", nullptr, "no progress bar and no summary line"};
+const Flag kStructure{"--structure", nullptr, "S",
+                      "packed-hilbert (default), packed-str, rstar or rtree (the last two in memory)"};
+const Flag kPer{"--per", nullptr, "feature|segment",
+                "index one box per feature (default) or one per segment of the linework"};
+const Flag kIndex{"--index", nullptr, "FILE", "sidecar to use (default: LAYER.loci when present)"};
+
+const std::vector<Command>& commands() {
+  static const std::vector<Command> table = {
+      {"info", "loci info LAYER [--layer NAME]",
+       "layer summary: features, geometry types, extent, fields, index status",
+       {kLayer, kQuiet},
+       "  loci info countries.shp\n",
+       run_info},
+      {"index", "loci index LAYER [-o FILE] [--structure S] [--per feature|segment] [--layer NAME]",
+       "writes the sidecar index LAYER.loci (or FILE), read by later queries in place",
+       {{"--output", "-o", "FILE", "where to write the index (default: LAYER.loci)"}, kStructure,
+        kPer, kLayer, kQuiet},
+       "  loci index countries.shp\n  loci index coastline.geojson --per segment -o coast.loci\n",
+       run_index},
+      {"query", "loci query LAYER (--bbox ... | --bbox-file F | --nearest X,Y [-k N] | ...) [-f FMT] [-o OUT]",
+       "features whose exact geometry meets the query (the index gives candidates)",
+       {{"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX", "features meeting the closed window"},
+        {"--bbox-file", nullptr, "F", "one window per line; rows start with the line number"},
+        {"--nearest", "-n", "X,Y", "the k features nearest to the point, nearest first"},
+        {"--nearest-file", nullptr, "F", "one X,Y per line; rows start with the line number"},
+        {"-k", nullptr, "N", "how many neighbours (default 1, must be >= 1)"},
+        {"--within", nullptr, "X,Y,D", "features at distance <= D from the point"},
+        {"--segment", nullptr, "X0,Y0,X1,Y1", "features meeting the closed segment"},
+        {"--point", nullptr, "X,Y", "features containing or touching the point"},
+        {"--candidates", nullptr, nullptr, "box-level answer from the index, no exact test"},
+        {"--format", "-f", "ids|csv|geojson", "output: FIDs (default), CSV with attributes, GeoJSON"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        kIndex, kStructure, kPer, kLayer, kQuiet},
+       "  loci query countries.shp --bbox 5,45,15,55\n"
+       "  loci query countries.shp --nearest 2.35,48.85 -k 3 -f csv\n"
+       "  loci query countries.shp --bbox-file windows.txt -o hits.txt\n",
+       run_query},
+      {"clip", "loci clip LAYER --bbox XMIN,YMIN,XMAX,YMAX -o OUT",
+       "windowing: the features meeting the window, cut to it (format from OUT's extension)",
+       {{"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX", "the window"},
+        {"--output", "-o", "OUT", "output dataset: .geojson, .shp, .gpkg, .fgb, ..."}, kIndex,
+        kStructure, kPer, kLayer, kQuiet},
+       "  loci clip countries.shp --bbox 5,45,15,55 -o alps.gpkg\n",
+       run_clip},
+      {"draw", "loci draw LAYER|FILE.loci -o OUT.svg [--levels N] [--width PX]",
+       "SVG of the layer's linework and the packed index's nodes, one colour per level",
+       {{"--output", "-o", "OUT.svg", "the drawing"},
+        {"--levels", nullptr, "N", "how many levels to draw, from the root down (default 3)"},
+        {"--width", nullptr, "PX", "width in pixels (default 1200)"}, kPer, kLayer, kQuiet},
+       "  loci draw countries.shp -o countries-index.svg --levels 2\n",
+       run_draw},
+      {"bench", "loci bench LAYER [--per feature|segment] [--queries N] [-k N]",
+       "the layer's boxes in loci's packed R-tree and in Boost.Geometry's rtree, side by side",
+       {{"--queries", nullptr, "N", "windows and nearest-n queries to time (default 10000)"},
+        {"-k", nullptr, "N", "neighbours per nearest-n query (default 10)"},
+        {"--per", nullptr, "feature|segment", "boxes of features or of segments (default segment)"},
+        kLayer, kQuiet},
+       "  loci bench coastline.geojson --queries 20000\n",
+       run_bench},
+  };
+  return table;
+}
+
+void print_command_help(const Command& c) {
+  std::printf("usage: %s\n\n%s\n\noptions:\n", c.usage, c.summary);
+  for (const Flag& f : c.flags) {
+    std::string left = f.alias ? std::string(f.alias) + ", " + f.name : std::string("    ") + f.name;
+    if (f.value) left += std::string(" ") + f.value;
+    std::printf("  %-34s %s\n", left.c_str(), f.help);
+  }
+  std::printf("  %-34s %s\n\nexamples:\n%s", "    --help", "this text", c.examples);
+}
+
+void print_help() {
+  std::printf(
+      "usage: loci COMMAND [options]\n\n"
+      "Spatial indexes for map layers (any vector layer GDAL opens).\n\ncommands:\n");
+  for (const auto& c : commands())
+    std::printf("  %-7s %s\n", c.name, c.summary);
+  std::printf(
+      "\nloci COMMAND --help documents every option of COMMAND.\n"
+      "Exit status 0 on success, 1 on failure with one line 'loci: error: ...' on stderr.\n\n"
+      "example:\n  loci index countries.shp && loci query countries.shp --bbox 5,45,15,55\n");
+}
+
+Args parse(const Command& c, int argc, char** argv) {
+  Args a;
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.size() < 2 || arg[0] != '-' ) {
+      a.positional.push_back(arg);
+      continue;
+    }
+    const Flag* flag = nullptr;
+    for (const Flag& f : c.flags)
+      if (arg == f.name || (f.alias && arg == f.alias)) flag = &f;
+    if (!flag)
+      throw UsageError("unknown option " + arg + " for loci " + c.name + " (see loci " + c.name +
+                       " --help)");
+    if (!flag->value) {
+      a.values[flag->name] = "";
+      continue;
+    }
+    if (i + 1 >= argc) throw UsageError(arg + " needs a value: " + flag->value);
+    a.values[flag->name] = argv[++i];
+  }
+  return a;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+    print_help();
+    return argc < 2 ? 1 : 0;
+  }
+  for (const auto& c : commands()) {
+    if (c.name != std::string(argv[1])) continue;
+    for (int i = 2; i < argc; ++i)
+      if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
+        print_command_help(c);
+        return 0;
+      }
+    try {
+      return c.run(parse(c, argc, argv));
+    } catch (const std::exception& e) {
+      std::fflush(stdout);
+      std::fprintf(stderr, "loci: error: %s\n", e.what());
+      return 1;
+    }
+  }
+  std::fprintf(stderr, "loci: error: unknown command '%s' (see loci --help)\n", argv[1]);
+  return 1;
+}

@@ -1,0 +1,37 @@
+// LSD radix sort of (key, index) pairs on the low `bits` bits of the key, 11 bits a pass.
+//
+// Packing sorts a million space-filling-curve keys per build; a comparison sort spends most
+// of the build there, while three counting passes (2D keys are 32 bits) touch each pair three
+// times. Stable, so equal keys keep their input order and builds are deterministic.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace loci::detail {
+
+struct KeyedIndex {
+  std::uint64_t key;
+  std::uint32_t index;
+};
+
+inline void radix_sort(std::vector<KeyedIndex>& v, int bits) {
+  constexpr int kDigit = 11;
+  constexpr std::size_t kBuckets = std::size_t(1) << kDigit;
+  std::vector<KeyedIndex> tmp(v.size());
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    std::array<std::size_t, kBuckets> count{};
+    for (const auto& x : v) ++count[(x.key >> shift) & (kBuckets - 1)];
+    std::size_t sum = 0;
+    for (auto& c : count) {
+      const std::size_t n = c;
+      c = sum;
+      sum += n;
+    }
+    for (const auto& x : v) tmp[count[(x.key >> shift) & (kBuckets - 1)]++] = x;
+    v.swap(tmp);
+  }
+}
+
+}  // namespace loci::detail

@@ -1,0 +1,543 @@
+// PrQuadtree<D>: the point-region quadtree (D = 2) and octree (D = 3), with one point per leaf
+// (bucket = 1, the PR quadtree of Orenstein, 1982) or up to `bucket` points per leaf (the
+// bucket PR quadtree; Samet, "Foundations of Multidimensional and Metric Data Structures",
+// 2006, section 1.4.2).
+//
+// Structure. Every node owns a region of space, a box; an internal node cuts it at its centre
+// into 2^D equal children (child c takes the upper half on axis a when bit a of c is set, and
+// a point on a cut belongs to the upper side). A leaf keeps a list of its points. A leaf is
+// split when it holds more than `bucket` points, unless (a) its points all coincide, (b) it
+// sits at max_depth, or (c) its region can no longer be halved in double precision; those
+// three cases let duplicates and points closer than the precision limit share one leaf
+// instead of recursing forever. The tree is shaped by the space, not by the insertion order:
+// the same set of points always gives the same tree.
+//
+// Region. A cube (a given box is extended to one), given at construction or taken from the
+// first points, and grown on demand: a point outside the root makes the root's region double
+// towards it (the old root becomes one child of the new one), so the tree accepts any finite
+// input.
+//
+// Layout. Nodes live in one pool indexed by 32-bit integers; the 2^D children of a node are
+// consecutive, allocated and freed as a group through a free list. Each node stores its region
+// (children's regions are computed once, from their parent's centre, so every node agrees
+// with its parent exactly), its subtree's point count and depth. Points live in a second pool
+// as singly linked lists, one per leaf. erase() merges a subtree back into a leaf as soon as
+// it holds at most `bucket` points.
+//
+// Queries: window (closed; a node whose region lies inside the window reports its points
+// without tests), nearest-n best first through detail::best_first, and visit_cells() for
+// drawing the subdivision.
+//
+// Invariants (checked by validate()): children tile their parent's region exactly; counts add
+// up; leaf points lie in the leaf's region; a leaf holds at most `bucket` points unless one of
+// (a)-(c) holds; an internal node holds more than `bucket` points; pools have no leaks.
+//
+// Complexity: insert/erase O(depth); depth is O(log(extent / closest pair)), bounded by
+// max_depth. Window and nearest-n as for any region tree. Memory about (32 + 8 * 2 * D) bytes
+// per node plus 32 (2D) or 40 (3D) bytes per point.
+//
+// Thread-safety: const member functions may run concurrently; insert/erase need exclusive
+// access.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "loci/geom/box.hpp"
+#include "loci/geom/error.hpp"
+#include "loci/index/detail/best_first.hpp"
+#include "loci/index/detail/scratch.hpp"
+#include "loci/index/query.hpp"
+
+namespace loci {
+
+template <int D>
+class PrQuadtree {
+ public:
+  static constexpr int dimension = D;
+  static constexpr int fan_out = 1 << D;
+
+  // Points closer than the region's extent / 2^max_depth share a leaf.
+  explicit PrQuadtree(std::uint32_t bucket = 1, int max_depth = 48)
+      : bucket_(bucket), max_depth_(max_depth) {
+    check_parameters();
+  }
+  // Starts with `region`; it still grows if a point falls outside.
+  PrQuadtree(const Box<D>& region, std::uint32_t bucket = 1, int max_depth = 48)
+      : bucket_(bucket), max_depth_(max_depth) {
+    check_parameters();
+    check_box(region, "quadtree region");
+    nodes_.push_back(leaf_node(cube(region), 0));
+  }
+
+  // Point i gets id i; the region is the points' bounding box. Throws InvalidGeometry on a NaN
+  // or infinite coordinate.
+  static PrQuadtree build(std::span<const Point<D>> points, std::uint32_t bucket = 1,
+                          int max_depth = 48) {
+    Box<D> region = Box<D>::empty();
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      check_point(points[i], ("point " + std::to_string(i)).c_str());
+      region.expand(points[i]);
+    }
+    PrQuadtree t = points.empty() ? PrQuadtree(bucket, max_depth)
+                                  : PrQuadtree(region, bucket, max_depth);
+    t.entries_.reserve(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      t.insert(points[i], Id(i));
+    return t;
+  }
+
+  std::size_t size() const { return nodes_.empty() ? 0 : nodes_[0].count; }
+  bool empty() const { return size() == 0; }
+  std::uint32_t bucket() const { return bucket_; }
+  int max_depth() const { return max_depth_; }
+  Box<D> region() const { return nodes_.empty() ? Box<D>::empty() : nodes_[0].region; }
+  int height() const;
+  std::size_t memory_bytes() const {
+    return nodes_.capacity() * sizeof(Node) + entries_.capacity() * sizeof(Entry);
+  }
+
+  // Throws InvalidGeometry on a NaN or infinite coordinate.
+  void insert(const Point<D>& p, Id id);
+  // Removes one entry equal to (p, id); returns false when there is none.
+  bool erase(const Point<D>& p, Id id);
+
+  // Calls visit(id, box) for each point inside the closed window; stops when it returns false.
+  // Throws InvalidGeometry on a bad window.
+  template <WindowVisitor<D> Visit>
+  QueryStats query(const Box<D>& window, Visit&& visit) const;
+  std::vector<Id> query(const Box<D>& window) const {
+    std::vector<Id> out;
+    query(window, [&](Id id, const Box<D>&) { return out.push_back(id), true; });
+    return out;
+  }
+
+  // Calls visit(id, box, distance) for the k points nearest to p, nearest first.
+  // Throws InvalidArgument for k = 0, InvalidGeometry for a bad point.
+  template <NearestVisitor<D> Visit>
+  QueryStats nearest(const Point<D>& p, std::size_t k, Visit&& visit) const;
+  std::vector<Neighbor> nearest(const Point<D>& p, std::size_t k) const {
+    std::vector<Neighbor> out;
+    nearest(p, k, [&](Id id, const Box<D>&, double d) { return out.push_back({id, d}), true; });
+    return out;
+  }
+
+  // Calls f(region, depth, count, is_leaf) for every node, parents before children: the cells
+  // a map draws.
+  template <class F>
+  void visit_cells(F&& f) const {
+    if (nodes_.empty()) return;
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+      const Node& x = nodes_[stack.back()];
+      stack.pop_back();
+      f(x.region, int(x.depth), std::size_t(x.count), x.leaf());
+      if (!x.leaf())
+        for (int c = fan_out - 1; c >= 0; --c)
+          stack.push_back(x.child + std::uint32_t(c));
+    }
+  }
+
+  // Throws loci::Error describing the first broken invariant.
+  void validate() const;
+
+ private:
+  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+  struct Node {
+    Box<D> region;
+    std::uint32_t child;  // first of fan_out children, kNone for a leaf; free list link
+    std::uint32_t first;  // leaf: head of its entry list
+    std::uint32_t count;  // points in the subtree
+    std::uint32_t depth;
+    bool leaf() const { return child == kNone; }
+  };
+  struct Entry {
+    Point<D> p;
+    Id id;
+    std::uint32_t next;  // next entry of the same leaf, or of the free list
+  };
+
+  static Node leaf_node(const Box<D>& region, std::uint32_t depth) {
+    return Node{region, kNone, kNone, 0, depth};
+  }
+
+  void check_parameters() const {
+    if (bucket_ < 1) throw InvalidArgument("quadtree bucket size must be >= 1");
+    if (max_depth_ < 1 || max_depth_ > 1100)
+      throw InvalidArgument("quadtree max_depth must be in [1, 1100]");
+  }
+
+  // Which child of internal node x takes p.
+  int child_of(const Node& x, const Point<D>& p) const {
+    const Node& last = nodes_[x.child + fan_out - 1];  // upper half on every axis
+    int c = 0;
+    for (int a = 0; a < D; ++a)
+      c |= int(p[a] >= last.region.min[a]) << a;
+    return c;
+  }
+  static Box<D> child_region(const Box<D>& r, int c) {
+    Box<D> b = r;
+    for (int a = 0; a < D; ++a)
+      (c >> a & 1 ? b.min[a] : b.max[a]) = r.center(a);
+    return b;
+  }
+  // Cells are cubes, so that no axis of a line of points is left unsplittable.
+  static Box<D> cube(Box<D> r) {
+    double side = 0;
+    for (int a = 0; a < D; ++a)
+      side = std::max(side, r.extent(a));
+    for (int a = 0; a < D; ++a)  // rounding must not cut off the old maximum
+      r.max[a] = std::max(r.max[a], r.min[a] + side);
+    return r;
+  }
+  static bool splittable(const Box<D>& r) {
+    for (int a = 0; a < D; ++a) {
+      const double m = r.center(a);
+      if (!(r.min[a] < m && m < r.max[a])) return false;
+    }
+    return true;
+  }
+  bool must_stay_leaf(const Node& x) const;
+
+  std::uint32_t allocate_group();
+  std::uint32_t allocate_entry(const Point<D>& p, Id id);
+  void grow_towards(const Point<D>& p);
+  void split(std::uint32_t n);
+  // Moves every entry of n's subtree into n's list and frees its descendants.
+  void collapse(std::uint32_t n);
+  void gather(std::uint32_t n, std::uint32_t& head);
+
+  std::uint32_t bucket_;
+  int max_depth_;
+  std::vector<Node> nodes_;  // node 0 is the root
+  std::vector<Entry> entries_;
+  std::uint32_t free_group_ = kNone;
+  std::uint32_t free_entry_ = kNone;
+};
+
+template <int D>
+std::uint32_t PrQuadtree<D>::allocate_group() {
+  if (free_group_ != kNone) {
+    const std::uint32_t g = free_group_;
+    free_group_ = nodes_[g].child;
+    return g;
+  }
+  if (nodes_.size() + fan_out >= kNone) throw InvalidArgument("quadtree node pool is full");
+  nodes_.resize(nodes_.size() + fan_out);
+  return std::uint32_t(nodes_.size() - fan_out);
+}
+
+template <int D>
+std::uint32_t PrQuadtree<D>::allocate_entry(const Point<D>& p, Id id) {
+  if (free_entry_ != kNone) {
+    const std::uint32_t e = free_entry_;
+    free_entry_ = entries_[e].next;
+    entries_[e] = {p, id, kNone};
+    return e;
+  }
+  if (entries_.size() >= kNone - 1) throw InvalidArgument("quadtree holds at most 2^32 - 2 points");
+  entries_.push_back({p, id, kNone});
+  return std::uint32_t(entries_.size() - 1);
+}
+
+template <int D>
+bool PrQuadtree<D>::must_stay_leaf(const Node& x) const {
+  if (x.count <= bucket_ || int(x.depth) >= max_depth_ || !splittable(x.region)) return true;
+  const Point<D>& p0 = entries_[x.first].p;
+  for (std::uint32_t e = entries_[x.first].next; e != kNone; e = entries_[e].next)
+    if (!(entries_[e].p == p0)) return false;
+  return true;  // all coincide: no split can separate them
+}
+
+template <int D>
+void PrQuadtree<D>::grow_towards(const Point<D>& p) {
+  while (!intersects(nodes_[0].region, p)) {
+    const Box<D> old = nodes_[0].region;
+    Box<D> grown = old;
+    int slot = 0;  // where the old root goes among the new root's children
+    for (int a = 0; a < D; ++a) {
+      const double side = std::max(old.extent(a), 1e-300);
+      if (p[a] < old.min[a]) {
+        grown.min[a] = old.min[a] - side;
+        slot |= 1 << a;
+      } else {
+        grown.max[a] = old.max[a] + side;
+      }
+    }
+    if (!is_finite(grown.min) || !is_finite(grown.max))
+      throw InvalidGeometry("point too far from the quadtree's region: " + to_string(p));
+    if (nodes_[0].leaf()) {  // nothing to re-route: widen the leaf to fit p
+      nodes_[0].region = cube(merged(old, Box<D>{p, p}));
+      continue;
+    }
+    const std::uint32_t g = allocate_group();
+    for (Node& x : nodes_)
+      ++x.depth;  // rare (once per doubling), so a pass over the pool is fine
+    // cut the grown region at the old root's corner so that the old root is a child exactly
+    Point<D> cut;
+    for (int a = 0; a < D; ++a)
+      cut[a] = (slot >> a & 1) ? old.min[a] : old.max[a];
+    for (int c = 0; c < fan_out; ++c) {
+      Box<D> r = grown;
+      for (int a = 0; a < D; ++a)
+        (c >> a & 1 ? r.min[a] : r.max[a]) = cut[a];
+      nodes_[g + c] = leaf_node(r, 1);
+    }
+    nodes_[g + slot] = nodes_[0];
+    nodes_[g + slot].depth = 1;
+    nodes_[0] = Node{grown, g, kNone, nodes_[g + slot].count, 0};
+  }
+}
+
+template <int D>
+void PrQuadtree<D>::split(std::uint32_t n) {
+  while (!must_stay_leaf(nodes_[n])) {
+    const std::uint32_t g = allocate_group();
+    Node& x = nodes_[n];
+    for (int c = 0; c < fan_out; ++c)
+      nodes_[g + c] = leaf_node(child_region(x.region, c), x.depth + 1);
+    x.child = g;
+    std::uint32_t e = x.first;
+    x.first = kNone;
+    while (e != kNone) {
+      const std::uint32_t next = entries_[e].next;
+      Node& y = nodes_[g + child_of(x, entries_[e].p)];
+      entries_[e].next = y.first;
+      y.first = e;
+      ++y.count;
+      e = next;
+    }
+    // at most one child can still be over capacity: the one that took every point
+    std::uint32_t over = kNone;
+    for (int c = 0; c < fan_out; ++c)
+      if (nodes_[g + c].count > bucket_) over = g + c;
+    if (over == kNone) return;
+    n = over;
+  }
+}
+
+template <int D>
+void PrQuadtree<D>::insert(const Point<D>& p, Id id) {
+  check_point(p, "inserted point");
+  if (nodes_.empty()) nodes_.push_back(leaf_node(Box<D>{p, p}, 0));
+  grow_towards(p);
+  const std::uint32_t e = allocate_entry(p, id);
+  std::uint32_t n = 0;
+  for (;;) {
+    Node& x = nodes_[n];
+    ++x.count;
+    if (x.leaf()) break;
+    n = x.child + std::uint32_t(child_of(x, p));
+  }
+  entries_[e].next = nodes_[n].first;
+  nodes_[n].first = e;
+  split(n);
+}
+
+template <int D>
+void PrQuadtree<D>::gather(std::uint32_t n, std::uint32_t& head) {
+  const Node x = nodes_[n];
+  if (x.leaf()) {
+    for (std::uint32_t e = x.first; e != kNone;) {
+      const std::uint32_t next = entries_[e].next;
+      entries_[e].next = head;
+      head = e;
+      e = next;
+    }
+    return;
+  }
+  for (int c = 0; c < fan_out; ++c)
+    gather(x.child + std::uint32_t(c), head);
+  nodes_[x.child].child = free_group_;
+  free_group_ = x.child;
+}
+
+template <int D>
+void PrQuadtree<D>::collapse(std::uint32_t n) {
+  std::uint32_t head = kNone;
+  gather(n, head);
+  nodes_[n].child = kNone;
+  nodes_[n].first = head;
+}
+
+template <int D>
+bool PrQuadtree<D>::erase(const Point<D>& p, Id id) {
+  check_point(p, "erased point");
+  if (nodes_.empty() || !intersects(nodes_[0].region, p)) return false;
+  detail::Scratch<std::uint32_t> scratch;
+  auto& path = *scratch;
+  std::uint32_t n = 0;
+  while (!nodes_[n].leaf()) {
+    path.push_back(n);
+    n = nodes_[n].child + std::uint32_t(child_of(nodes_[n], p));
+  }
+  path.push_back(n);
+  std::uint32_t* link = &nodes_[n].first;
+  while (*link != kNone && !(entries_[*link].id == id && entries_[*link].p == p))
+    link = &entries_[*link].next;
+  if (*link == kNone) return false;
+  const std::uint32_t e = *link;
+  *link = entries_[e].next;
+  entries_[e].next = free_entry_;
+  free_entry_ = e;
+  for (std::uint32_t m : path)
+    --nodes_[m].count;
+  for (std::uint32_t m : path)  // the highest internal node that no longer needs children
+    if (!nodes_[m].leaf() && nodes_[m].count <= bucket_) {
+      collapse(m);
+      break;
+    }
+  return true;
+}
+
+template <int D>
+int PrQuadtree<D>::height() const {
+  int h = 0;
+  visit_cells([&](const Box<D>&, int depth, std::size_t, bool) { h = std::max(h, depth + 1); });
+  return h;
+}
+
+template <int D>
+template <WindowVisitor<D> Visit>
+QueryStats PrQuadtree<D>::query(const Box<D>& window, Visit&& visit) const {
+  check_box(window, "query window");
+  QueryStats s;
+  if (empty()) return s;
+  detail::Scratch<std::uint64_t> scratch;
+  auto& stack = *scratch;
+  // low 32 bits: node; bit 32: the node is inside the window, report without tests
+  constexpr std::uint64_t kInside = std::uint64_t(1) << 32;
+  stack.push_back(0);
+  while (!stack.empty()) {
+    const std::uint64_t top = stack.back();
+    stack.pop_back();
+    const Node& x = nodes_[std::uint32_t(top)];
+    bool inside = top & kInside;
+    if (!inside) {
+      ++s.entries_tested;
+      if (!intersects(x.region, window)) continue;
+      inside = contains(window, x.region);
+    }
+    ++s.nodes_visited;
+    if (!x.leaf()) {
+      for (int c = fan_out - 1; c >= 0; --c)
+        if (nodes_[x.child + c].count)
+          stack.push_back((inside ? kInside : 0) | (x.child + std::uint32_t(c)));
+      continue;
+    }
+    for (std::uint32_t e = x.first; e != kNone; e = entries_[e].next) {
+      const Entry& en = entries_[e];
+      if (!inside) {
+        ++s.entries_tested;
+        if (!intersects(window, en.p)) continue;
+      }
+      ++s.results;
+      if (!visit(en.id, Box<D>::of_point(en.p))) return s;
+    }
+  }
+  return s;
+}
+
+template <int D>
+template <NearestVisitor<D> Visit>
+QueryStats PrQuadtree<D>::nearest(const Point<D>& p, std::size_t k, Visit&& visit) const {
+  check_point(p, "query point");
+  if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
+  if (empty()) return {};
+  auto expand = [&](std::uint64_t ref, auto& q) -> std::size_t {
+    const Node& x = nodes_[std::uint32_t(ref)];
+    std::size_t tested = 0;
+    if (!x.leaf()) {
+      for (int c = 0; c < fan_out; ++c) {
+        const Node& y = nodes_[x.child + c];
+        if (!y.count) continue;
+        ++tested;
+        q.push_subtree(squared_distance(p, y.region), x.child + std::uint32_t(c));
+      }
+      return tested;
+    }
+    for (std::uint32_t e = x.first; e != kNone; e = entries_[e].next, ++tested)
+      q.push_entry(squared_distance(p, entries_[e].p), e, entries_[e].id);
+    return tested;
+  };
+  auto report = [&](Id id, std::uint64_t e, double d) {
+    return visit(id, Box<D>::of_point(entries_[e].p), d);
+  };
+  return detail::best_first(0, k, expand, report);
+}
+
+template <int D>
+void PrQuadtree<D>::validate() const {
+  auto fail = [](const std::string& what) { throw Error("PrQuadtree invalid: " + what); };
+  if (nodes_.empty()) {
+    if (!entries_.empty()) fail("entries without nodes");
+    return;
+  }
+  std::vector<bool> node_seen(nodes_.size(), false), entry_seen(entries_.size(), false);
+  std::vector<std::uint32_t> stack{0};
+  node_seen[0] = true;
+  while (!stack.empty()) {
+    const std::uint32_t n = stack.back();
+    stack.pop_back();
+    const Node& x = nodes_[n];
+    const std::string at = " at node " + std::to_string(n);
+    if (x.leaf()) {
+      std::uint32_t count = 0;
+      for (std::uint32_t e = x.first; e != kNone; e = entries_[e].next) {
+        if (e >= entries_.size() || entry_seen[e]) fail("entry list corrupt" + at);
+        entry_seen[e] = true;
+        ++count;
+        if (!intersects(x.region, entries_[e].p)) fail("point outside its leaf" + at);
+      }
+      if (count != x.count) fail("leaf count wrong" + at);
+      if (count > bucket_ && !must_stay_leaf(x)) fail("leaf over capacity" + at);
+      continue;
+    }
+    if (x.count <= bucket_) fail("internal node with too few points" + at);
+    if (x.child >= nodes_.size() || nodes_.size() - x.child < std::size_t(fan_out))
+      fail("child group out of range" + at);
+    std::uint32_t sum = 0;
+    // the upper-on-every-axis child fixes the cut; all children must tile the region with it
+    const Box<D>& last = nodes_[x.child + fan_out - 1].region;
+    for (int c = 0; c < fan_out; ++c) {
+      const std::uint32_t y = x.child + std::uint32_t(c);
+      if (y >= nodes_.size() || node_seen[y]) fail("child reused" + at);
+      node_seen[y] = true;
+      const Node& ch = nodes_[y];
+      if (ch.depth != x.depth + 1) fail("child depth wrong" + at);
+      for (int a = 0; a < D; ++a) {
+        const double cut = last.min[a];
+        const bool upper = c >> a & 1;
+        const double lo = upper ? cut : x.region.min[a], hi = upper ? x.region.max[a] : cut;
+        if (ch.region.min[a] != lo || ch.region.max[a] != hi)
+          fail("children do not tile the region" + at);
+        if (!(x.region.min[a] <= cut && cut <= x.region.max[a])) fail("cut outside region" + at);
+      }
+      sum += ch.count;
+      stack.push_back(y);
+    }
+    if (sum != x.count) fail("counts do not add up" + at);
+  }
+  for (std::uint32_t g = free_group_; g != kNone; g = nodes_[g].child) {
+    for (int c = 0; c < fan_out; ++c) {
+      if (g + c >= nodes_.size() || node_seen[g + c]) fail("free group list corrupt");
+      node_seen[g + c] = true;
+    }
+  }
+  if (std::count(node_seen.begin(), node_seen.end(), false)) fail("nodes leaked");
+  for (std::uint32_t e = free_entry_; e != kNone; e = entries_[e].next) {
+    if (e >= entries_.size() || entry_seen[e]) fail("free entry list corrupt");
+    entry_seen[e] = true;
+  }
+  if (std::count(entry_seen.begin(), entry_seen.end(), false)) fail("entries leaked");
+}
+
+using PrQuadtree2 = PrQuadtree<2>;
+using Octree = PrQuadtree<3>;
+
+}  // namespace loci

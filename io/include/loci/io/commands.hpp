@@ -1,0 +1,111 @@
+// The work behind each `loci` sub-command, as library functions (the GDAL apps pattern: a
+// function per utility taking an options struct, and a thin main that parses arguments into
+// it). Everything here reports failure by throwing loci::Error with a one-line message.
+//
+//   describe_layer   `loci info`: the layer's summary and the state of its sidecar
+//   index_layer      `loci index`: reads the layer, packs the tree, writes the sidecar
+//   load_index       how `loci query` finds its index: a fresh sidecar is mapped, a stale or
+//                    corrupt one is refused, no sidecar means building in memory
+//   query_layer      `loci query`: one query or a numbered batch, exact or --candidates
+//   clip_layer       `loci clip`: features meeting a window, cut to it, written through GDAL
+//   draw_index       `loci draw`: an SVG of the layer and the index's nodes by level
+#pragma once
+
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "loci/io/layer_query.hpp"
+#include "loci/io/output.hpp"
+#include "loci/io/progress.hpp"
+
+namespace loci::io {
+
+// Parse "A,B,C,D" style arguments; throw InvalidArgument quoting the text and the form wanted.
+Box2 parse_bbox(const std::string& text);
+Point2 parse_point(const std::string& text);
+Segment2 parse_segment(const std::string& text);
+// "X,Y,D"
+Query parse_within(const std::string& text);
+
+// One query per non-empty line (XMIN,YMIN,XMAX,YMAX for bbox, X,Y for nearest); blank lines
+// and lines starting with '#' are skipped but still counted, so answers name file lines.
+// Throws Error naming the file and line of a bad line.
+std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& path,
+                                                           Query::Kind kind, std::size_t k);
+
+std::string describe_layer(const std::string& layer_path, const std::string& layer_name,
+                           const Progress& progress = {});
+
+struct IndexOptions {
+  std::string layer_path;
+  std::string layer_name;
+  std::string out_path;  // empty: default_sidecar_path(layer_path)
+  Structure structure = Structure::packed_hilbert;
+  Per per = Per::feature;
+  Progress progress;
+};
+
+struct IndexReport {
+  std::string path;
+  std::string layer_name;
+  std::size_t items = 0;
+  std::uint64_t bytes = 0;
+  double seconds = 0;
+};
+
+// Throws InvalidArgument for a structure that cannot be stored (the dynamic trees).
+IndexReport index_layer(const IndexOptions& options);
+
+struct LoadOptions {
+  std::string layer_path;
+  std::string layer_name;
+  std::string index_path;                // empty: default_sidecar_path(layer_path)
+  std::optional<Structure> structure;    // set: build that structure in memory if needed
+  std::optional<Per> per;                // set: the granularity wanted
+  Progress progress;
+};
+
+// `origin` receives a short description ("sidecar FILE" or "built in memory").
+LayerIndex load_index(const LoadOptions& options, std::string* origin = nullptr);
+
+struct QueryOptions {
+  LoadOptions load;
+  std::vector<std::pair<std::size_t, Query>> queries;  // number, query
+  bool numbered = false;     // batch output: every row starts with the query number
+  bool candidates = false;   // box-level answers only
+  Format format = Format::ids;
+  std::string out_path;      // empty: `fallback`
+  Progress progress;         // over the queries of a batch
+};
+
+struct QueryReport {
+  std::size_t answers = 0;
+  std::string index_origin;
+};
+
+QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
+
+struct ClipOptions {
+  LoadOptions load;
+  Box2 window{};
+  std::string out_path;
+};
+
+// Returns the number of features written.
+std::size_t clip_layer(const ClipOptions& options);
+
+struct DrawOptions {
+  std::string path;  // a layer, or a .loci sidecar (then the layer is the sidecar's name minus .loci)
+  std::string layer_name;
+  std::string out_path;
+  int width = 1200;
+  int max_levels = 3;  // how many levels above the leaves to draw
+  Progress progress;
+};
+
+// Returns the number of node rectangles drawn.
+std::size_t draw_index(const DrawOptions& options);
+
+}  // namespace loci::io

@@ -1,0 +1,55 @@
+// FlatGeometry: a feature's geometry as flat arrays of points and parts, and the exact tests
+// that refine index candidates into answers (DESIGN.md section 4).
+//
+// A layer's features arrive from GDAL in many shapes (points, lines, polygons with holes,
+// multi-geometries, collections). For refinement only three kinds of part matter: isolated
+// points, line strings, and polygon rings, the latter grouped by the polygon they bound so
+// that holes are handled by crossing parity. Keeping them as one vector of points plus part
+// ranges costs one allocation per feature and keeps the tests simple loops.
+//
+// Predicates are exact: a geometry meets a box, a segment or a point when one of its points
+// lies in it, one of its edges meets it (loci's exact box/segment and segment/segment tests),
+// or one of its polygons contains a point of it (crossing parity decided with the exact
+// orientation predicate; a point on a ring is caught by the edge test, not by parity).
+// Touching counts. Distances are computed in floating point and are 0 inside a polygon.
+// Thread-safety: plain values; the functions are pure.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "loci/geom/box.hpp"
+#include "loci/geom/segment.hpp"
+
+namespace loci::io {
+
+enum class PartKind : std::uint8_t { point, line, ring };
+
+struct Part {
+  std::uint32_t begin;    // first point in FlatGeometry::points
+  std::uint32_t end;      // one past the last
+  PartKind kind;
+  std::uint32_t polygon;  // rings only: which polygon of the feature the ring bounds
+};
+
+struct FlatGeometry {
+  std::vector<Point2> points;
+  std::vector<Part> parts;
+  std::uint32_t polygons = 0;  // number of polygons; rings name them 0..polygons-1
+
+  bool empty() const { return points.empty(); }
+  Box2 envelope() const;
+};
+
+// True when the geometry and the closed box share at least one point.
+bool meets(const FlatGeometry& g, const Box2& box);
+// True when the geometry and the closed segment share at least one point.
+bool meets(const FlatGeometry& g, const Segment2& s);
+// Euclidean distance from p to the nearest point of the geometry (0 inside a polygon).
+double distance(const FlatGeometry& g, const Point2& p);
+
+// Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
+// exactly; half-open in y so that a ray through a vertex counts once.
+bool ray_crosses(const Point2& a, const Point2& b, const Point2& p);
+
+}  // namespace loci::io

@@ -1,0 +1,136 @@
+// Queries on a layer: an index over the layer's features or segments (from a sidecar or built
+// in memory) gives candidates, and exact tests on the geometry decide (DESIGN.md section 4).
+//
+// LayerIndex holds one of the structures loci has (packed R-tree with Hilbert or STR packing,
+// which is what a sidecar maps; R*-tree or Guttman's quadratic R-tree, built in memory) and an
+// ItemRecord per entry. LayerQuery runs the five questions the command line asks:
+//
+//   bbox W        features whose geometry meets the closed window W
+//   point P       features whose geometry contains or touches P
+//   segment S     features whose geometry meets the closed segment S
+//   within P, D   features at distance <= D from P, with the distance
+//   nearest P, k  the k features nearest to P, nearest first, with the distance
+//
+// Refinement per feature fetches the candidate's geometry from GDAL by FID (cached for the
+// life of the LayerQuery, which is what makes a batch of queries cheap) and applies the exact
+// tests of exact.hpp. Per segment, the entries are the linework itself (a segment is its box
+// plus one bit saying which diagonal it is), so the exact tests run on the index alone and
+// the layer is never opened for `-f ids`; a polygon that contains the query without its rings
+// meeting it is found by crossing parity along a horizontal ray, itself an index query, with
+// the even-odd rule over all rings of the feature.
+//
+// Nearest-n is best first over entry boxes with exact distances: a feature is final once its
+// exact distance is no larger than the box distance of the next entry, since every entry not
+// yet seen is at least that far. --candidates answers from boxes alone.
+// Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry and belongs to one
+// thread.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "loci/index/packed_rtree.hpp"
+#include "loci/index/rstar_tree.hpp"
+#include "loci/index/rtree.hpp"
+#include "loci/io/layer_reader.hpp"
+#include "loci/io/sidecar.hpp"
+
+namespace loci::io {
+
+enum class Structure : std::uint8_t { packed_hilbert, packed_str, rstar, rtree };
+
+// Accepts "packed-hilbert" (alias "hilbert"), "packed-str" ("str"), "rstar", "rtree".
+// Throws InvalidArgument listing the choices.
+Structure parse_structure(const std::string& name);
+const char* to_string(Structure s);
+const char* to_string(Per p);
+
+class LayerIndex {
+ public:
+  // Builds `structure` over the items in memory.
+  static LayerIndex build(LayerItems&& items, Structure structure);
+  // Queries the mapped sidecar in place.
+  static LayerIndex adopt(Sidecar&& sidecar);
+
+  Per per() const { return per_; }
+  Structure structure() const { return structure_; }
+  bool has_polygons() const { return has_polygons_; }
+  std::size_t size() const { return records_.size(); }
+  Box2 bounds() const { return bounds_; }
+  const std::string& layer_name() const { return layer_name_; }
+  std::span<const ItemRecord> records() const { return records_; }
+  const PackedRTree2* packed() const { return std::get_if<PackedRTree2>(&tree_); }
+
+  // visit(record, box) for every entry whose box meets w; returning false stops.
+  template <class Visit>
+  void window(const Box2& w, Visit&& visit) const {
+    std::visit(
+        [&](const auto& t) {
+          t.query(w, [&](Id id, const Box2& b) { return id < records_.size() ? visit(records_[id], b) : true; });
+        },
+        tree_);
+  }
+  // visit(record, box, box_distance) for entries nearest first; returning false stops.
+  template <class Visit>
+  void browse(const Point2& p, Visit&& visit) const {
+    if (records_.empty()) return;
+    std::visit(
+        [&](const auto& t) {
+          t.nearest(p, records_.size(), [&](Id id, const Box2& b, double d) {
+            return id < records_.size() ? visit(records_[id], b, d) : true;
+          });
+        },
+        tree_);
+  }
+
+ private:
+  std::variant<PackedRTree2, RStarTree2, RTree2> tree_;
+  Per per_ = Per::feature;
+  Structure structure_ = Structure::packed_hilbert;
+  bool has_polygons_ = false;
+  Box2 bounds_ = Box2::empty();
+  std::string layer_name_;
+  std::vector<ItemRecord> own_records_;
+  std::span<const ItemRecord> records_;
+  std::shared_ptr<const void> keep_alive_;
+};
+
+struct Query {
+  enum class Kind : std::uint8_t { bbox, point, segment, within, nearest };
+  Kind kind = Kind::bbox;
+  Box2 box{};          // bbox
+  Point2 point{};      // point, within, nearest
+  Segment2 segment{};  // segment
+  double radius = 0;   // within
+  std::size_t k = 1;   // nearest
+};
+
+struct Answer {
+  std::size_t query;  // 1-based number of the query in its batch
+  std::int64_t fid;
+  double distance;  // within and nearest; NaN otherwise
+};
+
+class LayerQuery {
+ public:
+  // `layer_path`/`layer_name` are opened only when a per-feature refinement needs geometry.
+  LayerQuery(const LayerIndex& index, std::string layer_path, std::string layer_name);
+  ~LayerQuery();
+  LayerQuery(const LayerQuery&) = delete;
+  LayerQuery& operator=(const LayerQuery&) = delete;
+
+  // Appends the answers of q to out: windows in ascending FID, nearest-n nearest first.
+  // Throws InvalidArgument for k = 0 or a negative radius, InvalidGeometry for a NaN input.
+  void run(const Query& q, std::size_t number, bool candidates_only, std::vector<Answer>& out);
+
+ private:
+  struct Geometries;
+  const LayerIndex& index_;
+  std::unique_ptr<Geometries> geometries_;
+};
+
+}  // namespace loci::io

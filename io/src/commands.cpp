@@ -1,0 +1,233 @@
+// The library side of `loci info`, `loci index` and `loci query`: see commands.hpp.
+#include "loci/io/commands.hpp"
+
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "loci/geom/error.hpp"
+#include "loci/io/sidecar.hpp"
+
+namespace loci::io {
+namespace {
+
+std::vector<double> parse_numbers(const std::string& text, std::size_t n, const char* what,
+                                  const char* form) {
+  std::vector<double> v;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string part = text.substr(at, comma - at);
+    char* end = nullptr;
+    const double d = std::strtod(part.c_str(), &end);
+    const bool blank_tail = end && std::string(end).find_first_not_of(" \t\r") == std::string::npos;
+    if (part.find_first_not_of(" \t") == std::string::npos || !blank_tail || !std::isfinite(d))
+      throw InvalidArgument(std::string("bad ") + what + " '" + text + "': expected " + form);
+    v.push_back(d);
+    at = comma + 1;
+  }
+  if (v.size() != n)
+    throw InvalidArgument(std::string("bad ") + what + " '" + text + "': expected " + form);
+  return v;
+}
+
+bool file_exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string fmt(double d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", d);
+  return buf;
+}
+
+std::string stale_reason(const Fingerprint& was, const Fingerprint& now) {
+  if (was.size != now.size)
+    return "size " + std::to_string(was.size) + " -> " + std::to_string(now.size) + " bytes";
+  if (was.hash != now.hash) return "contents changed";
+  return "modified after the index was written";
+}
+
+}  // namespace
+
+Box2 parse_bbox(const std::string& text) {
+  const auto v = parse_numbers(text, 4, "bbox", "XMIN,YMIN,XMAX,YMAX");
+  const Box2 b{{v[0], v[1]}, {v[2], v[3]}};
+  if (v[0] > v[2] || v[1] > v[3])
+    throw InvalidArgument("bad bbox '" + text + "': XMIN > XMAX or YMIN > YMAX");
+  return b;
+}
+
+Point2 parse_point(const std::string& text) {
+  const auto v = parse_numbers(text, 2, "point", "X,Y");
+  return {v[0], v[1]};
+}
+
+Segment2 parse_segment(const std::string& text) {
+  const auto v = parse_numbers(text, 4, "segment", "X0,Y0,X1,Y1");
+  return {{v[0], v[1]}, {v[2], v[3]}};
+}
+
+Query parse_within(const std::string& text) {
+  const auto v = parse_numbers(text, 3, "--within", "X,Y,D");
+  if (v[2] < 0) throw InvalidArgument("bad --within '" + text + "': D must be >= 0");
+  Query q;
+  q.kind = Query::Kind::within;
+  q.point = {v[0], v[1]};
+  q.radius = v[2];
+  return q;
+}
+
+std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& path,
+                                                           Query::Kind kind, std::size_t k) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot read the query file");
+  std::vector<std::pair<std::size_t, Query>> out;
+  std::string line;
+  for (std::size_t n = 1; std::getline(in, line); ++n) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+    Query q;
+    q.kind = kind;
+    q.k = k;
+    try {
+      if (kind == Query::Kind::bbox)
+        q.box = parse_bbox(line);
+      else
+        q.point = parse_point(line);
+    } catch (const Error& e) {
+      throw Error(path + ": line " + std::to_string(n) + ": " + e.what());
+    }
+    out.emplace_back(n, q);
+  }
+  return out;
+}
+
+std::string describe_layer(const std::string& layer_path, const std::string& layer_name,
+                           const Progress& progress) {
+  const LayerSummary s = summarize_layer(layer_path, layer_name, progress);
+  std::ostringstream o;
+  o << "layer:     " << s.layer_name << " (" << s.driver << ")\n";
+  if (s.layer_names.size() > 1) {
+    o << "layers:   ";
+    for (const auto& n : s.layer_names) o << ' ' << n;
+    o << '\n';
+  }
+  o << "features:  " << s.feature_count << '\n';
+  o << "geometry: ";
+  for (const auto& [type, count] : s.geometry_types) o << ' ' << type << " x" << count;
+  o << '\n';
+  if (!s.extent.is_empty())
+    o << "extent:    " << fmt(s.extent.min[0]) << ',' << fmt(s.extent.min[1]) << ','
+      << fmt(s.extent.max[0]) << ',' << fmt(s.extent.max[1]) << '\n';
+  o << "crs:       " << (s.crs.empty() ? "(none)" : s.crs) << '\n';
+  o << "fields:   ";
+  if (s.fields.empty()) o << " (none)";
+  for (const auto& [name, type] : s.fields) o << ' ' << name << ':' << type;
+  o << '\n';
+  const std::string sidecar = default_sidecar_path(layer_path);
+  o << "index:     ";
+  if (!file_exists(sidecar)) {
+    o << "none (loci index " << layer_path << " writes " << sidecar << ")\n";
+    return o.str();
+  }
+  try {
+    const Sidecar sc = Sidecar::open(sidecar);
+    const auto& i = sc.info();
+    const Fingerprint now = fingerprint_of(layer_path);
+    o << sidecar << ": "
+      << (now == i.source ? "fresh" : "stale (" + stale_reason(i.source, now) + ")") << ", "
+      << (i.packing == Packing::str ? "packed-str" : "packed-hilbert") << " per "
+      << to_string(i.per) << ", layer " << i.layer_name << ", " << i.items << " entries, "
+      << i.file_size << " bytes\n";
+  } catch (const Error& e) {
+    o << "unusable: " << e.what() << '\n';
+  }
+  return o.str();
+}
+
+IndexReport index_layer(const IndexOptions& options) {
+  if (options.structure == Structure::rstar || options.structure == Structure::rtree)
+    throw InvalidArgument(std::string("--structure ") + to_string(options.structure) +
+                          " is built in memory only; a sidecar holds packed-hilbert or packed-str");
+  const auto t0 = std::chrono::steady_clock::now();
+  IndexReport r;
+  r.path = options.out_path.empty() ? default_sidecar_path(options.layer_path) : options.out_path;
+  // Fingerprint first: a layer changing while it is read must not look fresh afterwards.
+  const Fingerprint source = fingerprint_of(options.layer_path);
+  Progress reading;
+  if (options.progress) reading = [&](double f) { options.progress(0.9 * f); };
+  LayerItems items = read_items(options.layer_path, options.layer_name, options.per, reading);
+  const Packing packing =
+      options.structure == Structure::packed_str ? Packing::str : Packing::hilbert;
+  const PackedRTree2 tree = PackedRTree2::build(items.boxes, packing);
+  SidecarInfo info;
+  info.per = options.per;
+  info.packing = packing;
+  info.layer_name = items.layer_name;
+  info.has_polygons = items.has_polygons;
+  info.source = source;
+  write_sidecar(r.path, tree, items.records, info);
+  if (options.progress) options.progress(1.0);
+  r.layer_name = items.layer_name;
+  r.items = items.records.size();
+  r.bytes = Sidecar::open(r.path).info().file_size;
+  r.seconds = seconds_since(t0);
+  return r;
+}
+
+LayerIndex load_index(const LoadOptions& o, std::string* origin) {
+  const bool dynamic = o.structure && (*o.structure == Structure::rstar || *o.structure == Structure::rtree);
+  const std::string path = o.index_path.empty() ? default_sidecar_path(o.layer_path) : o.index_path;
+  if (!o.index_path.empty() && !file_exists(path)) throw Error(path + ": no such index file");
+  if (!dynamic && file_exists(path)) {
+    Sidecar sc = Sidecar::open(path);
+    const Fingerprint now = fingerprint_of(o.layer_path);
+    if (!(now == sc.info().source))
+      throw Error(path + ": stale index, " + o.layer_path + " changed since it was indexed (" +
+                  stale_reason(sc.info().source, now) + "); run 'loci index " + o.layer_path + "'");
+    if (!o.layer_name.empty() && o.layer_name != sc.info().layer_name)
+      throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + o.layer_name +
+                  "'; give another index file with --index");
+    const bool same_per = !o.per || *o.per == sc.info().per;
+    const bool same_packing =
+        !o.structure || (*o.structure == Structure::packed_str) == (sc.info().packing == Packing::str);
+    if (same_per && same_packing) {
+      if (origin) *origin = "sidecar " + path;
+      return LayerIndex::adopt(std::move(sc));
+    }
+  }
+  if (origin) *origin = "built in memory";
+  return LayerIndex::build(read_items(o.layer_path, o.layer_name, o.per.value_or(Per::feature), o.progress),
+                           o.structure.value_or(Structure::packed_hilbert));
+}
+
+QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
+  QueryReport report;
+  const LayerIndex index = load_index(options.load, &report.index_origin);
+  LayerQuery lq(index, options.load.layer_path, index.layer_name());
+  std::vector<Answer> answers;
+  bool with_distance = false;
+  ProgressTicker ticker(options.progress, double(options.queries.size()));
+  std::size_t done = 0;
+  for (const auto& [number, q] : options.queries) {
+    lq.run(q, number, options.candidates, answers);
+    with_distance |= q.kind == Query::Kind::within || q.kind == Query::Kind::nearest;
+    ticker.tick(double(++done));
+  }
+  write_answers({options.load.layer_path, index.layer_name()}, answers, options.format,
+                options.numbered, with_distance, options.out_path, fallback);
+  report.answers = answers.size();
+  return report;
+}
+
+}  // namespace loci::io

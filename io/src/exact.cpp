@@ -1,0 +1,92 @@
+// Exact refinement on flattened geometries; see exact.hpp for the semantics.
+#include "loci/io/exact.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "loci/geom/predicates.hpp"
+
+namespace loci::io {
+namespace {
+
+template <class F>
+bool any_edge(const FlatGeometry& g, F&& f) {
+  for (const Part& part : g.parts) {
+    if (part.kind == PartKind::point) continue;
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+      if (f(Segment2{g.points[i], g.points[i + 1]})) return true;
+  }
+  return false;
+}
+
+// True when p is strictly inside one of the polygons of g. Points on a ring may answer either
+// way; callers test the boundary separately.
+bool inside_polygon(const FlatGeometry& g, const Point2& p) {
+  if (g.polygons == 0) return false;
+  std::vector<std::uint8_t> parity(g.polygons, 0);
+  for (const Part& part : g.parts) {
+    if (part.kind != PartKind::ring) continue;
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+      if (ray_crosses(g.points[i], g.points[i + 1], p)) parity[part.polygon] ^= 1;
+  }
+  for (auto odd : parity)
+    if (odd) return true;
+  return false;
+}
+
+}  // namespace
+
+Box2 FlatGeometry::envelope() const {
+  Box2 b = Box2::empty();
+  for (const auto& p : points)
+    b.expand(p);
+  return b;
+}
+
+bool ray_crosses(const Point2& a, const Point2& b, const Point2& p) {
+  if ((a[1] > p[1]) == (b[1] > p[1])) return false;
+  // The edge spans p's horizontal line; the crossing lies to the right of p exactly when p is
+  // left of the edge directed upwards.
+  const Orientation o = a[1] < b[1] ? orientation(a, b, p) : orientation(b, a, p);
+  return o == Orientation::counterclockwise;
+}
+
+bool meets(const FlatGeometry& g, const Box2& box) {
+  if (g.empty() || !intersects(g.envelope(), box)) return false;
+  for (const Part& part : g.parts)
+    for (std::uint32_t i = part.begin; i < part.end; ++i)
+      if (intersects(box, g.points[i])) return true;
+  if (any_edge(g, [&](const Segment2& e) { return intersects(box, e); })) return true;
+  // No point and no edge of g meets the box: the box is either inside a polygon or outside g
+  // altogether, and one corner decides which.
+  return inside_polygon(g, box.min);
+}
+
+bool meets(const FlatGeometry& g, const Segment2& s) {
+  if (g.empty()) return false;
+  for (const Part& part : g.parts) {
+    if (part.end - part.begin == 1 || part.kind == PartKind::point) {
+      for (std::uint32_t i = part.begin; i < part.end; ++i)
+        if (intersects(Segment2{g.points[i], g.points[i]}, s)) return true;
+    }
+  }
+  if (any_edge(g, [&](const Segment2& e) { return intersects(e, s); })) return true;
+  return inside_polygon(g, s.a);
+}
+
+double distance(const FlatGeometry& g, const Point2& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Part& part : g.parts) {
+    if (part.end - part.begin == 1 || part.kind == PartKind::point) {
+      for (std::uint32_t i = part.begin; i < part.end; ++i)
+        best = std::min(best, squared_distance(p, g.points[i]));
+      continue;
+    }
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+      best = std::min(best, squared_distance(p, Segment2{g.points[i], g.points[i + 1]}));
+  }
+  if (best > 0 && inside_polygon(g, p)) return 0;
+  return std::sqrt(best);
+}
+
+}  // namespace loci::io

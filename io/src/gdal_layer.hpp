@@ -1,0 +1,38 @@
+// What the io/ sources share about GDAL: opening a layer with a useful error, walking the
+// linework of an OGR geometry, flattening it for the exact tests, and writing files through a
+// temporary name. Private to io/: no public header includes GDAL.
+#pragma once
+
+#include <gdal_priv.h>
+#include <ogrsf_frmts.h>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "loci/io/exact.hpp"
+
+namespace loci::io::detail {
+
+struct OpenLayer {
+  GDALDatasetUniquePtr dataset;
+  OGRLayer* layer = nullptr;
+};
+
+// Throws loci::Error for a path GDAL cannot open, a missing layer or a layer without geometry.
+OpenLayer open_layer(const std::string& path, const std::string& name);
+
+std::string where(const std::string& path, std::int64_t fid);
+
+// Calls f(curve, is_ring, polygon) for every line string and ring of g, in reading order;
+// `polygon` counts the polygons met so far (rings of one polygon share it).
+void for_each_curve(const OGRGeometry* g,
+                    const std::function<void(const OGRSimpleCurve&, bool, std::uint32_t)>& f);
+
+// Throws InvalidGeometry (naming `what`) on a NaN or infinite coordinate.
+FlatGeometry flatten(const OGRGeometry* g, const std::string& what);
+
+// A GDAL vector driver chosen from the output file name's extension (GeoJSON by default).
+GDALDriver* driver_for(const std::string& path);
+
+}  // namespace loci::io::detail

@@ -1,0 +1,329 @@
+// Exact queries on a layer through its index: see layer_query.hpp.
+#include "loci/io/layer_query.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <queue>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "gdal_layer.hpp"
+#include "loci/geom/error.hpp"
+#include "loci/io/exact.hpp"
+
+namespace loci::io {
+
+Structure parse_structure(const std::string& name) {
+  if (name == "packed-hilbert" || name == "hilbert") return Structure::packed_hilbert;
+  if (name == "packed-str" || name == "str") return Structure::packed_str;
+  if (name == "rstar") return Structure::rstar;
+  if (name == "rtree") return Structure::rtree;
+  throw InvalidArgument("unknown structure '" + name +
+                        "' (choose packed-hilbert, packed-str, rstar or rtree)");
+}
+
+const char* to_string(Structure s) {
+  switch (s) {
+    case Structure::packed_str:
+      return "packed-str";
+    case Structure::rstar:
+      return "rstar";
+    case Structure::rtree:
+      return "rtree";
+    default:
+      return "packed-hilbert";
+  }
+}
+
+const char* to_string(Per p) {
+  return p == Per::segment ? "segment" : "feature";
+}
+
+LayerIndex LayerIndex::build(LayerItems&& items, Structure structure) {
+  LayerIndex x;
+  x.per_ = items.per;
+  x.structure_ = structure;
+  x.has_polygons_ = items.has_polygons;
+  x.layer_name_ = items.layer_name;
+  for (const auto& b : items.boxes)
+    x.bounds_.expand(b);
+  switch (structure) {
+    case Structure::packed_hilbert:
+    case Structure::packed_str:
+      x.tree_ = PackedRTree2::build(
+          items.boxes, structure == Structure::packed_str ? Packing::str : Packing::hilbert);
+      break;
+    case Structure::rstar: {
+      RStarTree2 t;
+      for (std::size_t i = 0; i < items.boxes.size(); ++i)
+        t.insert(items.boxes[i], i);
+      x.tree_ = std::move(t);
+      break;
+    }
+    case Structure::rtree: {
+      RTree2 t;
+      for (std::size_t i = 0; i < items.boxes.size(); ++i)
+        t.insert(items.boxes[i], i);
+      x.tree_ = std::move(t);
+      break;
+    }
+  }
+  x.own_records_ = std::move(items.records);
+  x.records_ = x.own_records_;
+  return x;
+}
+
+LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
+  LayerIndex x;
+  const SidecarInfo& info = sidecar.info();
+  x.per_ = info.per;
+  x.structure_ = info.packing == Packing::str ? Structure::packed_str : Structure::packed_hilbert;
+  x.has_polygons_ = info.has_polygons;
+  x.bounds_ = info.bounds;
+  x.layer_name_ = info.layer_name;
+  x.records_ = sidecar.records();
+  x.keep_alive_ = sidecar.keep_alive();
+  x.tree_ = std::move(sidecar).take_tree();
+  return x;
+}
+
+struct LayerQuery::Geometries {
+  std::string path;
+  std::string name;
+  std::optional<detail::OpenLayer> layer;
+  std::unordered_map<std::int64_t, FlatGeometry> cache;
+
+  const FlatGeometry& get(std::int64_t fid) {
+    if (auto it = cache.find(fid); it != cache.end()) return it->second;
+    if (!layer) layer = detail::open_layer(path, name);
+    OGRFeatureUniquePtr f(layer->layer->GetFeature(fid));
+    if (!f)
+      throw Error(detail::where(path, fid) + " is not in the layer: the index does not match it");
+    return cache.emplace(fid, detail::flatten(f->GetGeometryRef(), detail::where(path, fid)))
+        .first->second;
+  }
+};
+
+LayerQuery::LayerQuery(const LayerIndex& index, std::string layer_path, std::string layer_name)
+    : index_(index), geometries_(new Geometries{std::move(layer_path), std::move(layer_name), {}, {}}) {}
+
+LayerQuery::~LayerQuery() = default;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// What one window-like question needs: where to search, which entry boxes and segments
+// qualify, how a whole feature qualifies, and the point whose polygon containment counts.
+struct Region {
+  Box2 search;
+  Point2 probe;
+  bool with_distance = false;
+  std::function<bool(const Box2&)> box_ok;
+  std::function<std::optional<double>(const Segment2&)> segment_ok;  // distance when it qualifies
+  std::function<std::optional<double>(const FlatGeometry&, const Box2&)> feature_ok;
+};
+
+Box2 around(const Point2& p, double r) {
+  const double inf = std::numeric_limits<double>::infinity();
+  // Rounded outwards, so that a feature at distance exactly r is not lost to the search box.
+  return {{std::nextafter(p[0] - r, -inf), std::nextafter(p[1] - r, -inf)},
+          {std::nextafter(p[0] + r, inf), std::nextafter(p[1] + r, inf)}};
+}
+
+Region region_of(const Query& q) {
+  Region r;
+  switch (q.kind) {
+    case Query::Kind::bbox:
+    case Query::Kind::point: {
+      const Box2 w = q.kind == Query::Kind::bbox ? q.box : Box2::of_point(q.point);
+      r.search = w;
+      r.probe = w.min;
+      r.box_ok = [](const Box2&) { return true; };
+      r.segment_ok = [w](const Segment2& s) -> std::optional<double> {
+        if (intersects(w, s)) return kNaN;
+        return std::nullopt;
+      };
+      r.feature_ok = [w](const FlatGeometry& g, const Box2& env) -> std::optional<double> {
+        if (intersects(env, w) && meets(g, w)) return kNaN;
+        return std::nullopt;
+      };
+      break;
+    }
+    case Query::Kind::segment: {
+      const Segment2 s = q.segment;
+      r.search = s.box();
+      r.probe = s.a;
+      r.box_ok = [s](const Box2& b) { return intersects(b, s); };
+      r.segment_ok = [s](const Segment2& e) -> std::optional<double> {
+        if (intersects(e, s)) return kNaN;
+        return std::nullopt;
+      };
+      r.feature_ok = [s](const FlatGeometry& g, const Box2&) -> std::optional<double> {
+        if (meets(g, s)) return kNaN;
+        return std::nullopt;
+      };
+      break;
+    }
+    default: {
+      const Point2 p = q.point;
+      const double rad = q.radius;
+      r.search = around(p, rad);
+      r.probe = p;
+      r.with_distance = true;
+      r.box_ok = [p, rad](const Box2& b) { return std::sqrt(squared_distance(p, b)) <= rad; };
+      r.segment_ok = [p, rad](const Segment2& e) -> std::optional<double> {
+        const double d = std::sqrt(squared_distance(p, e));
+        if (d <= rad) return d;
+        return std::nullopt;
+      };
+      r.feature_ok = [p, rad](const FlatGeometry& g, const Box2&) -> std::optional<double> {
+        const double d = distance(g, p);
+        if (d <= rad) return d;
+        return std::nullopt;
+      };
+      break;
+    }
+  }
+  return r;
+}
+
+void check_query(const Query& q) {
+  switch (q.kind) {
+    case Query::Kind::bbox:
+      check_box(q.box, "bbox");
+      break;
+    case Query::Kind::segment:
+      check_segment(q.segment, "segment");
+      break;
+    case Query::Kind::within:
+      check_point(q.point, "point");
+      if (!(q.radius >= 0) || !std::isfinite(q.radius))
+        throw InvalidArgument("distance must be a finite number >= 0");
+      break;
+    case Query::Kind::nearest:
+      check_point(q.point, "point");
+      if (q.k == 0) throw InvalidArgument("k must be >= 1");
+      break;
+    default:
+      check_point(q.point, "point");
+  }
+}
+
+// Features of a per-segment index whose polygons contain p by the even-odd rule: the ring
+// segments crossing the ray from p towards +x, counted per feature.
+std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p) {
+  std::vector<std::int64_t> out;
+  if (!index.has_polygons() || index.size() == 0 || p[0] > index.bounds().max[0]) return out;
+  const Box2 ray{p, {index.bounds().max[0], p[1]}};
+  std::unordered_map<std::int64_t, bool> odd;
+  index.window(ray, [&](const ItemRecord& r, const Box2& b) {
+    if (r.flags & item_ring) {
+      const Segment2 s = segment_of(b, r.flags);
+      if (ray_crosses(s.a, s.b, p)) odd[r.fid] = !odd[r.fid];
+    }
+    return true;
+  });
+  for (const auto& [fid, o] : odd)
+    if (o) out.push_back(fid);
+  return out;
+}
+
+}  // namespace
+
+void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
+                     std::vector<Answer>& out) {
+  check_query(q);
+  const bool per_segment = index_.per() == Per::segment;
+
+  if (q.kind == Query::Kind::nearest) {
+    const Point2 p = q.point;
+    std::unordered_map<std::int64_t, double> best;
+    std::unordered_set<std::int64_t> done;
+    using Pending = std::pair<double, std::int64_t>;
+    std::priority_queue<Pending, std::vector<Pending>, std::greater<>> pending;
+    std::size_t found = 0;
+    auto offer = [&](std::int64_t fid, double d) {
+      auto [it, fresh] = best.try_emplace(fid, d);
+      if (!fresh && d >= it->second) return;
+      it->second = d;
+      pending.push({d, fid});
+    };
+    // Everything pending at most `limit` away is final: every entry not yet browsed is at
+    // least `limit` away.
+    auto settle = [&](double limit) {
+      while (!pending.empty() && found < q.k && pending.top().first <= limit) {
+        const auto [d, fid] = pending.top();
+        pending.pop();
+        if (done.count(fid) || best[fid] != d) continue;
+        done.insert(fid);
+        out.push_back({number, fid, d});
+        ++found;
+      }
+    };
+    if (per_segment && !candidates_only)
+      for (const auto fid : containing_polygons(index_, p))
+        offer(fid, 0.0);
+    index_.browse(p, [&](const ItemRecord& r, const Box2& b, double box_distance) {
+      settle(box_distance);
+      if (found >= q.k) return false;
+      if (done.count(r.fid)) return true;
+      if (candidates_only)
+        offer(r.fid, box_distance);
+      else if (per_segment)
+        offer(r.fid, std::sqrt(squared_distance(p, segment_of(b, r.flags))));
+      else
+        offer(r.fid, distance(geometries_->get(r.fid), p));
+      return true;
+    });
+    settle(std::numeric_limits<double>::infinity());
+    return;
+  }
+
+  const Region region = region_of(q);
+  std::unordered_map<std::int64_t, double> hits;
+  auto hit = [&](std::int64_t fid, double d) {
+    auto [it, fresh] = hits.try_emplace(fid, d);
+    if (!fresh && d < it->second) it->second = d;
+  };
+  if (per_segment) {
+    index_.window(region.search, [&](const ItemRecord& r, const Box2& b) {
+      if (candidates_only) {
+        if (region.box_ok(b)) hit(r.fid, region.with_distance ? std::sqrt(squared_distance(q.point, b)) : kNaN);
+      } else if (auto d = region.segment_ok(segment_of(b, r.flags))) {
+        hit(r.fid, *d);
+      }
+      return true;
+    });
+    if (!candidates_only)
+      for (const auto fid : containing_polygons(index_, region.probe))
+        hit(fid, region.with_distance ? 0.0 : kNaN);
+  } else {
+    std::vector<std::pair<std::int64_t, Box2>> candidates;
+    index_.window(region.search, [&](const ItemRecord& r, const Box2& b) {
+      if (region.box_ok(b)) candidates.emplace_back(r.fid, b);
+      return true;
+    });
+    for (const auto& [fid, b] : candidates) {
+      // A feature whose envelope lies inside the window meets it: no geometry needed.
+      if (q.kind == Query::Kind::bbox && !candidates_only && within(b, q.box)) {
+        hit(fid, kNaN);
+        continue;
+      }
+      if (candidates_only) {
+        hit(fid, region.with_distance ? std::sqrt(squared_distance(q.point, b)) : kNaN);
+      } else if (auto d = region.feature_ok(geometries_->get(fid), b)) {
+        hit(fid, *d);
+      }
+    }
+  }
+  const std::size_t first = out.size();
+  for (const auto& [fid, d] : hits)
+    out.push_back({number, fid, d});
+  std::sort(out.begin() + std::ptrdiff_t(first), out.end(),
+            [](const Answer& a, const Answer& b) { return a.fid < b.fid; });
+}
+
+}  // namespace loci::io

@@ -1,0 +1,250 @@
+// Result writers and all-or-nothing output files: see output.hpp.
+#include "loci/io/output.hpp"
+
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "gdal_layer.hpp"
+#include "loci/geom/error.hpp"
+
+namespace loci::io {
+namespace {
+
+std::string directory_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+std::string base_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+Error cannot_write(const std::string& path, int err) {
+  return Error("cannot write " + path + " (" + std::strerror(err) + ")");
+}
+
+void remove_tree(const std::string& dir) {
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string name = e->d_name;
+      if (name != "." && name != "..") ::unlink((dir + "/" + name).c_str());
+    }
+    ::closedir(d);
+  }
+  ::rmdir(dir.c_str());
+}
+
+std::string csv_quoted(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"') q += '"';
+    q += c;
+  }
+  return q + "\"";
+}
+
+std::string number(double d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", d);
+  return buf;
+}
+
+OGRFeatureUniquePtr fetch(detail::OpenLayer& ol, const AnswerSource& src, std::int64_t fid) {
+  OGRFeatureUniquePtr f(ol.layer->GetFeature(fid));
+  if (!f) throw Error(detail::where(src.layer_path, fid) + " is not in the layer");
+  return f;
+}
+
+void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
+  for (const auto& a : answers) {
+    if (numbered)
+      std::fprintf(out, "%zu %lld\n", a.query, static_cast<long long>(a.fid));
+    else
+      std::fprintf(out, "%lld\n", static_cast<long long>(a.fid));
+  }
+}
+
+void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
+               bool with_distance, std::FILE* out) {
+  auto ol = detail::open_layer(src.layer_path, src.layer_name);
+  const OGRFeatureDefn* defn = ol.layer->GetLayerDefn();
+  std::string line = numbered ? "query,fid" : "fid";
+  if (with_distance) line += ",distance";
+  for (int i = 0; i < defn->GetFieldCount(); ++i)
+    line += "," + csv_quoted(defn->GetFieldDefn(i)->GetNameRef());
+  std::fprintf(out, "%s\n", line.c_str());
+  for (const auto& a : answers) {
+    const auto f = fetch(ol, src, a.fid);
+    line = numbered ? std::to_string(a.query) + "," : "";
+    line += std::to_string(a.fid);
+    if (with_distance) line += "," + number(a.distance);
+    for (int i = 0; i < defn->GetFieldCount(); ++i) {
+      line += ',';
+      if (f->IsFieldSetAndNotNull(i)) line += csv_quoted(f->GetFieldAsString(i));
+    }
+    std::fprintf(out, "%s\n", line.c_str());
+  }
+}
+
+void write_geojson(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
+                   bool with_distance, const std::string& target) {
+  auto ol = detail::open_layer(src.layer_path, src.layer_name);
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GeoJSON");
+  if (!driver) throw Error("GDAL has no GeoJSON driver");
+  CPLErrorReset();
+  GDALDatasetUniquePtr ds(driver->Create(target.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+  if (!ds) throw Error("cannot write GeoJSON: " + std::string(CPLGetLastErrorMsg()));
+  OGRLayer* layer = ds->CreateLayer(ol.layer->GetName(), ol.layer->GetSpatialRef(), wkbUnknown,
+                                    nullptr);
+  if (!layer) throw Error("cannot create the GeoJSON layer: " + std::string(CPLGetLastErrorMsg()));
+  std::vector<std::pair<int, int>> copied;  // source field, output field
+  int out_index = 0;
+  auto add_field = [&](const char* name, OGRFieldType type) {
+    OGRFieldDefn fd(name, type);
+    if (layer->CreateField(&fd) != OGRERR_NONE) throw Error("cannot create field " + std::string(name));
+    return out_index++;
+  };
+  const int query_field = numbered ? add_field("query", OFTInteger64) : -1;
+  const int fid_field = add_field("fid", OFTInteger64);
+  const int distance_field = with_distance ? add_field("distance", OFTReal) : -1;
+  const OGRFeatureDefn* defn = ol.layer->GetLayerDefn();
+  for (int i = 0; i < defn->GetFieldCount(); ++i) {
+    const OGRFieldDefn* fd = defn->GetFieldDefn(i);
+    const std::string name = fd->GetNameRef();
+    if (name == "query" || name == "fid" || name == "distance") continue;
+    OGRFieldDefn copy(fd);
+    if (layer->CreateField(&copy) != OGRERR_NONE) throw Error("cannot create field " + name);
+    copied.emplace_back(i, out_index++);
+  }
+  for (const auto& a : answers) {
+    const auto f = fetch(ol, src, a.fid);
+    OGRFeature out(layer->GetLayerDefn());
+    if (query_field >= 0) out.SetField(query_field, static_cast<GIntBig>(a.query));
+    out.SetField(fid_field, static_cast<GIntBig>(a.fid));
+    if (distance_field >= 0) out.SetField(distance_field, a.distance);
+    for (const auto& [from, to] : copied)
+      if (f->IsFieldSetAndNotNull(from)) out.SetField(to, f->GetRawFieldRef(from));
+    out.SetGeometry(f->GetGeometryRef());
+    if (layer->CreateFeature(&out) != OGRERR_NONE)
+      throw Error("cannot write feature " + std::to_string(a.fid) + " as GeoJSON");
+  }
+  if (ds->Close() != CE_None) throw Error("cannot finish the GeoJSON output");
+}
+
+}  // namespace
+
+Format parse_format(const std::string& name) {
+  if (name == "ids") return Format::ids;
+  if (name == "csv") return Format::csv;
+  if (name == "geojson") return Format::geojson;
+  throw InvalidArgument("unknown format '" + name + "' (choose ids, csv or geojson)");
+}
+
+OutputFile::OutputFile(const std::string& path, std::FILE* fallback) : path_(path) {
+  if (path.empty()) {
+    stream_ = fallback;
+    return;
+  }
+  tmp_ = directory_of(path) + "/." + base_of(path) + ".tmpXXXXXX";
+  const int fd = ::mkstemp(tmp_.data());
+  if (fd < 0) throw cannot_write(path, errno);
+  ::fchmod(fd, 0644);
+  stream_ = ::fdopen(fd, "w");
+  if (!stream_) {
+    const int e = errno;
+    ::close(fd);
+    ::unlink(tmp_.c_str());
+    throw cannot_write(path, e);
+  }
+}
+
+OutputFile::~OutputFile() {
+  if (path_.empty() || committed_) return;
+  std::fclose(stream_);
+  ::unlink(tmp_.c_str());
+}
+
+void OutputFile::commit() {
+  if (path_.empty()) {
+    if (std::fflush(stream_) != 0) throw Error(std::string("cannot write output (") + std::strerror(errno) + ")");
+    committed_ = true;
+    return;
+  }
+  committed_ = true;
+  const bool failed = std::ferror(stream_) != 0;
+  if (std::fclose(stream_) != 0 || failed) {
+    const int e = errno;
+    ::unlink(tmp_.c_str());
+    throw cannot_write(path_, e);
+  }
+  if (::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    const int e = errno;
+    ::unlink(tmp_.c_str());
+    throw cannot_write(path_, e);
+  }
+}
+
+OutputDataset::OutputDataset(const std::string& path) : path_(path) {
+  std::string tmpl = directory_of(path) + "/." + base_of(path) + ".tmpXXXXXX";
+  if (!::mkdtemp(tmpl.data())) throw cannot_write(path, errno);
+  dir_ = tmpl;
+  staging_ = dir_ + "/" + base_of(path);
+}
+
+OutputDataset::~OutputDataset() {
+  if (!committed_) remove_tree(dir_);
+}
+
+void OutputDataset::commit() {
+  committed_ = true;
+  const std::string target_dir = directory_of(path_);
+  std::vector<std::string> names;
+  if (DIR* d = ::opendir(dir_.c_str())) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string name = e->d_name;
+      if (name != "." && name != "..") names.push_back(name);
+    }
+    ::closedir(d);
+  }
+  for (const auto& name : names) {
+    if (::rename((dir_ + "/" + name).c_str(), (target_dir + "/" + name).c_str()) != 0) {
+      const int e = errno;
+      remove_tree(dir_);
+      throw cannot_write(path_, e);
+    }
+  }
+  ::rmdir(dir_.c_str());
+}
+
+void write_answers(const AnswerSource& source, std::span<const Answer> answers, Format format,
+                   bool numbered, bool with_distance, const std::string& out_path,
+                   std::FILE* fallback) {
+  if (format == Format::geojson) {
+    if (out_path.empty()) {
+      std::fflush(fallback);
+      write_geojson(source, answers, numbered, with_distance, "/vsistdout/");
+      return;
+    }
+    OutputDataset out(out_path);
+    write_geojson(source, answers, numbered, with_distance, out.staging_path());
+    out.commit();
+    return;
+  }
+  OutputFile out(out_path, fallback);
+  if (format == Format::ids)
+    write_ids(answers, numbered, out.stream());
+  else
+    write_csv(source, answers, numbered, with_distance, out.stream());
+  out.commit();
+}
+
+}  // namespace loci::io

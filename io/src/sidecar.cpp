@@ -1,0 +1,347 @@
+// The sidecar index file: see sidecar.hpp for the format and its guarantees.
+#include "loci/io/sidecar.hpp"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <vector>
+
+#include "loci/geom/error.hpp"
+
+namespace loci::io {
+namespace {
+
+constexpr char kMagic[8] = {'\x89', 'L', 'O', 'C', 'I', '\r', '\n', '\x1a'};
+constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kByteOrder = 0x01020304;
+constexpr std::uint8_t kStructurePackedRTree = 1;
+constexpr std::uint8_t kCoordFloat64 = 1;
+constexpr std::uint32_t kFlagPolygons = 1;
+constexpr std::size_t kAlign = 64;
+
+struct SidecarHeader {
+  char magic[8];
+  std::uint32_t version;
+  std::uint32_t byte_order;
+  std::uint8_t structure;
+  std::uint8_t packing;
+  std::uint8_t coordinate_type;
+  std::uint8_t per;
+  std::uint16_t dimension;
+  std::uint16_t node_size;
+  std::uint32_t flags;
+  std::uint32_t reserved0;
+  std::uint64_t item_count;
+  std::uint64_t block_count;
+  std::uint64_t slot_count;  // entries of item_indices
+  std::uint64_t name_offset;
+  std::uint64_t name_size;
+  std::uint64_t blocks_offset;
+  std::uint64_t items_offset;
+  std::uint64_t records_offset;
+  std::uint64_t file_size;
+  double bounds[4];  // min x, min y, max x, max y
+  std::uint64_t source_size;
+  std::int64_t source_mtime_ns;
+  std::uint64_t source_hash;
+  std::uint64_t payload_checksum;  // hash of bytes [sizeof(SidecarHeader), file_size)
+  std::uint8_t reserved[80];
+  std::uint64_t header_checksum;  // hash of the bytes before this field
+};
+static_assert(sizeof(SidecarHeader) == 256);
+static_assert(std::endian::native == std::endian::little, "sidecars are little-endian");
+
+std::size_t align_up(std::size_t n) {
+  return (n + kAlign - 1) / kAlign * kAlign;
+}
+
+constexpr std::uint64_t kP1 = 0x9E3779B185EBCA87ull;
+constexpr std::uint64_t kP2 = 0xC2B2AE3D27D4EB4Full;
+constexpr std::uint64_t kP3 = 0x165667B19E3779F9ull;
+
+std::uint64_t mix(std::uint64_t lane, std::uint64_t word) {
+  return std::rotl(lane + word * kP2, 31) * kP1;
+}
+
+std::uint64_t avalanche(std::uint64_t h) {
+  h ^= h >> 33;
+  h *= kP2;
+  h ^= h >> 29;
+  h *= kP3;
+  h ^= h >> 32;
+  return h;
+}
+
+// The number of blocks a packed tree of `n` items has; mirrors PackedRTree's level layout.
+std::uint64_t blocks_for(std::uint64_t n, std::uint64_t node) {
+  if (n == 0) return 0;
+  std::uint64_t total = 0;
+  for (std::uint64_t count = n;;) {
+    const std::uint64_t b = (count + node - 1) / node;
+    total += b;
+    if (b == 1) return total;
+    count = b;
+  }
+}
+
+struct Mapping {
+  const std::byte* data = nullptr;
+  std::size_t size = 0;
+};
+
+// Maps a whole file read-only; the returned pointer unmaps it. Empty files map to nullptr.
+std::shared_ptr<const Mapping> map_file(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw Error(path + ": cannot open (" + std::strerror(errno) + ")");
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw Error(path + ": not a regular file");
+  }
+  auto m = std::shared_ptr<Mapping>(new Mapping, [](Mapping* m) {
+    if (m->data) ::munmap(const_cast<std::byte*>(m->data), m->size);
+    delete m;
+  });
+  m->size = std::size_t(st.st_size);
+  if (m->size > 0) {
+    void* p = ::mmap(nullptr, m->size, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (p == MAP_FAILED) {
+      ::close(fd);
+      throw Error(path + ": cannot map (" + std::strerror(errno) + ")");
+    }
+    m->data = static_cast<const std::byte*>(p);
+  }
+  ::close(fd);
+  return m;
+}
+
+bool stat_file(const std::string& path, struct stat& st) {
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+std::int64_t mtime_ns(const struct stat& st) {
+  return std::int64_t(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec;
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+// Writes all of `data` or throws.
+void write_all(int fd, const void* data, std::size_t size, const std::string& path) {
+  const auto* p = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, p, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw Error("cannot write " + path + " (" + std::strerror(errno) + ")");
+    p += n;
+    size -= std::size_t(n);
+  }
+}
+
+}  // namespace
+
+std::uint64_t hash_bytes(const void* data, std::size_t size, std::uint64_t seed) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  std::uint64_t lane[4] = {seed + kP1 + kP2, seed + kP2, seed, seed - kP1};
+  std::size_t i = 0;
+  for (; i + 32 <= size; i += 32) {
+    for (int l = 0; l < 4; ++l) {
+      std::uint64_t w;
+      std::memcpy(&w, p + i + 8 * l, 8);
+      lane[l] = mix(lane[l], w);
+    }
+  }
+  std::uint64_t h = std::rotl(lane[0], 1) + std::rotl(lane[1], 7) + std::rotl(lane[2], 12) +
+                    std::rotl(lane[3], 18) + std::uint64_t(size);
+  for (; i + 8 <= size; i += 8) {
+    std::uint64_t w;
+    std::memcpy(&w, p + i, 8);
+    h = std::rotl(h ^ mix(0, w), 27) * kP1 + kP3;
+  }
+  for (; i < size; ++i)
+    h = std::rotl(h ^ (p[i] * kP3), 11) * kP1;
+  return avalanche(h);
+}
+
+Fingerprint fingerprint_of(const std::string& layer_path) {
+  struct stat st {};
+  if (!stat_file(layer_path, st)) {
+    // GDAL paths that are not files (virtual file systems, connection strings) cannot be
+    // fingerprinted here; GDAL itself reports whether they open.
+    if (layer_path.rfind("/vsi", 0) == 0 || layer_path.find(':') != std::string::npos) return {};
+    throw Error(layer_path + ": no such file");
+  }
+  Fingerprint f;
+  if (!S_ISREG(st.st_mode)) {
+    f.mtime_ns = mtime_ns(st);
+    return f;
+  }
+  std::vector<std::string> files{layer_path};
+  const std::string ext = layer_path.size() > 4 ? layer_path.substr(layer_path.size() - 4) : "";
+  if (lower(ext) == ".shp") {
+    const std::string stem = layer_path.substr(0, layer_path.size() - 4);
+    for (const char* shx : {".shx", ".SHX"}) {
+      struct stat s2 {};
+      if (stat_file(stem + shx, s2)) {
+        files.push_back(stem + shx);
+        break;
+      }
+    }
+  }
+  for (const auto& file : files) {
+    const auto m = map_file(file);
+    f.size += m->size;
+    struct stat s {};
+    stat_file(file, s);
+    f.mtime_ns = std::max(f.mtime_ns, mtime_ns(s));
+    f.hash = hash_bytes(m->data, m->size, f.hash);
+  }
+  return f;
+}
+
+std::string default_sidecar_path(const std::string& layer_path) {
+  std::string p = layer_path;
+  while (p.size() > 1 && p.back() == '/')
+    p.pop_back();
+  return p + ".loci";
+}
+
+void write_sidecar(const std::string& path, const PackedRTree2& tree,
+                   std::span<const ItemRecord> records, const SidecarInfo& info) {
+  if (records.size() != tree.size()) throw InvalidArgument("sidecar: one record per item");
+  const auto blocks = tree.blocks();
+  const auto items = tree.item_indices();
+
+  SidecarHeader h{};
+  std::memcpy(h.magic, kMagic, 8);
+  h.version = kVersion;
+  h.byte_order = kByteOrder;
+  h.structure = kStructurePackedRTree;
+  h.packing = std::uint8_t(info.packing);
+  h.coordinate_type = kCoordFloat64;
+  h.per = std::uint8_t(info.per);
+  h.dimension = 2;
+  h.node_size = PackedRTree2::node_size;
+  h.flags = info.has_polygons ? kFlagPolygons : 0;
+  h.item_count = tree.size();
+  h.block_count = blocks.size();
+  h.slot_count = items.size();
+  h.name_offset = sizeof(SidecarHeader);
+  h.name_size = info.layer_name.size();
+  h.blocks_offset = align_up(h.name_offset + h.name_size);
+  h.items_offset = align_up(h.blocks_offset + blocks.size_bytes());
+  h.records_offset = align_up(h.items_offset + items.size_bytes());
+  h.file_size = h.records_offset + records.size_bytes();
+  const Box2 b = tree.bounds();
+  h.bounds[0] = b.min[0];
+  h.bounds[1] = b.min[1];
+  h.bounds[2] = b.max[0];
+  h.bounds[3] = b.max[1];
+  h.source_size = info.source.size;
+  h.source_mtime_ns = info.source.mtime_ns;
+  h.source_hash = info.source.hash;
+
+  std::vector<std::byte> payload(h.file_size - sizeof(SidecarHeader));
+  auto put = [&](std::uint64_t offset, const void* data, std::size_t size) {
+    if (size) std::memcpy(payload.data() + (offset - sizeof(SidecarHeader)), data, size);
+  };
+  put(h.name_offset, info.layer_name.data(), info.layer_name.size());
+  put(h.blocks_offset, blocks.data(), blocks.size_bytes());
+  put(h.items_offset, items.data(), items.size_bytes());
+  put(h.records_offset, records.data(), records.size_bytes());
+  h.payload_checksum = hash_bytes(payload.data(), payload.size());
+  h.header_checksum = hash_bytes(&h, offsetof(SidecarHeader, header_checksum));
+
+  std::string tmp = path + ".tmpXXXXXX";
+  const int fd = ::mkstemp(tmp.data());
+  if (fd < 0) throw Error("cannot write " + path + " (" + std::strerror(errno) + ")");
+  try {
+    write_all(fd, &h, sizeof h, path);
+    write_all(fd, payload.data(), payload.size(), path);
+    if (::fchmod(fd, 0644) != 0 || ::close(fd) != 0)
+      throw Error("cannot write " + path + " (" + std::strerror(errno) + ")");
+  } catch (...) {
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw;
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int e = errno;
+    ::unlink(tmp.c_str());
+    throw Error("cannot write " + path + " (" + std::strerror(e) + ")");
+  }
+}
+
+Sidecar Sidecar::open(const std::string& path) {
+  const auto m = map_file(path);
+  auto refuse = [&](const std::string& why) -> Error {
+    return Error(path + ": " + why + "; run 'loci index' to rebuild it");
+  };
+  if (m->size < sizeof(SidecarHeader)) {
+    if (m->size >= 8 && std::memcmp(m->data, kMagic, 8) == 0)
+      throw refuse("truncated index file (" + std::to_string(m->size) + " bytes)");
+    throw Error(path + ": not a loci index file");
+  }
+  SidecarHeader h;
+  std::memcpy(&h, m->data, sizeof h);
+  if (std::memcmp(h.magic, kMagic, 8) != 0) throw Error(path + ": not a loci index file");
+  if (h.byte_order != kByteOrder) throw refuse("index written on a machine of other byte order");
+  if (h.version != kVersion)
+    throw refuse("index format version " + std::to_string(h.version) + ", this loci reads " +
+                 std::to_string(kVersion));
+  if (h.header_checksum != hash_bytes(&h, offsetof(SidecarHeader, header_checksum)))
+    throw refuse("corrupt index file (header checksum mismatch)");
+  if (h.file_size != m->size)
+    throw refuse(std::string(m->size < h.file_size ? "truncated" : "damaged") + " index file (" +
+                 std::to_string(m->size) + " bytes, header says " + std::to_string(h.file_size) +
+                 ")");
+  if (h.structure != kStructurePackedRTree || h.coordinate_type != kCoordFloat64 ||
+      h.dimension != 2 || h.node_size != PackedRTree2::node_size || h.packing > 1 || h.per > 1)
+    throw refuse("index of a structure this loci does not read");
+  const std::uint64_t node = PackedRTree2::node_size;
+  const std::uint64_t expect_blocks = blocks_for(h.item_count, node);
+  const std::uint64_t expect_slots =
+      h.item_count == 0 ? 0 : (h.item_count + node - 1) / node * node;
+  using Block = PackedRTree2::Block;
+  auto fits = [&](std::uint64_t offset, std::uint64_t count, std::uint64_t size) {
+    return offset % 8 == 0 && offset >= sizeof(SidecarHeader) && offset <= m->size &&
+           count <= (m->size - offset) / size;
+  };
+  if (h.item_count >= (1ull << 32) || h.block_count != expect_blocks ||
+      h.slot_count != expect_slots || h.blocks_offset % kAlign != 0 ||
+      !fits(h.name_offset, h.name_size, 1) || !fits(h.blocks_offset, h.block_count, sizeof(Block)) ||
+      !fits(h.items_offset, h.slot_count, 4) || !fits(h.records_offset, h.item_count, 16))
+    throw refuse("corrupt index file (inconsistent sizes)");
+  if (h.payload_checksum !=
+      hash_bytes(m->data + sizeof(SidecarHeader), m->size - sizeof(SidecarHeader)))
+    throw refuse("corrupt index file (checksum mismatch)");
+
+  Sidecar s;
+  s.info_.per = Per(h.per);
+  s.info_.packing = Packing(h.packing);
+  s.info_.layer_name.assign(reinterpret_cast<const char*>(m->data + h.name_offset), h.name_size);
+  s.info_.has_polygons = (h.flags & kFlagPolygons) != 0;
+  s.info_.items = h.item_count;
+  s.info_.bounds = {{h.bounds[0], h.bounds[1]}, {h.bounds[2], h.bounds[3]}};
+  s.info_.source = {h.source_size, h.source_mtime_ns, h.source_hash};
+  s.info_.file_size = h.file_size;
+  const auto* blocks = reinterpret_cast<const Block*>(m->data + h.blocks_offset);
+  const auto* items = reinterpret_cast<const std::uint32_t*>(m->data + h.items_offset);
+  s.records_ = {reinterpret_cast<const ItemRecord*>(m->data + h.records_offset),
+                std::size_t(h.item_count)};
+  s.tree_ = PackedRTree2::adopt(std::size_t(h.item_count), Packing(h.packing),
+                                {blocks, std::size_t(h.block_count)},
+                                {items, std::size_t(h.slot_count)}, m);
+  s.mapping_ = m;
+  return s;
+}
+
+}  // namespace loci::io

@@ -1,0 +1,139 @@
+// The shared index machinery: Hilbert keys, radix sort, STR tiling, SoA node tests.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "loci/index/detail/hilbert.hpp"
+#include "loci/index/detail/radix_sort.hpp"
+#include "loci/index/detail/soa_boxes.hpp"
+#include "loci/index/detail/str_partition.hpp"
+#include "support/random_data.hpp"
+
+using namespace loci;
+using namespace loci::detail;
+
+namespace {
+
+// The cells of the 2^k-wide corner cube must take the first 2^(kD) keys, each cell one key,
+// and consecutive keys must name face-adjacent cells: the defining property of the curve.
+template <int D, class Key>
+void expect_hilbert_walk(int k, Key key) {
+  const std::uint32_t side = 1u << k;
+  std::size_t cells = 1;
+  for (int a = 0; a < D; ++a) cells *= side;
+  std::vector<std::pair<std::uint64_t, std::array<std::uint32_t, D>>> walk;
+  for (std::size_t c = 0; c < cells; ++c) {
+    std::array<std::uint32_t, D> x;
+    std::size_t rest = c;
+    for (int a = 0; a < D; ++a) x[a] = std::uint32_t(rest % side), rest /= side;
+    walk.push_back({key(x), x});
+  }
+  std::sort(walk.begin(), walk.end());
+  for (std::size_t i = 0; i < walk.size(); ++i) {
+    ASSERT_EQ(walk[i].first, i);
+    if (i == 0) continue;
+    int steps = 0;
+    for (int a = 0; a < D; ++a) steps += std::abs(int(walk[i].second[a]) - int(walk[i - 1].second[a]));
+    ASSERT_EQ(steps, 1) << "keys " << i - 1 << " and " << i << " are not adjacent";
+  }
+}
+
+}  // namespace
+
+TEST(Hilbert, TableDriven2DIsAHilbertWalk) {
+  for (int k : {1, 2, 3, 5, 8})
+    expect_hilbert_walk<2>(k, [](auto x) { return hilbert_key_2d(x[0], x[1]); });
+}
+
+TEST(Hilbert, Generic2DIsAHilbertWalk) {
+  for (int k : {1, 4, 6})
+    expect_hilbert_walk<2>(k, [](auto x) {
+      std::uint32_t c[2] = {x[0], x[1]};
+      return hilbert_key_generic<2>(c);
+    });
+}
+
+TEST(Hilbert, Generic3DIsAHilbertWalk) {
+  for (int k : {1, 3, 5})
+    expect_hilbert_walk<3>(k, [](auto x) {
+      std::uint32_t c[3] = {x[0], x[1], x[2]};
+      return hilbert_key_generic<3>(c);
+    });
+}
+
+TEST(Hilbert, FullRangeKeysAreDistinctAndBounded) {
+  std::mt19937_64 rng(3);
+  std::vector<std::uint64_t> keys;
+  for (int i = 0; i < 5000; ++i) {
+    const std::uint32_t x = rng() & 0xffff, y = rng() & 0xffff;
+    keys.push_back(hilbert_key_2d(x, y));
+    EXPECT_LT(keys.back(), std::uint64_t(1) << 32);
+  }
+  EXPECT_EQ(hilbert_key_2d(0, 0), 0u);
+  EXPECT_EQ(hilbert_key_2d(0xffff, 0), (std::uint64_t(1) << 32) - 1);  // ends at the far x corner
+}
+
+TEST(RadixSort, MatchesStableSort) {
+  std::mt19937_64 rng(4);
+  for (int bits : {5, 32, 63}) {
+    std::vector<KeyedIndex> v(20000);
+    for (std::uint32_t i = 0; i < v.size(); ++i)
+      v[i] = {rng() & ((std::uint64_t(1) << bits) - 1) & ~std::uint64_t(bits == 5 ? 0 : 3), i};
+    auto ref = v;
+    std::stable_sort(ref.begin(), ref.end(), [](auto& a, auto& b) { return a.key < b.key; });
+    radix_sort(v, bits);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      ASSERT_EQ(v[i].key, ref[i].key);
+      ASSERT_EQ(v[i].index, ref[i].index);
+    }
+  }
+}
+
+TEST(StrTile, GroupsAreSlabsThenTiles) {
+  std::mt19937_64 rng(5);
+  std::vector<Point2> pts(1000);
+  for (auto& p : pts) p = test::random_point<2>(rng);
+  std::vector<std::size_t> cuts;
+  for (std::size_t c = 0; c <= 1000; c += 100) cuts.push_back(c);  // 10 groups: 4 slabs
+  str_tile<2>(pts.data(), std::span<const std::size_t>(cuts), [](const Point2& p, int a) { return p[a]; });
+  // slabs of 3 groups (300 points) are ordered along x
+  for (std::size_t s = 0; s + 1 < 4; ++s) {
+    double max_x = -1, next_min_x = 1e18;
+    for (std::size_t i = s * 300; i < std::min<std::size_t>(1000, (s + 1) * 300); ++i) max_x = std::max(max_x, pts[i][0]);
+    for (std::size_t i = (s + 1) * 300; i < std::min<std::size_t>(1000, (s + 2) * 300); ++i)
+      next_min_x = std::min(next_min_x, pts[i][0]);
+    EXPECT_LE(max_x, next_min_x);
+  }
+  // within a slab, groups are ordered along y
+  for (std::size_t g = 0; g + 1 < 3; ++g) {
+    double max_y = -1, next_min_y = 1e18;
+    for (std::size_t i = g * 100; i < (g + 1) * 100; ++i) max_y = std::max(max_y, pts[i][1]);
+    for (std::size_t i = (g + 1) * 100; i < (g + 2) * 100; ++i) next_min_y = std::min(next_min_y, pts[i][1]);
+    EXPECT_LE(max_y, next_min_y);
+  }
+}
+
+TEST(SoaBoxes, MasksMatchScalarTests) {
+  std::mt19937_64 rng(6);
+  SoaBoxes<3, 16> node;
+  node.clear();
+  const auto boxes = test::make_boxes<3>(test::Shape::uniform, 12, 8);  // 4 slots stay empty
+  for (int i = 0; i < 12; ++i) node.set(i, boxes[i]);
+  for (int q = 0; q < 500; ++q) {
+    const auto w = test::random_window<3>(rng, 600);
+    std::uint32_t meets = 0, in = 0, holds = 0;
+    for (int i = 0; i < 12; ++i) {
+      meets |= std::uint32_t(intersects(boxes[i], w)) << i;
+      in |= std::uint32_t(within(boxes[i], w)) << i;
+      holds |= std::uint32_t(contains(boxes[i], w)) << i;
+    }
+    ASSERT_EQ(node.intersecting(w), meets);
+    ASSERT_EQ(node.inside(w) & 0xfff, in);  // an empty slot lies inside anything
+    ASSERT_EQ(node.containing(w), holds);
+    double d2[16];
+    const Point3 p = test::random_point<3>(rng);
+    node.squared_distances(p, d2);
+    for (int i = 0; i < 12; ++i) ASSERT_DOUBLE_EQ(d2[i], squared_distance(p, boxes[i]));
+  }
+}
