@@ -124,12 +124,24 @@ void churn(PointShape shape, std::uint32_t bucket, std::uint64_t seed) {
   EXPECT_EQ(tree.height(), 1);
 }
 
-TEST(QuadDynamic, ChurnUniformPr) { churn<2>(PointShape::uniform, 1, 1); }
-TEST(QuadDynamic, ChurnClusteredBucket) { churn<2>(PointShape::clustered, 4, 2); }
-TEST(QuadDynamic, ChurnDuplicatesPr) { churn<2>(PointShape::duplicates, 1, 3); }
-TEST(QuadDynamic, ChurnTinyGapsPr) { churn<2>(PointShape::tiny_gaps, 1, 4); }
-TEST(QuadDynamic, ChurnHorizontalOctree) { churn<3>(PointShape::horizontal, 2, 5); }
-TEST(QuadDynamic, ChurnIdenticalOctree) { churn<3>(PointShape::identical, 1, 6); }
+TEST(QuadDynamic, ChurnUniformPr) {
+  churn<2>(PointShape::uniform, 1, 1);
+}
+TEST(QuadDynamic, ChurnClusteredBucket) {
+  churn<2>(PointShape::clustered, 4, 2);
+}
+TEST(QuadDynamic, ChurnDuplicatesPr) {
+  churn<2>(PointShape::duplicates, 1, 3);
+}
+TEST(QuadDynamic, ChurnTinyGapsPr) {
+  churn<2>(PointShape::tiny_gaps, 1, 4);
+}
+TEST(QuadDynamic, ChurnHorizontalOctree) {
+  churn<3>(PointShape::horizontal, 2, 5);
+}
+TEST(QuadDynamic, ChurnIdenticalOctree) {
+  churn<3>(PointShape::identical, 1, 6);
+}
 
 TEST(PrQuadtree, CoincidentPointsShareOneLeaf) {
   PrQuadtree2 tree(Box2{{0, 0}, {1, 1}});
@@ -162,8 +174,7 @@ TEST(PrQuadtree, RegionGrowsInEveryDirection) {
     tree.insert(p, Id(i));
   }
   tree.validate();
-  EXPECT_TRUE(contains(tree.region(), Box2{{-1e6, -1e6}, {1e6, 1e6}}) ||
-              tree.size() == pts.size());
+  EXPECT_TRUE(contains(tree.region(), Box2{{-1e6, -1e6}, {1e6, 1e6}}) || tree.size() == pts.size());
   const auto all = tree.query(Box2{{-1e7, -1e7}, {1e7, 1e7}});
   EXPECT_EQ(all.size(), pts.size());
   expect_nearest(tree.nearest({0, 0}, 7), point_boxes(pts), Point2{0, 0}, 7);

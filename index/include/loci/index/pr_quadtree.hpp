@@ -12,10 +12,10 @@
 // instead of recursing forever. The tree is shaped by the space, not by the insertion order:
 // the same set of points always gives the same tree.
 //
-// Region. A cube (a given box is extended to one), given at construction or taken from the
-// first points, and grown on demand: a point outside the root makes the root's region double
-// towards it (the old root becomes one child of the new one), so the tree accepts any finite
-// input.
+// Region. A cube (a given box is extended to one), half-open at its upper faces, given at
+// construction or taken from the first points, and grown on demand: a point outside the root makes
+// the root's region double towards it (the old root becomes one child of the new one), so the tree
+// accepts any finite input.
 //
 // Layout. Nodes live in one pool indexed by 32-bit integers; the 2^D children of a node are
 // consecutive, allocated and freed as a group through a free list. Each node stores its region
@@ -41,6 +41,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -83,8 +84,10 @@ class PrQuadtree {
       check_point(points[i], ("point " + std::to_string(i)).c_str());
       region.expand(points[i]);
     }
-    PrQuadtree t = points.empty() ? PrQuadtree(bucket, max_depth)
-                                  : PrQuadtree(region, bucket, max_depth);
+    for (int a = 0; a < D && !points.empty(); ++a)  // the root is open at the top
+      region.max[a] = std::nextafter(region.max[a], std::numeric_limits<double>::infinity());
+    PrQuadtree t =
+        points.empty() ? PrQuadtree(bucket, max_depth) : PrQuadtree(region, bucket, max_depth);
     t.entries_.reserve(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
       t.insert(points[i], Id(i));
@@ -186,6 +189,14 @@ class PrQuadtree {
       (c >> a & 1 ? b.min[a] : b.max[a]) = r.center(a);
     return b;
   }
+  // The root is half-open, [min, max): a point on its upper boundary would be routed away
+  // from the old root by the cut that growing upwards puts there.
+  bool in_root(const Point<D>& p) const {
+    const Box<D>& r = nodes_[0].region;
+    for (int a = 0; a < D; ++a)
+      if (!(r.min[a] <= p[a] && p[a] < r.max[a])) return false;
+    return true;
+  }
   // Cells are cubes, so that no axis of a line of points is left unsplittable.
   static Box<D> cube(Box<D> r) {
     double side = 0;
@@ -256,7 +267,7 @@ bool PrQuadtree<D>::must_stay_leaf(const Node& x) const {
 
 template <int D>
 void PrQuadtree<D>::grow_towards(const Point<D>& p) {
-  while (!intersects(nodes_[0].region, p)) {
+  while (!in_root(p)) {
     const Box<D> old = nodes_[0].region;
     Box<D> grown = old;
     int slot = 0;  // where the old root goes among the new root's children
@@ -272,7 +283,12 @@ void PrQuadtree<D>::grow_towards(const Point<D>& p) {
     if (!is_finite(grown.min) || !is_finite(grown.max))
       throw InvalidGeometry("point too far from the quadtree's region: " + to_string(p));
     if (nodes_[0].leaf()) {  // nothing to re-route: widen the leaf to fit p
-      nodes_[0].region = cube(merged(old, Box<D>{p, p}));
+      Box<D> r = cube(merged(old, Box<D>{p, p}));
+      for (int a = 0; a < D; ++a)
+        r.max[a] = std::nextafter(r.max[a], std::numeric_limits<double>::infinity());
+      if (!is_finite(r.max))
+        throw InvalidGeometry("point too far from the quadtree's region: " + to_string(p));
+      nodes_[0].region = r;
       continue;
     }
     const std::uint32_t g = allocate_group();
