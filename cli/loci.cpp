@@ -62,8 +62,8 @@ Progress progress_bar(const Args& a, const char* what) {
   if (a.has("--quiet") || !::isatty(STDERR_FILENO)) return {};
   return [what](double f) {
     const int width = 30, filled = int(f * width + 0.5);
-    std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", what, filled, "==============================",
-                 width - filled, "", int(f * 100 + 0.5));
+    std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", what, filled,
+                 "==============================", width - filled, "", int(f * 100 + 0.5));
     if (f >= 1.0) std::fprintf(stderr, "\n");
     std::fflush(stderr);
   };
@@ -80,7 +80,8 @@ std::size_t parse_k(const std::string& text) {
   char* end = nullptr;
   errno = 0;
   const long long k = std::strtoll(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || errno != 0) throw UsageError("bad -k '" + text + "': expected a whole number");
+  if (text.empty() || *end != '\0' || errno != 0)
+    throw UsageError("bad -k '" + text + "': expected a whole number");
   if (k <= 0) throw UsageError("-k must be >= 1 (got " + text + ")");
   return std::size_t(k);
 }
@@ -128,13 +129,15 @@ int run_query(const Args& a) {
   QueryOptions o;
   const std::string& layer = layer_arg(a, "query");
   o.load = load_options(a, layer);
-  const char* kinds[] = {"--bbox", "--bbox-file", "--nearest", "--nearest-file", "--within",
-                         "--segment", "--point"};
+  const char* kinds[] = {"--bbox",   "--bbox-file", "--nearest", "--nearest-file",
+                         "--within", "--segment",   "--point"};
   int given = 0;
-  for (const char* k : kinds) given += a.has(k);
+  for (const char* k : kinds)
+    given += a.has(k);
   if (given != 1)
-    throw UsageError("loci query needs exactly one of --bbox, --bbox-file, --nearest, "
-                     "--nearest-file, --within, --segment, --point");
+    throw UsageError(
+        "loci query needs exactly one of --bbox, --bbox-file, --nearest, "
+        "--nearest-file, --within, --segment, --point");
   const std::size_t k = a.has("-k") ? parse_k(a.get("-k")) : 1;
   Query q;
   q.k = k;
@@ -178,7 +181,8 @@ int run_clip(const Args& a) {
   o.window = parse_bbox(a.get("--bbox"));
   o.out_path = a.get("--output");
   const std::size_t n = clip_layer(o);
-  if (!a.has("--quiet")) std::fprintf(stderr, "loci: %zu features clipped into %s\n", n, o.out_path.c_str());
+  if (!a.has("--quiet"))
+    std::fprintf(stderr, "loci: %zu features clipped into %s\n", n, o.out_path.c_str());
   return 0;
 }
 
@@ -192,7 +196,8 @@ int run_draw(const Args& a) {
   if (a.has("--width")) o.width = int(parse_k(a.get("--width")));
   o.progress = progress_bar(a, "indexing");
   const std::size_t n = draw_index(o);
-  if (!a.has("--quiet")) std::fprintf(stderr, "loci: %zu nodes drawn into %s\n", n, o.out_path.c_str());
+  if (!a.has("--quiet"))
+    std::fprintf(stderr, "loci: %zu nodes drawn into %s\n", n, o.out_path.c_str());
   return 0;
 }
 
@@ -209,28 +214,37 @@ int run_bench(const Args& a) {
   return 0;
 }
 
-const Flag kLayer{"--layer", nullptr, "NAME", "layer of a multi-layer dataset (default: the first)"};
+const Flag kLayer{"--layer", nullptr, "NAME",
+                  "layer of a multi-layer dataset (default: the first)"};
 const Flag kQuiet{"--quiet", "-q", nullptr, "no progress bar and no summary line"};
-const Flag kStructure{"--structure", nullptr, "S",
-                      "packed-hilbert (default), packed-str, rstar or rtree (the last two in memory)"};
+const Flag kStructure{
+    "--structure", nullptr, "S",
+    "packed-hilbert (default), packed-str, rstar or rtree (the last two in memory)"};
 const Flag kPer{"--per", nullptr, "feature|segment",
                 "index one box per feature (default) or one per segment of the linework"};
 const Flag kIndex{"--index", nullptr, "FILE", "sidecar to use (default: LAYER.loci when present)"};
 
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
-      {"info", "loci info LAYER [--layer NAME]",
+      {"info",
+       "loci info LAYER [--layer NAME]",
        "layer summary: features, geometry types, extent, fields, index status",
        {kLayer, kQuiet},
        "  loci info countries.shp\n",
        run_info},
-      {"index", "loci index LAYER [-o FILE] [--structure S] [--per feature|segment] [--layer NAME]",
+      {"index",
+       "loci index LAYER [-o FILE] [--structure S] [--per feature|segment] [--layer NAME]",
        "writes the sidecar index LAYER.loci (or FILE), read by later queries in place",
-       {{"--output", "-o", "FILE", "where to write the index (default: LAYER.loci)"}, kStructure,
-        kPer, kLayer, kQuiet},
+       {{"--output", "-o", "FILE", "where to write the index (default: LAYER.loci)"},
+        kStructure,
+        kPer,
+        kLayer,
+        kQuiet},
        "  loci index countries.shp\n  loci index coastline.geojson --per segment -o coast.loci\n",
        run_index},
-      {"query", "loci query LAYER (--bbox ... | --bbox-file F | --nearest X,Y [-k N] | ...) [-f FMT] [-o OUT]",
+      {"query",
+       "loci query LAYER (--bbox ... | --bbox-file F | --nearest X,Y [-k N] | ...) [-f FMT] [-o "
+       "OUT]",
        "features whose exact geometry meets the query (the index gives candidates)",
        {{"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX", "features meeting the closed window"},
         {"--bbox-file", nullptr, "F", "one window per line; rows start with the line number"},
@@ -241,33 +255,49 @@ const std::vector<Command>& commands() {
         {"--segment", nullptr, "X0,Y0,X1,Y1", "features meeting the closed segment"},
         {"--point", nullptr, "X,Y", "features containing or touching the point"},
         {"--candidates", nullptr, nullptr, "box-level answer from the index, no exact test"},
-        {"--format", "-f", "ids|csv|geojson", "output: FIDs (default), CSV with attributes, GeoJSON"},
+        {"--format", "-f", "ids|csv|geojson",
+         "output: FIDs (default), CSV with attributes, GeoJSON"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
-        kIndex, kStructure, kPer, kLayer, kQuiet},
+        kIndex,
+        kStructure,
+        kPer,
+        kLayer,
+        kQuiet},
        "  loci query countries.shp --bbox 5,45,15,55\n"
        "  loci query countries.shp --nearest 2.35,48.85 -k 3 -f csv\n"
        "  loci query countries.shp --bbox-file windows.txt -o hits.txt\n",
        run_query},
-      {"clip", "loci clip LAYER --bbox XMIN,YMIN,XMAX,YMAX -o OUT",
+      {"clip",
+       "loci clip LAYER --bbox XMIN,YMIN,XMAX,YMAX -o OUT",
        "windowing: the features meeting the window, cut to it (format from OUT's extension)",
        {{"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX", "the window"},
-        {"--output", "-o", "OUT", "output dataset: .geojson, .shp, .gpkg, .fgb, ..."}, kIndex,
-        kStructure, kPer, kLayer, kQuiet},
+        {"--output", "-o", "OUT", "output dataset: .geojson, .shp, .gpkg, .fgb, ..."},
+        kIndex,
+        kStructure,
+        kPer,
+        kLayer,
+        kQuiet},
        "  loci clip countries.shp --bbox 5,45,15,55 -o alps.gpkg\n",
        run_clip},
-      {"draw", "loci draw LAYER|FILE.loci -o OUT.svg [--levels N] [--width PX]",
+      {"draw",
+       "loci draw LAYER|FILE.loci -o OUT.svg [--levels N] [--width PX]",
        "SVG of the layer's linework and the packed index's nodes, one colour per level",
        {{"--output", "-o", "OUT.svg", "the drawing"},
         {"--levels", nullptr, "N", "how many levels to draw, from the root down (default 3)"},
-        {"--width", nullptr, "PX", "width in pixels (default 1200)"}, kPer, kLayer, kQuiet},
+        {"--width", nullptr, "PX", "width in pixels (default 1200)"},
+        kPer,
+        kLayer,
+        kQuiet},
        "  loci draw countries.shp -o countries-index.svg --levels 2\n",
        run_draw},
-      {"bench", "loci bench LAYER [--per feature|segment] [--queries N] [-k N]",
+      {"bench",
+       "loci bench LAYER [--per feature|segment] [--queries N] [-k N]",
        "the layer's boxes in loci's packed R-tree and in Boost.Geometry's rtree, side by side",
        {{"--queries", nullptr, "N", "windows and nearest-n queries to time (default 10000)"},
         {"-k", nullptr, "N", "neighbours per nearest-n query (default 10)"},
         {"--per", nullptr, "feature|segment", "boxes of features or of segments (default segment)"},
-        kLayer, kQuiet},
+        kLayer,
+        kQuiet},
        "  loci bench coastline.geojson --queries 20000\n",
        run_bench},
   };
@@ -277,7 +307,8 @@ const std::vector<Command>& commands() {
 void print_command_help(const Command& c) {
   std::printf("usage: %s\n\n%s\n\noptions:\n", c.usage, c.summary);
   for (const Flag& f : c.flags) {
-    std::string left = f.alias ? std::string(f.alias) + ", " + f.name : std::string("    ") + f.name;
+    std::string left =
+        f.alias ? std::string(f.alias) + ", " + f.name : std::string("    ") + f.name;
     if (f.value) left += std::string(" ") + f.value;
     std::printf("  %-34s %s\n", left.c_str(), f.help);
   }
@@ -300,7 +331,7 @@ Args parse(const Command& c, int argc, char** argv) {
   Args a;
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg.size() < 2 || arg[0] != '-' ) {
+    if (arg.size() < 2 || arg[0] != '-') {
       a.positional.push_back(arg);
       continue;
     }

@@ -28,10 +28,12 @@ std::size_t clip_layer(const ClipOptions& options) {
   OutputDataset out(options.out_path);
   std::size_t written = 0;
   {
-    GDALDatasetUniquePtr ds(driver->Create(out.staging_path().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    GDALDatasetUniquePtr ds(
+        driver->Create(out.staging_path().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
     if (!ds) throw Error("cannot write " + options.out_path + ": " + CPLGetLastErrorMsg());
     const OGRwkbGeometryType type = src.layer->GetGeomType();
-    OGRLayer* layer = ds->CreateLayer(src.layer->GetName(), src.layer->GetSpatialRef(), type, nullptr);
+    OGRLayer* layer =
+        ds->CreateLayer(src.layer->GetName(), src.layer->GetSpatialRef(), type, nullptr);
     if (!layer) throw Error("cannot write " + options.out_path + ": " + CPLGetLastErrorMsg());
     const OGRFeatureDefn* defn = src.layer->GetLayerDefn();
     for (int i = 0; i < defn->GetFieldCount(); ++i) {
@@ -65,7 +67,10 @@ std::size_t clip_layer(const ClipOptions& options) {
         throw Error("cannot write " + options.out_path + ": feature " + std::to_string(a.fid));
       ++written;
     }
-    if (ds->Close() != CE_None) throw Error("cannot write " + options.out_path);
+    // Closing flushes; GDAL reports a failed flush only through its error state.
+    CPLErrorReset();
+    ds.reset();
+    if (CPLGetLastErrorType() == CE_Failure) throw Error("cannot write " + options.out_path);
   }
   out.commit();
   return written;

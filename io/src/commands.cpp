@@ -95,7 +95,8 @@ std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& pa
   std::string line;
   for (std::size_t n = 1; std::getline(in, line); ++n) {
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
-    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' '))
+      line.pop_back();
     Query q;
     q.kind = kind;
     q.k = k;
@@ -119,12 +120,14 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   o << "layer:     " << s.layer_name << " (" << s.driver << ")\n";
   if (s.layer_names.size() > 1) {
     o << "layers:   ";
-    for (const auto& n : s.layer_names) o << ' ' << n;
+    for (const auto& n : s.layer_names)
+      o << ' ' << n;
     o << '\n';
   }
   o << "features:  " << s.feature_count << '\n';
   o << "geometry: ";
-  for (const auto& [type, count] : s.geometry_types) o << ' ' << type << " x" << count;
+  for (const auto& [type, count] : s.geometry_types)
+    o << ' ' << type << " x" << count;
   o << '\n';
   if (!s.extent.is_empty())
     o << "extent:    " << fmt(s.extent.min[0]) << ',' << fmt(s.extent.min[1]) << ','
@@ -132,7 +135,8 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   o << "crs:       " << (s.crs.empty() ? "(none)" : s.crs) << '\n';
   o << "fields:   ";
   if (s.fields.empty()) o << " (none)";
-  for (const auto& [name, type] : s.fields) o << ' ' << name << ':' << type;
+  for (const auto& [name, type] : s.fields)
+    o << ' ' << name << ':' << type;
   o << '\n';
   const std::string sidecar = default_sidecar_path(layer_path);
   o << "index:     ";
@@ -186,7 +190,8 @@ IndexReport index_layer(const IndexOptions& options) {
 }
 
 LayerIndex load_index(const LoadOptions& o, std::string* origin) {
-  const bool dynamic = o.structure && (*o.structure == Structure::rstar || *o.structure == Structure::rtree);
+  const bool dynamic =
+      o.structure && (*o.structure == Structure::rstar || *o.structure == Structure::rtree);
   const std::string path = o.index_path.empty() ? default_sidecar_path(o.layer_path) : o.index_path;
   if (!o.index_path.empty() && !file_exists(path)) throw Error(path + ": no such index file");
   if (!dynamic && file_exists(path)) {
@@ -199,16 +204,17 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin) {
       throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + o.layer_name +
                   "'; give another index file with --index");
     const bool same_per = !o.per || *o.per == sc.info().per;
-    const bool same_packing =
-        !o.structure || (*o.structure == Structure::packed_str) == (sc.info().packing == Packing::str);
+    const bool same_packing = !o.structure || (*o.structure == Structure::packed_str) ==
+                                                  (sc.info().packing == Packing::str);
     if (same_per && same_packing) {
       if (origin) *origin = "sidecar " + path;
       return LayerIndex::adopt(std::move(sc));
     }
   }
   if (origin) *origin = "built in memory";
-  return LayerIndex::build(read_items(o.layer_path, o.layer_name, o.per.value_or(Per::feature), o.progress),
-                           o.structure.value_or(Structure::packed_hilbert));
+  return LayerIndex::build(
+      read_items(o.layer_path, o.layer_name, o.per.value_or(Per::feature), o.progress),
+      o.structure.value_or(Structure::packed_hilbert));
 }
 
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {

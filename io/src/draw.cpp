@@ -62,20 +62,21 @@ std::size_t draw_index(const DrawOptions& options) {
   auto src = detail::open_layer(load.layer_path, index.layer_name());
   std::fprintf(o, "<g fill=\"none\" stroke=\"#555\" stroke-width=\"0.5\">\n");
   for (auto& feature : *src.layer) {
-    detail::for_each_curve(feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
-      const int n = c.getNumPoints();
-      if (n < 2) return;
-      std::fprintf(o, "<path d=\"");
-      long lx = LONG_MIN, ly = LONG_MIN;
-      for (int i = 0; i < n; ++i) {
-        const long px = std::lround(f.x(c.getX(i)) * 10), py = std::lround(f.y(c.getY(i)) * 10);
-        if (px == lx && py == ly && i + 1 < n) continue;
-        std::fprintf(o, "%c%.1f %.1f", i == 0 ? 'M' : 'L', px / 10.0, py / 10.0);
-        lx = px;
-        ly = py;
-      }
-      std::fprintf(o, "\"/>\n");
-    });
+    detail::for_each_curve(
+        feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
+          const int n = c.getNumPoints();
+          if (n < 2) return;
+          std::fprintf(o, "<path d=\"");
+          long lx = LONG_MIN, ly = LONG_MIN;
+          for (int i = 0; i < n; ++i) {
+            const long px = std::lround(f.x(c.getX(i)) * 10), py = std::lround(f.y(c.getY(i)) * 10);
+            if (px == lx && py == ly && i + 1 < n) continue;
+            std::fprintf(o, "%c%.1f %.1f", i == 0 ? 'M' : 'L', px / 10.0, py / 10.0);
+            lx = px;
+            ly = py;
+          }
+          std::fprintf(o, "\"/>\n");
+        });
   }
   std::fprintf(o, "</g>\n");
 
@@ -97,11 +98,11 @@ std::size_t draw_index(const DrawOptions& options) {
                  colours[(levels - 1 - l) % 6], 0.6 + 0.6 * (l - first));
     const std::size_t nb = offset[l + 1] - offset[l];
     for (std::size_t b = 0; b < nb; ++b) {
-      const int used = int(std::min<std::size_t>(PackedRTree2::node_size,
-                                                 count[l] - b * PackedRTree2::node_size));
+      const int used = int(
+          std::min<std::size_t>(PackedRTree2::node_size, count[l] - b * PackedRTree2::node_size));
       const Box2 r = blocks[offset[l] + b].bounds(used);
-      std::fprintf(o, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", f.x(r.min[0]),
-                   f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);
+      std::fprintf(o, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n",
+                   f.x(r.min[0]), f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);
       ++drawn;
     }
     std::fprintf(o, "</g>\n");

@@ -107,7 +107,8 @@ struct LayerQuery::Geometries {
 };
 
 LayerQuery::LayerQuery(const LayerIndex& index, std::string layer_path, std::string layer_name)
-    : index_(index), geometries_(new Geometries{std::move(layer_path), std::move(layer_name), {}, {}}) {}
+    : index_(index),
+      geometries_(new Geometries{std::move(layer_path), std::move(layer_name), {}, {}}) {}
 
 LayerQuery::~LayerQuery() = default;
 
@@ -291,7 +292,8 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
   if (per_segment) {
     index_.window(region.search, [&](const ItemRecord& r, const Box2& b) {
       if (candidates_only) {
-        if (region.box_ok(b)) hit(r.fid, region.with_distance ? std::sqrt(squared_distance(q.point, b)) : kNaN);
+        if (region.box_ok(b))
+          hit(r.fid, region.with_distance ? std::sqrt(squared_distance(q.point, b)) : kNaN);
       } else if (auto d = region.segment_ok(segment_of(b, r.flags))) {
         hit(r.fid, *d);
       }

@@ -117,8 +117,8 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
       if (!is_finite(q)) throw InvalidGeometry(what + " has a NaN or infinite coordinate");
       out.points.push_back(q);
     }
-    out.parts.push_back({at, std::uint32_t(out.points.size()), ring ? PartKind::ring : PartKind::line,
-                         polygon});
+    out.parts.push_back(
+        {at, std::uint32_t(out.points.size()), ring ? PartKind::ring : PartKind::line, polygon});
   });
   out.polygons = polygons;
   return out;
@@ -127,7 +127,8 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
 GDALDriver* driver_for(const std::string& path) {
   GDALAllRegister();
   std::string ext = CPLGetExtension(path.c_str());
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   const char* name = "GeoJSON";
   if (ext == "shp")
     name = "ESRI Shapefile";
@@ -157,19 +158,17 @@ std::vector<SegmentRecord> read_segments(const std::string& path, const std::str
   for (auto& feature : *ol.layer) {
     const std::int64_t fid = feature->GetFID();
     std::int32_t part = 0;
-    detail::for_each_curve(feature->GetGeometryRef(),
-                           [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
-                             const int n = c.getNumPoints();
-                             for (int i = 0; i + 1 < n; ++i) {
-                               const Segment<2> s{{c.getX(i), c.getY(i)},
-                                                  {c.getX(i + 1), c.getY(i + 1)}};
-                               if (!is_finite(s.a) || !is_finite(s.b))
-                                 throw InvalidGeometry(where(path, fid) +
-                                                       " has a NaN or infinite coordinate");
-                               out.push_back({s, fid, part});
-                             }
-                             ++part;
-                           });
+    detail::for_each_curve(
+        feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
+          const int n = c.getNumPoints();
+          for (int i = 0; i + 1 < n; ++i) {
+            const Segment<2> s{{c.getX(i), c.getY(i)}, {c.getX(i + 1), c.getY(i + 1)}};
+            if (!is_finite(s.a) || !is_finite(s.b))
+              throw InvalidGeometry(where(path, fid) + " has a NaN or infinite coordinate");
+            out.push_back({s, fid, part});
+          }
+          ++part;
+        });
   }
   return out;
 }
@@ -193,8 +192,8 @@ namespace {
 
 bool is_polygonal(const OGRGeometry* g) {
   const auto t = wkbFlatten(g->getGeometryType());
-  return t == wkbPolygon || t == wkbMultiPolygon || t == wkbCurvePolygon ||
-         t == wkbMultiSurface || t == wkbGeometryCollection;
+  return t == wkbPolygon || t == wkbMultiPolygon || t == wkbCurvePolygon || t == wkbMultiSurface ||
+         t == wkbGeometryCollection;
 }
 
 void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& path,

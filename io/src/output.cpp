@@ -103,14 +103,15 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
   CPLErrorReset();
   GDALDatasetUniquePtr ds(driver->Create(target.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
   if (!ds) throw Error("cannot write GeoJSON: " + std::string(CPLGetLastErrorMsg()));
-  OGRLayer* layer = ds->CreateLayer(ol.layer->GetName(), ol.layer->GetSpatialRef(), wkbUnknown,
-                                    nullptr);
+  OGRLayer* layer =
+      ds->CreateLayer(ol.layer->GetName(), ol.layer->GetSpatialRef(), wkbUnknown, nullptr);
   if (!layer) throw Error("cannot create the GeoJSON layer: " + std::string(CPLGetLastErrorMsg()));
   std::vector<std::pair<int, int>> copied;  // source field, output field
   int out_index = 0;
   auto add_field = [&](const char* name, OGRFieldType type) {
     OGRFieldDefn fd(name, type);
-    if (layer->CreateField(&fd) != OGRERR_NONE) throw Error("cannot create field " + std::string(name));
+    if (layer->CreateField(&fd) != OGRERR_NONE)
+      throw Error("cannot create field " + std::string(name));
     return out_index++;
   };
   const int query_field = numbered ? add_field("query", OFTInteger64) : -1;
@@ -137,7 +138,10 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
     if (layer->CreateFeature(&out) != OGRERR_NONE)
       throw Error("cannot write feature " + std::to_string(a.fid) + " as GeoJSON");
   }
-  if (ds->Close() != CE_None) throw Error("cannot finish the GeoJSON output");
+  // Closing flushes; GDAL reports a failed flush only through its error state.
+  CPLErrorReset();
+  ds.reset();
+  if (CPLGetLastErrorType() == CE_Failure) throw Error("cannot finish the GeoJSON output");
 }
 
 }  // namespace
@@ -175,7 +179,8 @@ OutputFile::~OutputFile() {
 
 void OutputFile::commit() {
   if (path_.empty()) {
-    if (std::fflush(stream_) != 0) throw Error(std::string("cannot write output (") + std::strerror(errno) + ")");
+    if (std::fflush(stream_) != 0)
+      throw Error(std::string("cannot write output (") + std::strerror(errno) + ")");
     committed_ = true;
     return;
   }

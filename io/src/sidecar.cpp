@@ -317,7 +317,8 @@ Sidecar Sidecar::open(const std::string& path) {
   };
   if (h.item_count >= (1ull << 32) || h.block_count != expect_blocks ||
       h.slot_count != expect_slots || h.blocks_offset % kAlign != 0 ||
-      !fits(h.name_offset, h.name_size, 1) || !fits(h.blocks_offset, h.block_count, sizeof(Block)) ||
+      !fits(h.name_offset, h.name_size, 1) ||
+      !fits(h.blocks_offset, h.block_count, sizeof(Block)) ||
       !fits(h.items_offset, h.slot_count, 4) || !fits(h.records_offset, h.item_count, 16))
     throw refuse("corrupt index file (inconsistent sizes)");
   if (h.payload_checksum !=

@@ -61,9 +61,9 @@ IndexReport index_layer(const IndexOptions& options);
 struct LoadOptions {
   std::string layer_path;
   std::string layer_name;
-  std::string index_path;                // empty: default_sidecar_path(layer_path)
-  std::optional<Structure> structure;    // set: build that structure in memory if needed
-  std::optional<Per> per;                // set: the granularity wanted
+  std::string index_path;              // empty: default_sidecar_path(layer_path)
+  std::optional<Structure> structure;  // set: build that structure in memory if needed
+  std::optional<Per> per;              // set: the granularity wanted
   Progress progress;
 };
 
@@ -73,11 +73,11 @@ LayerIndex load_index(const LoadOptions& options, std::string* origin = nullptr)
 struct QueryOptions {
   LoadOptions load;
   std::vector<std::pair<std::size_t, Query>> queries;  // number, query
-  bool numbered = false;     // batch output: every row starts with the query number
-  bool candidates = false;   // box-level answers only
+  bool numbered = false;    // batch output: every row starts with the query number
+  bool candidates = false;  // box-level answers only
   Format format = Format::ids;
-  std::string out_path;      // empty: `fallback`
-  Progress progress;         // over the queries of a batch
+  std::string out_path;  // empty: `fallback`
+  Progress progress;     // over the queries of a batch
 };
 
 struct QueryReport {
@@ -97,7 +97,8 @@ struct ClipOptions {
 std::size_t clip_layer(const ClipOptions& options);
 
 struct DrawOptions {
-  std::string path;  // a layer, or a .loci sidecar (then the layer is the sidecar's name minus .loci)
+  std::string
+      path;  // a layer, or a .loci sidecar (then the layer is the sidecar's name minus .loci)
   std::string layer_name;
   std::string out_path;
   int width = 1200;

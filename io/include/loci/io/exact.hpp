@@ -26,8 +26,8 @@ namespace loci::io {
 enum class PartKind : std::uint8_t { point, line, ring };
 
 struct Part {
-  std::uint32_t begin;    // first point in FlatGeometry::points
-  std::uint32_t end;      // one past the last
+  std::uint32_t begin;  // first point in FlatGeometry::points
+  std::uint32_t end;    // one past the last
   PartKind kind;
   std::uint32_t polygon;  // rings only: which polygon of the feature the ring bounds
 };

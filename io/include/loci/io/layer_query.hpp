@@ -70,7 +70,9 @@ class LayerIndex {
   void window(const Box2& w, Visit&& visit) const {
     std::visit(
         [&](const auto& t) {
-          t.query(w, [&](Id id, const Box2& b) { return id < records_.size() ? visit(records_[id], b) : true; });
+          t.query(w, [&](Id id, const Box2& b) {
+            return id < records_.size() ? visit(records_[id], b) : true;
+          });
         },
         tree_);
   }

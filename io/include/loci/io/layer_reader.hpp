@@ -39,15 +39,15 @@ std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::st
 
 // What one index entry stands for. 16 bytes, trivially copyable: stored as is in sidecars.
 struct ItemRecord {
-  std::int64_t fid;    // the feature id GDAL reports
-  std::int32_t part;   // per segment: the line or ring within the feature; per feature: 0
+  std::int64_t fid;     // the feature id GDAL reports
+  std::int32_t part;    // per segment: the line or ring within the feature; per feature: 0
   std::uint32_t flags;  // ItemFlags
 };
 static_assert(sizeof(ItemRecord) == 16);
 
 enum ItemFlags : std::uint32_t {
-  item_ring = 1u,           // the segment lies on a polygon ring
-  item_antidiagonal = 2u,   // the segment runs from (min x, max y) to (max x, min y) of its box
+  item_ring = 1u,          // the segment lies on a polygon ring
+  item_antidiagonal = 2u,  // the segment runs from (min x, max y) to (max x, min y) of its box
 };
 
 // The segment an entry of a per-segment index stands for, recovered from its box and flags.

@@ -41,8 +41,8 @@
 namespace loci::io {
 
 struct Fingerprint {
-  std::uint64_t size = 0;      // bytes
-  std::int64_t mtime_ns = 0;   // latest modification time of the files hashed
+  std::uint64_t size = 0;     // bytes
+  std::int64_t mtime_ns = 0;  // latest modification time of the files hashed
   std::uint64_t hash = 0;
   friend bool operator==(const Fingerprint&, const Fingerprint&) = default;
 };
