@@ -1,0 +1,479 @@
+// The `loci` executable end to end on small layers the suite makes itself with GDAL: a
+// polygon shapefile (holes, multipolygons), a line shapefile (multilines) and a point
+// shapefile, from a fixed seed. Every `-f ids` answer is compared with a brute force over all
+// features through OGR's geometry (GEOS), for both granularities, with and without a sidecar;
+// then every error the command line promises to report, and the sidecar's defences against
+// truncation, corruption and a layer that changed after indexing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "layers/cli_support.hpp"
+
+namespace fs = std::filesystem;
+using namespace loci::test;
+
+namespace {
+
+fs::path g_dir;
+
+OGRLinearRing star(double cx, double cy, double r, std::mt19937_64& rng, bool reverse = false) {
+  std::uniform_real_distribution<double> u(0.5, 1.0);
+  const int n = 5 + int(rng() % 8);
+  OGRLinearRing ring;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * (reverse ? n - i : i) / n;
+    const double rr = r * u(rng);
+    ring.addPoint(cx + rr * std::cos(a), cy + rr * std::sin(a));
+  }
+  ring.closeRings();
+  return ring;
+}
+
+OGRPolygon star_polygon(double cx, double cy, double r, std::mt19937_64& rng, bool hole) {
+  OGRPolygon p;
+  OGRLinearRing outer = star(cx, cy, r, rng);
+  p.addRing(&outer);
+  if (hole) {
+    // The outer ring's radius is at least r / 2; a square of half-side r / 4 fits inside.
+    const double h = r / 4;
+    OGRLinearRing inner;
+    inner.addPoint(cx - h, cy - h);
+    inner.addPoint(cx - h, cy + h);
+    inner.addPoint(cx + h, cy + h);
+    inner.addPoint(cx + h, cy - h);
+    inner.closeRings();
+    p.addRing(&inner);
+  }
+  return p;
+}
+
+void write_layer(const fs::path& path, OGRwkbGeometryType type,
+                 const std::function<std::unique_ptr<OGRGeometry>(int)>& make, int count) {
+  GDALDriver* d = GetGDALDriverManager()->GetDriverByName("ESRI Shapefile");
+  GDALDatasetUniquePtr ds(d->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+  ASSERT_TRUE(ds);
+  OGRLayer* layer = ds->CreateLayer(path.stem().c_str(), nullptr, type, nullptr);
+  OGRFieldDefn label("label", OFTString);
+  layer->CreateField(&label);
+  for (int i = 0; i < count; ++i) {
+    OGRFeature f(layer->GetLayerDefn());
+    f.SetField(0, ("f," + std::to_string(i)).c_str());
+    f.SetGeometryDirectly(make(i).release());
+    ASSERT_EQ(layer->CreateFeature(&f), OGRERR_NONE);
+  }
+}
+
+void make_layers() {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> pos(0, 100), rad(1, 8);
+  write_layer(
+      g_dir / "polys.shp", wkbMultiPolygon,
+      [&](int i) -> std::unique_ptr<OGRGeometry> {
+        auto mp = std::make_unique<OGRMultiPolygon>();
+        const double cx = pos(rng), cy = pos(rng), r = rad(rng);
+        OGRPolygon a = star_polygon(cx, cy, r, rng, i % 3 == 0);
+        mp->addGeometry(&a);
+        if (i % 4 == 1) {  // a second, disjoint part
+          OGRPolygon b = star_polygon(cx + 3 * r + 10, cy, r, rng, false);
+          mp->addGeometry(&b);
+        }
+        return mp;
+      },
+      60);
+  write_layer(
+      g_dir / "lines.shp", wkbMultiLineString,
+      [&](int i) -> std::unique_ptr<OGRGeometry> {
+        auto ml = std::make_unique<OGRMultiLineString>();
+        for (int part = 0; part < 1 + (i % 3 == 0); ++part) {
+          OGRLineString l;
+          double x = pos(rng), y = pos(rng);
+          const int n = 2 + int(rng() % 12);
+          for (int k = 0; k < n; ++k) {
+            l.addPoint(x, y);
+            x += rad(rng) - 4.5;
+            y += rad(rng) - 4.5;
+          }
+          ml->addGeometry(&l);
+        }
+        return ml;
+      },
+      60);
+  write_layer(
+      g_dir / "points.shp", wkbPoint,
+      [&](int) -> std::unique_ptr<OGRGeometry> {
+        return std::make_unique<OGRPoint>(pos(rng), pos(rng));
+      },
+      50);
+  // A layer with no geometry column and a file that is no layer at all.
+  std::ofstream(g_dir / "table.csv") << "a,b\n1,2\n3,4\n";
+  std::ofstream(g_dir / "garbage.geojson") << "this is not a layer\n";
+}
+
+class LayersCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    GDALAllRegister();
+    g_dir = fs::temp_directory_path() / ("loci-layers-" + std::to_string(::getpid()));
+    fs::remove_all(g_dir);
+    fs::create_directories(g_dir);
+    make_layers();
+  }
+  static void TearDownTestSuite() { fs::remove_all(g_dir); }
+  static std::string path(const std::string& name) { return (g_dir / name).string(); }
+};
+
+struct Window {
+  double x0, y0, x1, y1;
+};
+
+// Random windows, plus windows that only touch a vertex of some feature and degenerate ones.
+std::vector<Window> windows_for(const OgrFeatureSet& s, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> pos(-5, 105), size(0.5, 25);
+  std::vector<Window> w;
+  for (int i = 0; i < 30; ++i) {
+    const double x = pos(rng), y = pos(rng);
+    w.push_back({x, y, x + size(rng), y + size(rng)});
+  }
+  for (int i = 0; i < 10; ++i) {
+    const OGRGeometry* g = s.geoms[rng() % s.geoms.size()].get();
+    OGREnvelope e;
+    g->getEnvelope(&e);
+    // The window's top-right corner is the feature's lowest-left envelope corner: it touches
+    // the feature only when a vertex sits there, which GEOS and loci must agree on.
+    w.push_back({e.MinX - 3, e.MinY - 3, e.MinX, e.MinY});
+    w.push_back({e.MaxX, e.MinY, e.MaxX, e.MaxY});  // degenerate: a vertical segment
+  }
+  return w;
+}
+
+void check_windows(const std::string& layer, const std::string& extra, std::uint64_t seed) {
+  const OgrFeatureSet s = read_with_ogr(layer);
+  ASSERT_FALSE(s.fids.empty());
+  const auto windows = windows_for(s, seed);
+  const std::string file = layer + ".windows";
+  {
+    std::ofstream out(file);
+    out.precision(17);
+    for (const auto& w : windows)
+      out << w.x0 << ',' << w.y0 << ',' << w.x1 << ',' << w.y1 << '\n';
+  }
+  const CliRun r =
+      run_loci("query " + shell_quote(layer) + " --bbox-file " + shell_quote(file) + extra);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto got = parse_ids(r.out, windows.size());
+  std::size_t hits = 0;
+  for (std::size_t i = 0; i < windows.size(); ++i) {
+    const auto& w = windows[i];
+    const auto expected = brute_intersects(s, *ogr_box(w.x0, w.y0, w.x1, w.y1));
+    EXPECT_EQ(got[i + 1], expected) << layer << extra << " window " << i + 1;
+    hits += expected.size();
+  }
+  EXPECT_GT(hits, windows.size() / 2);  // the comparison must have had something to compare
+}
+
+void check_nearest(const std::string& layer, const std::string& extra, std::uint64_t seed) {
+  const OgrFeatureSet s = read_with_ogr(layer);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> pos(-10, 110);
+  const std::string file = layer + ".points";
+  std::vector<std::pair<double, double>> points;
+  {
+    std::ofstream out(file);
+    out.precision(17);
+    for (int i = 0; i < 12; ++i) {
+      points.emplace_back(pos(rng), pos(rng));
+      out << points.back().first << ',' << points.back().second << '\n';
+    }
+  }
+  const std::size_t k = 5;
+  const CliRun r = run_loci("query " + shell_quote(layer) + " --nearest-file " + shell_quote(file) +
+                            " -k 5 -f csv" + extra);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = lines(r.out);
+  ASSERT_EQ(rows.size(), 1 + points.size() * k);
+  EXPECT_EQ(rows[0], "query,fid,distance,label");
+  for (std::size_t q = 0; q < points.size(); ++q) {
+    const auto brute = brute_distances(s, points[q].first, points[q].second);
+    for (std::size_t i = 0; i < k; ++i) {
+      std::istringstream in(rows[1 + q * k + i]);
+      std::string number, fid, dist;
+      std::getline(in, number, ',');
+      std::getline(in, fid, ',');
+      std::getline(in, dist, ',');
+      ASSERT_EQ(std::stoul(number), q + 1);
+      const double d = std::stod(dist);
+      const double tol = 1e-9 * (1 + brute[i].first);
+      EXPECT_NEAR(d, brute[i].first, tol) << layer << extra << " point " << q + 1 << " rank " << i;
+      // The reported distance is the feature's own, not only the rank's.
+      auto it = std::find_if(brute.begin(), brute.end(),
+                             [&](const auto& b) { return b.second == std::stoll(fid); });
+      ASSERT_NE(it, brute.end());
+      EXPECT_NEAR(it->first, d, tol);
+    }
+  }
+}
+
+// --point, --segment and --within, a few of each.
+void check_singles(const std::string& layer, const std::string& extra, std::uint64_t seed) {
+  const OgrFeatureSet s = read_with_ogr(layer);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> pos(0, 100), len(-15, 15);
+  char buf[200];
+  for (int i = 0; i < 3; ++i) {
+    const double x = pos(rng), y = pos(rng), x1 = x + len(rng), y1 = y + len(rng), d = 4 + i;
+    std::snprintf(buf, sizeof buf, " --segment %.17g,%.17g,%.17g,%.17g", x, y, x1, y1);
+    CliRun r = run_loci("query " + shell_quote(layer) + buf + extra);
+    ASSERT_EQ(r.status, 0) << r.err;
+    OGRLineString seg;
+    seg.addPoint(x, y);
+    seg.addPoint(x1, y1);
+    EXPECT_EQ(parse_ids(r.out, 1)[1], brute_intersects(s, seg)) << buf;
+
+    std::snprintf(buf, sizeof buf, " --within %.17g,%.17g,%.17g", x, y, d);
+    r = run_loci("query " + shell_quote(layer) + buf + extra);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::vector<long long> expected;
+    for (const auto& [dist, fid] : brute_distances(s, x, y))
+      if (dist <= d) expected.push_back(fid);
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(parse_ids(r.out, 1)[1], expected) << buf;
+
+    // A point inside a random feature's envelope, and one of its vertices.
+    const std::size_t f = rng() % s.geoms.size();
+    const OGREnvelope& e = s.envelopes[f];
+    const double px = (e.MinX + e.MaxX) / 2, py = (e.MinY + e.MaxY) / 2;
+    std::snprintf(buf, sizeof buf, " --point %.17g,%.17g", px, py);
+    r = run_loci("query " + shell_quote(layer) + buf + extra);
+    ASSERT_EQ(r.status, 0) << r.err;
+    OGRPoint p(px, py);
+    EXPECT_EQ(parse_ids(r.out, 1)[1], brute_intersects(s, p)) << buf;
+  }
+}
+
+}  // namespace
+
+class LayersExact : public LayersCli,
+                    public ::testing::WithParamInterface<std::tuple<const char*, const char*>> {};
+
+TEST_P(LayersExact, MatchesOgrBruteForce) {
+  const auto [name, per] = GetParam();
+  const std::string layer = path(name);
+  const std::string extra = std::string(" --per ") + per;
+  // In memory first, then through a sidecar of that granularity.
+  fs::remove(layer + ".loci");
+  check_windows(layer, extra, 1);
+  CliRun r = run_loci("index " + shell_quote(layer) + extra + " -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(fs::exists(layer + ".loci"));
+  check_windows(layer, "", 2);
+  check_nearest(layer, "", 3);
+  check_singles(layer, "", 4);
+  fs::remove(layer + ".loci");
+}
+
+INSTANTIATE_TEST_SUITE_P(Layers, LayersExact,
+                         ::testing::Combine(::testing::Values("polys.shp", "lines.shp",
+                                                              "points.shp"),
+                                            ::testing::Values("feature", "segment")),
+                         [](const auto& info) {
+                           return std::string(std::get<0>(info.param))
+                                      .substr(0, std::string(std::get<0>(info.param)).find('.')) +
+                                  "_" + std::get<1>(info.param);
+                         });
+
+TEST_F(LayersCli, CandidatesAreASupersetOfTheExactAnswer) {
+  const std::string layer = path("polys.shp");
+  const char* window = " --bbox 20,20,45,40";
+  const CliRun exact = run_loci("query " + layer + window);
+  const CliRun boxes = run_loci("query " + layer + window + " --candidates");
+  ASSERT_EQ(exact.status, 0);
+  ASSERT_EQ(boxes.status, 0);
+  const auto e = parse_ids(exact.out, 1)[1], c = parse_ids(boxes.out, 1)[1];
+  EXPECT_TRUE(std::includes(c.begin(), c.end(), e.begin(), e.end()));
+  // Envelopes overlap the window more often than the stars themselves do.
+  const OgrFeatureSet s = read_with_ogr(layer);
+  std::vector<long long> env;
+  for (std::size_t i = 0; i < s.fids.size(); ++i)
+    if (s.envelopes[i].MaxX >= 20 && s.envelopes[i].MinX <= 45 && s.envelopes[i].MaxY >= 20 &&
+        s.envelopes[i].MinY <= 40)
+      env.push_back(s.fids[i]);
+  EXPECT_EQ(c, env);
+}
+
+TEST_F(LayersCli, CsvAndGeoJsonCarryAttributes) {
+  const std::string layer = path("polys.shp");
+  CliRun r = run_loci("query " + layer + " --bbox 0,0,100,100 -f csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = lines(r.out);
+  ASSERT_EQ(rows.size(), 61u);
+  EXPECT_EQ(rows[0], "fid,label");
+  EXPECT_EQ(rows[1], "0,\"f,0\"");
+  const std::string out = path("answer.geojson");
+  r = run_loci("query " + layer + " --bbox 0,0,100,100 -f geojson -o " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const OgrFeatureSet s = read_with_ogr(out);
+  EXPECT_EQ(s.fids.size(), 60u);
+  fs::remove(out);
+}
+
+TEST_F(LayersCli, ClipCutsToTheWindow) {
+  const std::string out = path("clipped.shp");
+  const CliRun r = run_loci("clip " + path("polys.shp") + " --bbox 20,20,60,60 -q -o " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const OgrFeatureSet s = read_with_ogr(out);
+  ASSERT_FALSE(s.fids.empty());
+  for (const auto& e : s.envelopes) {
+    EXPECT_GE(e.MinX, 20 - 1e-9);
+    EXPECT_LE(e.MaxX, 60 + 1e-9);
+  }
+  for (const char* ext : {".shp", ".shx", ".dbf"})
+    fs::remove(path(std::string("clipped") + ext));
+}
+
+TEST_F(LayersCli, DrawWritesAnSvg) {
+  const std::string out = path("index.svg");
+  const CliRun r = run_loci("draw " + path("lines.shp") + " -q --levels 2 -o " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string svg = read_text(out);
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("<rect x="), std::string::npos);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+}
+
+TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
+  const std::string layer = path("lines.shp");
+  fs::remove(layer + ".loci");
+  CliRun r = run_loci("info " + layer);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("features:  60"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("index:     none"), std::string::npos) << r.out;
+  ASSERT_EQ(run_loci("index -q " + layer).status, 0);
+  r = run_loci("info " + layer);
+  EXPECT_NE(r.out.find("fresh"), std::string::npos) << r.out;
+  fs::remove(layer + ".loci");
+}
+
+TEST_F(LayersCli, HelpDocumentsEveryCommand) {
+  const CliRun top = run_loci("--help");
+  EXPECT_EQ(top.status, 0);
+  for (const char* c : {"info", "index", "query", "clip", "draw", "bench"}) {
+    EXPECT_NE(top.out.find(std::string("  ") + c), std::string::npos) << c;
+    const CliRun h = run_loci(std::string(c) + " --help");
+    EXPECT_EQ(h.status, 0);
+    EXPECT_NE(h.out.find("examples:"), std::string::npos) << c;
+  }
+  EXPECT_NE(run_loci("query --help").out.find("--bbox-file"), std::string::npos);
+}
+
+// ---- errors: one line, exit 1, no partial output ----
+
+void expect_error(const std::string& args, const std::string& fragment) {
+  const CliRun r = run_loci(args);
+  EXPECT_EQ(r.status, 1) << args << "\n" << r.err;
+  EXPECT_EQ(r.err.rfind("loci: error: ", 0), 0u) << args << "\n" << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(fragment), std::string::npos) << args << "\n" << r.err;
+  EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
+}
+
+TEST_F(LayersCli, ReportsBadInput) {
+  const std::string polys = path("polys.shp");
+  expect_error("query " + path("missing.shp") + " --bbox 0,0,1,1", "no such file");
+  expect_error("index " + path("missing.shp"), "no such file");
+  expect_error("query " + path("garbage.geojson") + " --bbox 0,0,1,1", "cannot open");
+  expect_error("query " + path("table.csv") + " --bbox 0,0,1,1", "has no geometry");
+  expect_error("query " + polys + " --layer nope --bbox 0,0,1,1", "no layer named 'nope'");
+  expect_error("query " + polys + " --bbox 0,0,1", "bad bbox '0,0,1'");
+  expect_error("query " + polys + " --bbox a,b,c,d", "bad bbox");
+  expect_error("query " + polys + " --bbox 5,0,1,1", "XMIN > XMAX");
+  expect_error("query " + polys + " --nearest 1,1 -k 0", "-k must be >= 1");
+  expect_error("query " + polys + " --nearest 1,1 -k -3", "-k must be >= 1");
+  expect_error("query " + polys + " --nearest 1,1 -k x", "bad -k");
+  expect_error("query " + polys, "exactly one of");
+  expect_error("query " + polys + " --bbox 0,0,1,1 --frobnicate", "unknown option --frobnicate");
+  expect_error("query " + polys + " --bbox 0,0,1,1 -f xml", "unknown format 'xml'");
+  expect_error("index " + polys + " --structure rstar", "built in memory only");
+  expect_error("frobnicate", "unknown command");
+  const std::string windows = path("bad.windows");
+  std::ofstream(windows) << "0,0,1,1\n0,0,x,1\n";
+  expect_error("query " + polys + " --bbox-file " + windows, "line 2");
+}
+
+TEST_F(LayersCli, UnwritableOutputLeavesNothing) {
+  const std::string polys = path("polys.shp");
+  expect_error("query " + polys + " --bbox 0,0,50,50 -o /nonexistent-dir/out.txt", "cannot write");
+  expect_error("query " + polys + " --bbox 0,0,50,50 -f geojson -o /nonexistent-dir/o.geojson",
+               "cannot write");
+  expect_error("index " + polys + " -o /nonexistent-dir/x.loci", "cannot write");
+  expect_error("clip " + polys + " --bbox 0,0,50,50 -o /nonexistent-dir/c.shp", "cannot write");
+  // A failing query does not leave its output behind either.
+  const std::string out = path("never.txt");
+  expect_error("query " + polys + " --nearest 1,1 -k 0 -o " + out, "-k must be >= 1");
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(g_dir))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
+  const std::string layer = path("lines.shp"), sidecar = layer + ".loci";
+  ASSERT_EQ(run_loci("index -q --per segment " + layer).status, 0);
+  const std::string good = read_text(sidecar);
+  ASSERT_GT(good.size(), 1000u);
+  const std::string query = "query " + layer + " --bbox 10,10,60,60";
+  std::mt19937_64 rng(5);
+  auto put = [&](const std::string& bytes) { std::ofstream(sidecar, std::ios::binary) << bytes; };
+  for (std::size_t cut : {std::size_t(0), std::size_t(5), std::size_t(8), std::size_t(100),
+                          std::size_t(256), std::size_t(300), good.size() / 2, good.size() - 1}) {
+    put(good.substr(0, cut));
+    const CliRun r = run_loci(query);
+    EXPECT_EQ(r.status, 1) << "cut at " << cut << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("loci: error: ", 0), 0u) << r.err;
+  }
+  for (int i = 0; i < 12; ++i) {  // one flipped byte anywhere: header or payload
+    std::string bad = good;
+    const std::size_t at = i < 4 ? std::size_t(8 + 20 * i) : rng() % bad.size();
+    bad[at] = char(bad[at] ^ (1 + rng() % 255));
+    put(bad);
+    const CliRun r = run_loci(query);
+    EXPECT_EQ(r.status, 1) << "byte " << at;
+    EXPECT_NE(r.err.find(sidecar), std::string::npos) << r.err;
+  }
+  put(good + "extra");
+  expect_error(query, "damaged index");
+  put(good);
+  EXPECT_EQ(run_loci(query).status, 0);
+  fs::remove(sidecar);
+}
+
+TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {
+  // A copy, so that other tests keep their layer.
+  for (const char* ext : {".shp", ".shx", ".dbf"})
+    fs::copy_file(path(std::string("polys") + ext), path(std::string("stale") + ext),
+                  fs::copy_options::overwrite_existing);
+  const std::string layer = path("stale.shp");
+  ASSERT_EQ(run_loci("index -q " + layer).status, 0);
+  ASSERT_EQ(run_loci("query " + layer + " --bbox 0,0,9,9").status, 0);
+  // Touched only: newer than the index, so the index is refused as make would.
+  fs::last_write_time(layer, fs::last_write_time(layer) + std::chrono::seconds(5));
+  expect_error("query " + layer + " --bbox 0,0,9,9", "stale index");
+  // Really changed: a feature added through GDAL.
+  ASSERT_EQ(run_loci("index -q " + layer).status, 0);
+  {
+    GDALDatasetUniquePtr ds(GDALDataset::Open(layer.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE));
+    ASSERT_TRUE(ds);
+    OGRLayer* l = ds->GetLayer(0);
+    OGRFeature f(l->GetLayerDefn());
+    std::mt19937_64 rng(9);
+    OGRPolygon p = star_polygon(5, 5, 3, rng, false);
+    f.SetGeometry(&p);
+    ASSERT_EQ(l->CreateFeature(&f), OGRERR_NONE);
+  }
+  expect_error("query " + layer + " --bbox 0,0,9,9 -o " + path("stale.txt"), "stale index");
+  EXPECT_FALSE(fs::exists(path("stale.txt")));
+  const CliRun info = run_loci("info " + layer);
+  EXPECT_NE(info.out.find("stale"), std::string::npos) << info.out;
+}
