@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# loci against GDAL's own shapefile spatial index (.qix) on the Natural Earth layers:
+#   1. index time: `loci index` vs `ogrinfo -sql "CREATE SPATIAL INDEX ON ..."`
+#   2. a batch of N windows (default 1000): one `loci query --bbox-file` vs N `ogrinfo -spat`
+#      runs on the .qix-indexed shapefile, both giving the features whose exact geometry meets
+#      the window; the FID sets must be identical.
+# Usage: ogr_qix_compare.sh [LOCI_EXE] [N]. Needs datasets/fetch.sh to have filled the cache.
+# Windows come from a fixed seed, so every run times the same batch.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../../.." && pwd)
+loci=${1:-$root/build/cli/loci}
+n=${2:-1000}
+work=${LOCI_BENCH_DIR:-$root/build/bench-layers}
+mkdir -p "$work"
+export OGR_GEOJSON_MAX_OBJ_SIZE=0
+
+now() { date +%s.%N; }
+elapsed() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", b - a }'; }
+
+# N windows inside lon [-170, 170], lat [-60, 75], 0.2 to 12 degrees wide.
+awk -v n="$n" 'BEGIN { srand(2024); for (i = 0; i < n; i++) {
+  x = -170 + 340 * rand(); y = -60 + 135 * rand(); w = 0.2 + 11.8 * rand(); h = w / 2;
+  printf "%.6f,%.6f,%.6f,%.6f\n", x, y, x + w, y + h } }' > "$work/windows.txt"
+
+for name in countries-land-10m countries-coastline-1m; do
+  src="$root/datasets/cache/$name/map.geo.json"
+  [ -s "$src" ] || { echo "skip $name: run datasets/fetch.sh"; continue; }
+  shp="$work/$name.shp"
+  [ -s "$shp" ] || ogr2ogr -f "ESRI Shapefile" -nln "$name" "$shp" "$src"
+  rm -f "$work/$name.qix" "$shp.loci"
+
+  t0=$(now); "$loci" index -q "$shp"; t1=$(now)
+  ogrinfo -q "$shp" -sql "CREATE SPATIAL INDEX ON \"$name\"" >/dev/null; t2=$(now)
+  index_loci=$(elapsed "$t0" "$t1"); index_ogr=$(elapsed "$t1" "$t2")
+
+  t0=$(now); "$loci" query -q "$shp" --bbox-file "$work/windows.txt" > "$work/$name.loci.txt"; t1=$(now)
+  : > "$work/$name.ogr.txt"
+  i=0
+  while IFS=, read -r x0 y0 x1 y1; do
+    i=$((i + 1))
+    ogrinfo -ro -q -al -geom=NO -spat "$x0" "$y0" "$x1" "$y1" "$shp" |
+      sed -n 's/^OGRFeature([^)]*):\([0-9]*\)$/\1/p' | awk -v q="$i" '{ print q, $1 }' >> "$work/$name.ogr.txt"
+  done < "$work/windows.txt"
+  t2=$(now)
+  query_loci=$(elapsed "$t0" "$t1"); query_ogr=$(elapsed "$t1" "$t2")
+
+  if cmp -s <(sort "$work/$name.loci.txt") <(sort "$work/$name.ogr.txt"); then same=identical; else same=DIFFERENT; fi
+  hits=$(wc -l < "$work/$name.loci.txt")
+  echo "$name: index loci ${index_loci}s vs ogrinfo .qix ${index_ogr}s;" \
+    "$n windows ($hits answers, $same): loci ${query_loci}s vs ogrinfo -spat ${query_ogr}s," \
+    "$(awk -v a="$query_ogr" -v b="$query_loci" 'BEGIN { printf "%.1f", a / b }')x"
+  [ "$same" = identical ] || exit 1
+done
