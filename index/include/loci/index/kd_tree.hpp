@@ -482,18 +482,28 @@ QueryStats KdTree<D, Bucket>::nearest(const Point<D>& p, std::size_t k, Visit&& 
   check_point(p, "query point");
   if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
   if (root_ == kNone) return {};
-  // `q` is best_first's sink, which drops whatever lies beyond the k-th best entry so far
+  // `q` is best_first's sink, which drops whatever lies beyond the k-th best entry so far.
+  // An expansion walks down the nearer child to a leaf and queues only the farther siblings:
+  // half the queue operations of queueing both, and the best candidates are found first.
   auto expand = [&](std::uint64_t ref, auto& q) -> std::size_t {
-    const Node& x = nodes_[std::uint32_t(ref)];
-    if (!x.leaf()) {
-      q.push_subtree(squared_distance(p, nodes_[x.left].box), x.left);
-      q.push_subtree(squared_distance(p, nodes_[x.right].box), x.right);
-      return 2;
+    std::uint32_t n = std::uint32_t(ref);
+    std::size_t tested = 0;
+    while (!nodes_[n].leaf()) {
+      const Node& x = nodes_[n];
+      const double dl = squared_distance(p, nodes_[x.left].box);
+      const double dr = squared_distance(p, nodes_[x.right].box);
+      tested += 2;
+      const bool left_first = dl <= dr;
+      q.push_subtree(left_first ? dr : dl, left_first ? x.right : x.left);
+      n = left_first ? x.left : x.right;
+      if constexpr (requires { q.bound(); })
+        if ((left_first ? dl : dr) > q.bound()) return tested;
     }
+    const Node& x = nodes_[n];
     const std::size_t base = std::size_t(x.right) * Bucket;
     for (std::size_t i = 0; i < x.size; ++i)
       q.push_entry(squared_distance(p, points_[base + i]), base + i, ids_[base + i]);
-    return x.size;
+    return tested + x.size;
   };
   auto report = [&](Id id, std::uint64_t pos, double d) {
     return visit(id, Box<D>::of_point(points_[pos]), d);

@@ -343,6 +343,7 @@ QueryStats PackedRTree<D, NodeSize>::query(const Box<D>& window, Visit&& visit,
     }
     while (hits) {
       const std::size_t e = base + detail::pop_lowest(hits);
+      block(level - 1, e).prefetch();
       stack.push_back((std::uint64_t(level - 1) << 32) | e);
     }
   }
@@ -363,12 +364,11 @@ QueryStats PackedRTree<D, NodeSize>::nearest(const Point<D>& p, std::size_t k,
     const int used = int(std::min<std::size_t>(NodeSize, level_count_[level] - base));
     double d2[NodeSize];
     block(level, b).squared_distances(p, d2);
-    for (int i = 0; i < used; ++i) {
-      if (level == 0)
-        sink.push_entry(d2[i], base + i, Id(items_[base + i]));
-      else
-        sink.push_subtree(d2[i], (std::uint64_t(level - 1) << 32) | (base + i));
-    }
+    if (level == 0)
+      sink.push_entries(
+          d2, used, [&](int i) { return base + i; }, [&](int i) { return Id(items_[base + i]); });
+    else
+      sink.push_subtrees(d2, used, [&](int i) { return (std::uint64_t(level - 1) << 32) | (base + i); });
     return std::size_t(used);
   };
   auto report = [&](Id id, std::uint64_t pos, double d) { return visit(id, leaf_box(pos), d); };

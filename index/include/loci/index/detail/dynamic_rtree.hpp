@@ -432,12 +432,11 @@ QueryStats DynamicRTree<D, M, P>::nearest(const Point<D>& p, std::size_t k, Visi
     const Node& nd = node(std::uint32_t(ref));
     double d2[M];
     nd.boxes.squared_distances(p, d2);
-    for (int i = 0; i < nd.count; ++i) {
-      if (nd.level == 0)
-        sink.push_entry(d2[i], ref * M + i, Id(nd.slot[i]));
-      else
-        sink.push_subtree(d2[i], nd.slot[i]);
-    }
+    if (nd.level == 0)
+      sink.push_entries(
+          d2, nd.count, [&](int i) { return ref * M + i; }, [&](int i) { return Id(nd.slot[i]); });
+    else
+      sink.push_subtrees(d2, nd.count, [&](int i) { return nd.slot[i]; });
     return std::size_t(nd.count);
   };
   auto report = [&](Id id, std::uint64_t ref, double d) {
