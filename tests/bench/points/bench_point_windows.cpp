@@ -6,6 +6,7 @@
 // each structure's speed relative to PackedRTree.
 #include <boost/geometry.hpp>
 #include <boost/geometry/index/rtree.hpp>
+#include <boost/iterator/function_output_iterator.hpp>
 #include <cstdio>
 #include <random>
 
