@@ -4,7 +4,8 @@
 #   2. a batch of N windows (default 1000): one `loci query --bbox-file` vs N `ogrinfo -spat`
 #      runs on the .qix-indexed shapefile, both giving the features whose exact geometry meets
 #      the window; the FID sets must be identical.
-# Usage: ogr_qix_compare.sh [LOCI_EXE] [N]. Needs datasets/fetch.sh to have filled the cache.
+# Usage: ogr_qix_compare.sh [LOCI_EXE] [N]; LOCI_BENCH_LAYERS picks layers, LOCI_BENCH_DIR the
+# working directory (shapefiles made there by ogr2ogr on first use). Needs datasets/fetch.sh to have filled the cache.
 # Windows come from a fixed seed, so every run times the same batch.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -23,7 +24,7 @@ awk -v n="$n" 'BEGIN { srand(2024); for (i = 0; i < n; i++) {
   x = -170 + 340 * rand(); y = -60 + 135 * rand(); w = 0.2 + 11.8 * rand(); h = w / 2;
   printf "%.6f,%.6f,%.6f,%.6f\n", x, y, x + w, y + h } }' > "$work/windows.txt"
 
-for name in countries-land-10m countries-coastline-1m; do
+for name in ${LOCI_BENCH_LAYERS:-countries-land-10m countries-coastline-1m}; do
   src="$root/datasets/cache/$name/map.geo.json"
   [ -s "$src" ] || { echo "skip $name: run datasets/fetch.sh"; continue; }
   shp="$work/$name.shp"
