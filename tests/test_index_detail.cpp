@@ -21,12 +21,14 @@ template <int D, class Key>
 void expect_hilbert_walk(int k, Key key) {
   const std::uint32_t side = 1u << k;
   std::size_t cells = 1;
-  for (int a = 0; a < D; ++a) cells *= side;
+  for (int a = 0; a < D; ++a)
+    cells *= side;
   std::vector<std::pair<std::uint64_t, std::array<std::uint32_t, D>>> walk;
   for (std::size_t c = 0; c < cells; ++c) {
     std::array<std::uint32_t, D> x;
     std::size_t rest = c;
-    for (int a = 0; a < D; ++a) x[a] = std::uint32_t(rest % side), rest /= side;
+    for (int a = 0; a < D; ++a)
+      x[a] = std::uint32_t(rest % side), rest /= side;
     walk.push_back({key(x), x});
   }
   std::sort(walk.begin(), walk.end());
@@ -34,7 +36,8 @@ void expect_hilbert_walk(int k, Key key) {
     ASSERT_EQ(walk[i].first, i);
     if (i == 0) continue;
     int steps = 0;
-    for (int a = 0; a < D; ++a) steps += std::abs(int(walk[i].second[a]) - int(walk[i - 1].second[a]));
+    for (int a = 0; a < D; ++a)
+      steps += std::abs(int(walk[i].second[a]) - int(walk[i - 1].second[a]));
     ASSERT_EQ(steps, 1) << "keys " << i - 1 << " and " << i << " are not adjacent";
   }
 }
@@ -93,14 +96,18 @@ TEST(RadixSort, MatchesStableSort) {
 TEST(StrTile, GroupsAreSlabsThenTiles) {
   std::mt19937_64 rng(5);
   std::vector<Point2> pts(1000);
-  for (auto& p : pts) p = test::random_point<2>(rng);
+  for (auto& p : pts)
+    p = test::random_point<2>(rng);
   std::vector<std::size_t> cuts;
-  for (std::size_t c = 0; c <= 1000; c += 100) cuts.push_back(c);  // 10 groups: 4 slabs
-  str_tile<2>(pts.data(), std::span<const std::size_t>(cuts), [](const Point2& p, int a) { return p[a]; });
+  for (std::size_t c = 0; c <= 1000; c += 100)
+    cuts.push_back(c);  // 10 groups: 4 slabs
+  str_tile<2>(pts.data(), std::span<const std::size_t>(cuts),
+              [](const Point2& p, int a) { return p[a]; });
   // slabs of 3 groups (300 points) are ordered along x
   for (std::size_t s = 0; s + 1 < 4; ++s) {
     double max_x = -1, next_min_x = 1e18;
-    for (std::size_t i = s * 300; i < std::min<std::size_t>(1000, (s + 1) * 300); ++i) max_x = std::max(max_x, pts[i][0]);
+    for (std::size_t i = s * 300; i < std::min<std::size_t>(1000, (s + 1) * 300); ++i)
+      max_x = std::max(max_x, pts[i][0]);
     for (std::size_t i = (s + 1) * 300; i < std::min<std::size_t>(1000, (s + 2) * 300); ++i)
       next_min_x = std::min(next_min_x, pts[i][0]);
     EXPECT_LE(max_x, next_min_x);
@@ -108,8 +115,10 @@ TEST(StrTile, GroupsAreSlabsThenTiles) {
   // within a slab, groups are ordered along y
   for (std::size_t g = 0; g + 1 < 3; ++g) {
     double max_y = -1, next_min_y = 1e18;
-    for (std::size_t i = g * 100; i < (g + 1) * 100; ++i) max_y = std::max(max_y, pts[i][1]);
-    for (std::size_t i = (g + 1) * 100; i < (g + 2) * 100; ++i) next_min_y = std::min(next_min_y, pts[i][1]);
+    for (std::size_t i = g * 100; i < (g + 1) * 100; ++i)
+      max_y = std::max(max_y, pts[i][1]);
+    for (std::size_t i = (g + 1) * 100; i < (g + 2) * 100; ++i)
+      next_min_y = std::min(next_min_y, pts[i][1]);
     EXPECT_LE(max_y, next_min_y);
   }
 }
@@ -119,7 +128,8 @@ TEST(SoaBoxes, MasksMatchScalarTests) {
   SoaBoxes<3, 16> node;
   node.clear();
   const auto boxes = test::make_boxes<3>(test::Shape::uniform, 12, 8);  // 4 slots stay empty
-  for (int i = 0; i < 12; ++i) node.set(i, boxes[i]);
+  for (int i = 0; i < 12; ++i)
+    node.set(i, boxes[i]);
   for (int q = 0; q < 500; ++q) {
     const auto w = test::random_window<3>(rng, 600);
     std::uint32_t meets = 0, in = 0, holds = 0;
@@ -134,6 +144,7 @@ TEST(SoaBoxes, MasksMatchScalarTests) {
     double d2[16];
     const Point3 p = test::random_point<3>(rng);
     node.squared_distances(p, d2);
-    for (int i = 0; i < 12; ++i) ASSERT_DOUBLE_EQ(d2[i], squared_distance(p, boxes[i]));
+    for (int i = 0; i < 12; ++i)
+      ASSERT_DOUBLE_EQ(d2[i], squared_distance(p, boxes[i]));
   }
 }

@@ -97,7 +97,8 @@ double time_ms(const std::function<void()>& f) {
 
 double median_ms(int reps, const std::function<void()>& f) {
   std::vector<double> t;
-  for (int r = 0; r < reps; ++r) t.push_back(time_ms(f));
+  for (int r = 0; r < reps; ++r)
+    t.push_back(time_ms(f));
   return median(t);
 }
 
@@ -106,7 +107,8 @@ double median_ms(int reps, const std::function<void()>& f) {
 std::vector<loci::Box2> make_windows(const std::vector<loci::Box2>& boxes, std::size_t count,
                                      double target, std::mt19937_64& rng) {
   std::vector<loci::Point2> centres(count);
-  for (auto& c : centres) c = boxes[rng() % boxes.size()].center();
+  for (auto& c : centres)
+    c = boxes[rng() % boxes.size()].center();
   const auto tree = loci::PackedRTree2::build(boxes);
   auto windows_of = [&](double side) {
     std::vector<loci::Box2> w(count);
@@ -118,7 +120,8 @@ std::vector<loci::Box2> make_windows(const std::vector<loci::Box2>& boxes, std::
   auto mean_hits = [&](double side) {
     const auto w = windows_of(side);
     std::size_t hits = 0;
-    for (std::size_t i = 0; i < std::min<std::size_t>(count, 500); ++i) hits += tree.query(w[i]).size();
+    for (std::size_t i = 0; i < std::min<std::size_t>(count, 500); ++i)
+      hits += tree.query(w[i]).size();
     return double(hits) / double(std::min<std::size_t>(count, 500));
   };
   double lo = 0, hi = std::max(tree.bounds().extent(0), tree.bounds().extent(1));
@@ -137,7 +140,8 @@ Workload coastline(const Options& o) {
     std::printf("workload A skipped: %s is missing (run datasets/fetch.sh)\n", path.c_str());
     return w;
   }
-  for (const auto& s : loci::io::read_segments(path)) w.boxes.push_back(s.segment.box());
+  for (const auto& s : loci::io::read_segments(path))
+    w.boxes.push_back(s.segment.box());
   std::mt19937_64 rng(42);
   std::shuffle(w.boxes.begin(), w.boxes.end(), rng);
   if (w.boxes.size() > o.n) w.boxes.resize(o.n);
@@ -155,7 +159,9 @@ Workload uniform(const Options& o) {
   return w;
 }
 
-BBox to_boost(const loci::Box2& b) { return {{b.min[0], b.min[1]}, {b.max[0], b.max[1]}}; }
+BBox to_boost(const loci::Box2& b) {
+  return {{b.min[0], b.min[1]}, {b.max[0], b.max[1]}};
+}
 
 struct Result {
   double build_ms = 0;
@@ -191,7 +197,8 @@ PHASE loci::PackedRTree2 loci_pack(const std::vector<loci::Box2>& boxes, loci::P
 
 template <class Tree>
 PHASE void loci_insert_all(Tree& t, const std::vector<loci::Box2>& boxes) {
-  for (std::size_t i = 0; i < boxes.size(); ++i) t.insert(boxes[i], i);
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    t.insert(boxes[i], i);
 }
 
 template <class Tree>
@@ -252,7 +259,8 @@ PHASE double boost_nearest(const Tree& t, const std::vector<BPoint>& ps) {
   for (const auto& p : ps) {
     out.clear();
     t.query(bgi::nearest(p, 10), std::back_inserter(out));
-    for (const auto& v : out) sum += bg::distance(p, v.first);
+    for (const auto& v : out)
+      sum += bg::distance(p, v.first);
   }
   return sum;
 }
@@ -264,17 +272,21 @@ PHASE void boost_pack(std::unique_ptr<BoostTree<Params>>& t, const std::vector<B
 
 template <class Params>
 PHASE void boost_insert_all(BoostTree<Params>& t, const std::vector<BValue>& values) {
-  for (const auto& v : values) t.insert(v);
+  for (const auto& v : values)
+    t.insert(v);
 }
 
 template <class Params>
 Result run_boost(const Workload& w, const Options& o, bool packed) {
   std::vector<BValue> values;
-  for (std::size_t i = 0; i < w.boxes.size(); ++i) values.push_back({to_boost(w.boxes[i]), std::uint32_t(i)});
+  for (std::size_t i = 0; i < w.boxes.size(); ++i)
+    values.push_back({to_boost(w.boxes[i]), std::uint32_t(i)});
   std::vector<BBox> ws;
-  for (const auto& b : w.windows) ws.push_back(to_boost(b));
+  for (const auto& b : w.windows)
+    ws.push_back(to_boost(b));
   std::vector<BPoint> ps;
-  for (const auto& p : w.points) ps.push_back({p[0], p[1]});
+  for (const auto& p : w.points)
+    ps.push_back({p[0], p[1]});
   Result r;
   std::unique_ptr<BoostTree<Params>> t;
   std::vector<double> times;
@@ -301,10 +313,12 @@ Result run_boost(const Workload& w, const Options& o, bool packed) {
 PHASE GEOSSTRtree* geos_build(GEOSContextHandle_t ctx, const std::vector<GEOSGeometry*>& geoms,
                               std::vector<std::uint32_t>& items) {
   GEOSSTRtree* t = GEOSSTRtree_create_r(ctx, 10);
-  for (std::size_t i = 0; i < geoms.size(); ++i) GEOSSTRtree_insert_r(ctx, t, geoms[i], &items[i]);
+  for (std::size_t i = 0; i < geoms.size(); ++i)
+    GEOSSTRtree_insert_r(ctx, t, geoms[i], &items[i]);
   // GEOS 3.11 builds lazily on the first query: make that happen inside the build time.
   GEOSGeometry* nothing = GEOSGeom_createRectangle_r(ctx, 1e300, 1e300, 1e300, 1e300);
-  GEOSSTRtree_query_r(ctx, t, nothing, [](void*, void*) {}, nullptr);
+  GEOSSTRtree_query_r(
+      ctx, t, nothing, [](void*, void*) {}, nullptr);
   GEOSGeom_destroy_r(ctx, nothing);
   return t;
 }
@@ -313,7 +327,8 @@ PHASE std::size_t geos_windows(GEOSContextHandle_t ctx, GEOSSTRtree* t,
                                const std::vector<GEOSGeometry*>& ws) {
   std::size_t hits = 0;
   for (auto* w : ws)
-    GEOSSTRtree_query_r(ctx, t, w, [](void*, void* n) { ++*static_cast<std::size_t*>(n); }, &hits);
+    GEOSSTRtree_query_r(
+        ctx, t, w, [](void*, void* n) { ++*static_cast<std::size_t*>(n); }, &hits);
   return hits;
 }
 
@@ -336,8 +351,10 @@ Result run_geos(const Workload& w, const Options& o) {
   r.window_ms = median_ms(o.reps, [&] { r.window_hits = geos_windows(ctx, t, ws); });
   r.has_window = true;
   GEOSSTRtree_destroy_r(ctx, t);
-  for (auto* g : geoms) GEOSGeom_destroy_r(ctx, g);
-  for (auto* g : ws) GEOSGeom_destroy_r(ctx, g);
+  for (auto* g : geoms)
+    GEOSGeom_destroy_r(ctx, g);
+  for (auto* g : ws)
+    GEOSGeom_destroy_r(ctx, g);
   GEOS_finish_r(ctx);
   return r;
 }
@@ -382,7 +399,8 @@ struct CountVisitor : SpatialIndex::IVisitor {
 
 PHASE std::size_t sidx_windows(SpatialIndex::ISpatialIndex& t, const std::vector<loci::Box2>& ws) {
   CountVisitor v;
-  for (const auto& w : ws) t.intersectsWithQuery(SpatialIndex::Region(w.min.c, w.max.c, 2), v);
+  for (const auto& w : ws)
+    t.intersectsWithQuery(SpatialIndex::Region(w.min.c, w.max.c, 2), v);
   return v.hits;
 }
 
@@ -402,18 +420,22 @@ PHASE SpatialIndex::ISpatialIndex* sidx_build(SpatialIndex::IStorageManager& sm,
   SpatialIndex::id_type index_id;
   if (bulk) {
     BoxStream stream(boxes);
-    return SpatialIndex::RTree::createAndBulkLoadNewRTree(SpatialIndex::RTree::BLM_STR, stream, sm, 0.7,
-                                                          16, 16, 2, SpatialIndex::RTree::RV_RSTAR, index_id);
+    return SpatialIndex::RTree::createAndBulkLoadNewRTree(SpatialIndex::RTree::BLM_STR, stream, sm,
+                                                          0.7, 16, 16, 2,
+                                                          SpatialIndex::RTree::RV_RSTAR, index_id);
   }
-  auto* t = SpatialIndex::RTree::createNewRTree(sm, 0.7, 16, 16, 2, SpatialIndex::RTree::RV_RSTAR, index_id);
+  auto* t = SpatialIndex::RTree::createNewRTree(sm, 0.7, 16, 16, 2, SpatialIndex::RTree::RV_RSTAR,
+                                                index_id);
   for (std::size_t i = 0; i < boxes.size(); ++i)
-    t->insertData(0, nullptr, SpatialIndex::Region(boxes[i].min.c, boxes[i].max.c, 2), SpatialIndex::id_type(i));
+    t->insertData(0, nullptr, SpatialIndex::Region(boxes[i].min.c, boxes[i].max.c, 2),
+                  SpatialIndex::id_type(i));
   return t;
 }
 
 Result run_sidx(const Workload& w, const Options& o, bool bulk) {
   Result r;
-  std::unique_ptr<SpatialIndex::IStorageManager> sm(SpatialIndex::StorageManager::createNewMemoryStorageManager());
+  std::unique_ptr<SpatialIndex::IStorageManager> sm(
+      SpatialIndex::StorageManager::createNewMemoryStorageManager());
   std::unique_ptr<SpatialIndex::ISpatialIndex> t;
   r.build_ms = time_ms([&] { t.reset(sidx_build(*sm, w.boxes, bulk)); });
   const int reps = std::max(1, o.reps / 2);
@@ -429,9 +451,13 @@ bool run_workload(Workload w, const Options& o) {
   if (w.boxes.empty()) return true;
   std::mt19937_64 rng(99);
   w.windows = make_windows(w.boxes, o.queries, 100.0, rng);
-  for (std::size_t i = 0; i < o.queries; ++i) w.points.push_back(w.boxes[rng() % w.boxes.size()].center());
-  std::printf("\n== workload %s: %zu boxes, %zu windows (side %.4g), %zu nearest-10 queries, median of %d\n",
-              w.name.c_str(), w.boxes.size(), w.windows.size(), w.windows[0].extent(0), w.points.size(), o.reps);
+  for (std::size_t i = 0; i < o.queries; ++i)
+    w.points.push_back(w.boxes[rng() % w.boxes.size()].center());
+  std::printf(
+      "\n== workload %s: %zu boxes, %zu windows (side %.4g), %zu nearest-10 queries, median of "
+      "%d\n",
+      w.name.c_str(), w.boxes.size(), w.windows.size(), w.windows[0].extent(0), w.points.size(),
+      o.reps);
 
   std::vector<std::pair<std::string, Result>> rows;
   auto add = [&](const std::string& name, auto&& run) {
@@ -451,11 +477,15 @@ bool run_workload(Workload w, const Options& o) {
   add("GEOS STRtree (cap 10)", [&] { return run_geos(w, o); });
   add("libspatialindex STR (cap 16)", [&] { return run_sidx(w, o, true); });
   add("loci RStarTree<16> insert", [&] { return run_loci_inserted<loci::RStarTree2>(w, o); });
-  add("loci RTree quadratic<16> insert", [&] { return run_loci_inserted<loci::RTree<2, loci::QuadraticSplit>>(w, o); });
-  add("loci RTree linear<16> insert", [&] { return run_loci_inserted<loci::RTree<2, loci::LinearSplit>>(w, o); });
+  add("loci RTree quadratic<16> insert",
+      [&] { return run_loci_inserted<loci::RTree<2, loci::QuadraticSplit>>(w, o); });
+  add("loci RTree linear<16> insert",
+      [&] { return run_loci_inserted<loci::RTree<2, loci::LinearSplit>>(w, o); });
   add("Boost rtree insert rstar<16>", [&] { return run_boost<bgi::rstar<16>>(w, o, false); });
-  add("Boost rtree insert quadratic<16>", [&] { return run_boost<bgi::quadratic<16>>(w, o, false); });
-  if (o.slow_peers) add("libspatialindex R* insert (cap 16)", [&] { return run_sidx(w, o, false); });
+  add("Boost rtree insert quadratic<16>",
+      [&] { return run_boost<bgi::quadratic<16>>(w, o, false); });
+  if (o.slow_peers)
+    add("libspatialindex R* insert (cap 16)", [&] { return run_sidx(w, o, false); });
 
   if (rows.empty()) return true;
   // Every structure must agree, or the figures mean nothing.
@@ -463,35 +493,58 @@ bool run_workload(Workload w, const Options& o) {
   const Result& ref = rows.front().second;
   for (const auto& [name, r] : rows) {
     if (r.has_window && r.window_hits != ref.window_hits) {
-      std::printf("MISMATCH: %s found %zu window hits, loci %zu\n", name.c_str(), r.window_hits, ref.window_hits);
+      std::printf("MISMATCH: %s found %zu window hits, loci %zu\n", name.c_str(), r.window_hits,
+                  ref.window_hits);
       ok = false;
     }
-    if (r.has_nearest && std::fabs(r.nearest_sum - ref.nearest_sum) > 1e-6 * (1 + ref.nearest_sum)) {
-      std::printf("MISMATCH: %s nearest distances sum %.9g, loci %.9g\n", name.c_str(), r.nearest_sum, ref.nearest_sum);
+    if (r.has_nearest &&
+        std::fabs(r.nearest_sum - ref.nearest_sum) > 1e-6 * (1 + ref.nearest_sum)) {
+      std::printf("MISMATCH: %s nearest distances sum %.9g, loci %.9g\n", name.c_str(),
+                  r.nearest_sum, ref.nearest_sum);
       ok = false;
     }
   }
   std::printf("answers agree: %s (%zu window hits, %.1f per window)\n", ok ? "yes" : "NO",
               ref.window_hits, double(ref.window_hits) / double(o.queries));
 
-  auto get = [&](const std::string& n) -> const Result& {
+  auto find = [&](const std::string& n) -> const Result* {
     for (const auto& [name, r] : rows)
-      if (name == n) return r;
-    return ref;
+      if (name == n) return &r;
+    return nullptr;
   };
-  const Result& hil = get("loci PackedRTree (Hilbert)");
-  const Result& bpack = get("Boost rtree pack rstar<16>");
-  const Result& geos = get("GEOS STRtree (cap 10)");
-  const Result& rstar = get("loci RStarTree<16> insert");
-  const Result& brstar = get("Boost rtree insert rstar<16>");
   std::printf("ratios (higher is better for loci, target in brackets):\n");
-  std::printf("  PackedRTree windows/s vs Boost packed     %5.2fx  [>= 2.0]\n", bpack.window_ms / hil.window_ms);
-  std::printf("  PackedRTree windows/s vs GEOS STRtree     %5.2fx  [>= 1.5]\n", geos.window_ms / hil.window_ms);
-  std::printf("  PackedRTree nearest-10/s vs Boost packed  %5.2fx  [>= 2.0]\n", bpack.nearest_ms / hil.nearest_ms);
-  std::printf("  PackedRTree build time / Boost packing    %5.2f   [<= 0.5]\n", hil.build_ms / bpack.build_ms);
-  std::printf("  PackedRTree bytes per box / Boost packed  %5.2f   [<= 1.0]\n", hil.bytes_per_box / bpack.bytes_per_box);
-  std::printf("  RStarTree insert time / Boost rstar<16>   %5.2f   [<= 0.5]\n", rstar.build_ms / brstar.build_ms);
-  std::printf("  RStarTree windows/s vs Boost R*-built     %5.2fx  [>= 1.0]\n", brstar.window_ms / rstar.window_ms);
+  // loci's figure over the peer's for times (lower is better), the inverse for rates
+  auto ratio = [&](const char* label, const char* ours, const char* peer,
+                   double (*f)(const Result&, const Result&), const char* target) {
+    const Result* a = find(ours);
+    const Result* b = find(peer);
+    if (a && b) std::printf("  %-42s %6.2f   [%s]\n", label, f(*a, *b), target);
+  };
+  const char* hil = "loci PackedRTree (Hilbert)";
+  const char* bpack = "Boost rtree pack rstar<16>";
+  const char* rstar = "loci RStarTree<16> insert";
+  const char* brstar = "Boost rtree insert rstar<16>";
+  ratio(
+      "PackedRTree windows/s vs Boost packed", hil, bpack,
+      [](const Result& a, const Result& b) { return b.window_ms / a.window_ms; }, ">= 2.0");
+  ratio(
+      "PackedRTree windows/s vs GEOS STRtree", hil, "GEOS STRtree (cap 10)",
+      [](const Result& a, const Result& b) { return b.window_ms / a.window_ms; }, ">= 1.5");
+  ratio(
+      "PackedRTree nearest-10/s vs Boost packed", hil, bpack,
+      [](const Result& a, const Result& b) { return b.nearest_ms / a.nearest_ms; }, ">= 2.0");
+  ratio(
+      "PackedRTree build time / Boost packing", hil, bpack,
+      [](const Result& a, const Result& b) { return a.build_ms / b.build_ms; }, "<= 0.5");
+  ratio(
+      "PackedRTree bytes per box / Boost packed", hil, bpack,
+      [](const Result& a, const Result& b) { return a.bytes_per_box / b.bytes_per_box; }, "<= 1.0");
+  ratio(
+      "RStarTree insert time / Boost rstar<16>", rstar, brstar,
+      [](const Result& a, const Result& b) { return a.build_ms / b.build_ms; }, "<= 0.5");
+  ratio(
+      "RStarTree windows/s vs Boost R*-built", rstar, brstar,
+      [](const Result& a, const Result& b) { return b.window_ms / a.window_ms; }, ">= 1.0");
   return ok;
 }
 
@@ -508,12 +561,18 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--n") o.n = std::stoul(next());
-    else if (a == "--queries") o.queries = std::stoul(next());
-    else if (a == "--reps") o.reps = std::max(1, std::stoi(next()));
-    else if (a == "--workload") o.workload = next();
-    else if (a == "--no-slow-peers") o.slow_peers = false;
-    else if (a == "--only") o.only = next();
+    if (a == "--n")
+      o.n = std::stoul(next());
+    else if (a == "--queries")
+      o.queries = std::stoul(next());
+    else if (a == "--reps")
+      o.reps = std::max(1, std::stoi(next()));
+    else if (a == "--workload")
+      o.workload = next();
+    else if (a == "--no-slow-peers")
+      o.slow_peers = false;
+    else if (a == "--only")
+      o.only = next();
     else {
       std::fprintf(stderr,
                    "usage: bench_rtree [--n N] [--queries Q] [--reps R] "

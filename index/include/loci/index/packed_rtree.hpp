@@ -260,7 +260,8 @@ void PackedRTree<D, NodeSize>::order_hilbert(std::vector<Item>& items) const {
   }
   detail::radix_sort(keyed, D * detail::hilbert_bits<D>());
   std::vector<Item> sorted(items.size());
-  for (std::size_t i = 0; i < items.size(); ++i) sorted[i] = items[keyed[i].index];
+  for (std::size_t i = 0; i < items.size(); ++i)
+    sorted[i] = items[keyed[i].index];
   items.swap(sorted);
 }
 
@@ -368,7 +369,8 @@ QueryStats PackedRTree<D, NodeSize>::nearest(const Point<D>& p, std::size_t k,
       sink.push_entries(
           d2, used, [&](int i) { return base + i; }, [&](int i) { return Id(items_[base + i]); });
     else
-      sink.push_subtrees(d2, used, [&](int i) { return (std::uint64_t(level - 1) << 32) | (base + i); });
+      sink.push_subtrees(d2, used,
+                         [&](int i) { return (std::uint64_t(level - 1) << 32) | (base + i); });
     return std::size_t(used);
   };
   auto report = [&](Id id, std::uint64_t pos, double d) { return visit(id, leaf_box(pos), d); };

@@ -51,6 +51,7 @@
 #include "loci/geom/box.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/best_first.hpp"
+#include "loci/index/detail/hilbert.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/query.hpp"
 
@@ -89,7 +90,20 @@ class PrQuadtree {
     PrQuadtree t =
         points.empty() ? PrQuadtree(bucket, max_depth) : PrQuadtree(region, bucket, max_depth);
     t.entries_.reserve(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i)
+    // inserting along a Hilbert curve puts each leaf's entries, and each subtree's nodes,
+    // next to each other in the pools: window queries then read memory in order
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> order(points.size());
+    constexpr double kCells = double((1u << detail::hilbert_bits<D>()) - 1);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      std::uint32_t g[D];
+      for (int a = 0; a < D; ++a) {
+        const double e = region.extent(a);
+        g[a] = e > 0 ? std::uint32_t((points[i][a] - region.min[a]) / e * kCells) : 0;
+      }
+      order[i] = {detail::hilbert_key<D>(g), std::uint32_t(i)};
+    }
+    std::sort(order.begin(), order.end());
+    for (const auto& [key, i] : order)
       t.insert(points[i], Id(i));
     return t;
   }

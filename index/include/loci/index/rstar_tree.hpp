@@ -59,8 +59,8 @@ struct RStarInsertion {
       }
       total += after - before;
     }
-    // j == i contributed content(grown) - content(old); take it back out.
-    return total - (grown.content() - old.content());
+    // j == i adds nothing: grown covers old, so both overlaps are content(old).
+    return total;
   }
 
   template <int D, int M>

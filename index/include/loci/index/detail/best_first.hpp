@@ -70,7 +70,8 @@ class BestFirstSink {
     if (sorted_) {
       if (best_.size() < k_) best_.emplace_back();
       std::size_t i = best_.size() - 1;  // the slot to fill: new, or the worst one dropped
-      for (; i > 0 && best_[i - 1].d2 > d2; --i) best_[i] = best_[i - 1];
+      for (; i > 0 && best_[i - 1].d2 > d2; --i)
+        best_[i] = best_[i - 1];
       best_[i] = {d2, ref, id};
       if (best_.size() == k_) bound_ = best_.back().d2;
       return;
@@ -138,7 +139,8 @@ class BestFirstSink {
   std::uint64_t within_bound(const double* d2, int count) const {
     std::uint64_t m = 0;
     const double b = bound_;
-    for (int i = 0; i < count; ++i) m |= std::uint64_t(d2[i] <= b) << i;
+    for (int i = 0; i < count; ++i)
+      m |= std::uint64_t(d2[i] <= b) << i;
     return m;
   }
 

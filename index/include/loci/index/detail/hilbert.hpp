@@ -29,15 +29,24 @@ namespace hilbert2 {
 // Orientation states: 0 identity, 1 transpose, 2 anti-transpose, 3 half turn.
 constexpr unsigned apply(unsigned state, unsigned x, unsigned y, unsigned& cx, unsigned& cy) {
   switch (state) {
-    case 1: cx = y, cy = x; break;
-    case 2: cx = 1 - y, cy = 1 - x; break;
-    case 3: cx = 1 - x, cy = 1 - y; break;
-    default: cx = x, cy = y;
+    case 1:
+      cx = y, cy = x;
+      break;
+    case 2:
+      cx = 1 - y, cy = 1 - x;
+      break;
+    case 3:
+      cx = 1 - x, cy = 1 - y;
+      break;
+    default:
+      cx = x, cy = y;
   }
   return 0;
 }
 // Product in the Klein four-group {I, S, A, R}: S*A = R, S*R = A, A*R = S.
-constexpr unsigned compose(unsigned a, unsigned b) { return a ^ b; }
+constexpr unsigned compose(unsigned a, unsigned b) {
+  return a ^ b;
+}
 
 struct Step {
   std::uint8_t digits;  // four base-4 digits, most significant first

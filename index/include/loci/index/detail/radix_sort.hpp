@@ -22,14 +22,16 @@ inline void radix_sort(std::vector<KeyedIndex>& v, int bits) {
   std::vector<KeyedIndex> tmp(v.size());
   for (int shift = 0; shift < bits; shift += kDigit) {
     std::array<std::size_t, kBuckets> count{};
-    for (const auto& x : v) ++count[(x.key >> shift) & (kBuckets - 1)];
+    for (const auto& x : v)
+      ++count[(x.key >> shift) & (kBuckets - 1)];
     std::size_t sum = 0;
     for (auto& c : count) {
       const std::size_t n = c;
       c = sum;
       sum += n;
     }
-    for (const auto& x : v) tmp[count[(x.key >> shift) & (kBuckets - 1)]++] = x;
+    for (const auto& x : v)
+      tmp[count[(x.key >> shift) & (kBuckets - 1)]++] = x;
     v.swap(tmp);
   }
 }

@@ -40,7 +40,8 @@ struct SoaBoxes {
   // overlaps the memory latency with the work on the nodes before it.
   void prefetch() const {
     const char* p = reinterpret_cast<const char*>(this);
-    for (std::size_t off = 0; off < sizeof(SoaBoxes); off += 64) __builtin_prefetch(p + off);
+    for (std::size_t off = 0; off < sizeof(SoaBoxes); off += 64)
+      __builtin_prefetch(p + off);
   }
 
   Box<D> box(int i) const {
@@ -79,23 +80,23 @@ struct SoaBoxes {
 
   // Bit i set when child i meets w.
   Mask intersecting(const Box<D>& w) const {
-    return mask([](auto lo_v, auto hi_v, auto wmin, auto wmax) {
-      return both(less_equal(lo_v, wmax), less_equal(wmin, hi_v));
-    }, w);
+    return mask([](auto lo_v, auto hi_v, auto wmin,
+                   auto wmax) { return both(less_equal(lo_v, wmax), less_equal(wmin, hi_v)); },
+                w);
   }
 
   // Bit i set when child i lies inside w.
   Mask inside(const Box<D>& w) const {
-    return mask([](auto lo_v, auto hi_v, auto wmin, auto wmax) {
-      return both(less_equal(wmin, lo_v), less_equal(hi_v, wmax));
-    }, w);
+    return mask([](auto lo_v, auto hi_v, auto wmin,
+                   auto wmax) { return both(less_equal(wmin, lo_v), less_equal(hi_v, wmax)); },
+                w);
   }
 
   // Bit i set when child i contains w.
   Mask containing(const Box<D>& w) const {
-    return mask([](auto lo_v, auto hi_v, auto wmin, auto wmax) {
-      return both(less_equal(lo_v, wmin), less_equal(wmax, hi_v));
-    }, w);
+    return mask([](auto lo_v, auto hi_v, auto wmin,
+                   auto wmax) { return both(less_equal(lo_v, wmin), less_equal(wmax, hi_v)); },
+                w);
   }
 
   // out[i] = squared distance from p to child i, for all N slots (empty slots give +inf).
@@ -104,7 +105,8 @@ struct SoaBoxes {
 #if defined(__SSE2__)
     const __m128d zero = _mm_setzero_pd();
     __m128d pv[D];
-    for (int a = 0; a < D; ++a) pv[a] = _mm_set1_pd(p[a]);
+    for (int a = 0; a < D; ++a)
+      pv[a] = _mm_set1_pd(p[a]);
     for (int i = 0; i < N; i += 2) {
       __m128d sum = zero;
       for (int a = 0; a < D; ++a) {
@@ -116,7 +118,8 @@ struct SoaBoxes {
       _mm_storeu_pd(out + i, sum);
     }
 #else
-    for (int i = 0; i < N; ++i) out[i] = squared_distance(i, p);
+    for (int i = 0; i < N; ++i)
+      out[i] = squared_distance(i, p);
 #endif
   }
 
@@ -137,30 +140,52 @@ struct SoaBoxes {
 #if defined(__SSE2__)
   using Lane = __m128d;
   static constexpr int kLanes = 2;
-  static Lane load(const double* p) { return _mm_loadu_pd(p); }
-  static Lane splat(double v) { return _mm_set1_pd(v); }
-  static Lane less_equal(Lane a, Lane b) { return _mm_cmple_pd(a, b); }
-  static Lane both(Lane a, Lane b) { return _mm_and_pd(a, b); }
-  static unsigned bits(Lane a) { return unsigned(_mm_movemask_pd(a)); }
+  static Lane load(const double* p) {
+    return _mm_loadu_pd(p);
+  }
+  static Lane splat(double v) {
+    return _mm_set1_pd(v);
+  }
+  static Lane less_equal(Lane a, Lane b) {
+    return _mm_cmple_pd(a, b);
+  }
+  static Lane both(Lane a, Lane b) {
+    return _mm_and_pd(a, b);
+  }
+  static unsigned bits(Lane a) {
+    return unsigned(_mm_movemask_pd(a));
+  }
 #else
   using Lane = bool;
   static constexpr int kLanes = 1;
-  static double load(const double* p) { return *p; }
-  static double splat(double v) { return v; }
-  static Lane less_equal(double a, double b) { return a <= b; }
-  static Lane both(Lane a, Lane b) { return a && b; }
-  static unsigned bits(Lane a) { return unsigned(a); }
+  static double load(const double* p) {
+    return *p;
+  }
+  static double splat(double v) {
+    return v;
+  }
+  static Lane less_equal(double a, double b) {
+    return a <= b;
+  }
+  static Lane both(Lane a, Lane b) {
+    return a && b;
+  }
+  static unsigned bits(Lane a) {
+    return unsigned(a);
+  }
 #endif
 
   template <class Test>
   Mask mask(Test test, const Box<D>& w) const {
     static_assert(N % kLanes == 0);
     decltype(splat(0.0)) wmin[D], wmax[D];
-    for (int a = 0; a < D; ++a) wmin[a] = splat(w.min[a]), wmax[a] = splat(w.max[a]);
+    for (int a = 0; a < D; ++a)
+      wmin[a] = splat(w.min[a]), wmax[a] = splat(w.max[a]);
     Mask m = 0;
     for (int i = 0; i < N; i += kLanes) {
       auto acc = test(load(&lo[0][i]), load(&hi[0][i]), wmin[0], wmax[0]);
-      for (int a = 1; a < D; ++a) acc = both(acc, test(load(&lo[a][i]), load(&hi[a][i]), wmin[a], wmax[a]));
+      for (int a = 1; a < D; ++a)
+        acc = both(acc, test(load(&lo[a][i]), load(&hi[a][i]), wmin[a], wmax[a]));
       m |= Mask(bits(acc)) << i;
     }
     return m;
