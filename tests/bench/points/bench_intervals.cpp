@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   const auto ivs = make(n);
   std::mt19937_64 rng(8);
   std::uniform_real_distribution<double> u(0, 1e6);
-  constexpr std::size_t kQueries = 100000, kScanQueries = 300;
+  constexpr std::size_t kQueries = 20000, kScanQueries = 300;
   std::vector<double> xs(kQueries);
   for (auto& x : xs)
     x = u(rng);
@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
   for (const double width : {0.0, 200.0}) {
     const bool stab = width == 0;
     std::size_t h_it = 0, h_st = 0, h_rt = 0, h_scan = 0, h_rt_small = 0;
-    const double q_it = bench::median_seconds(3, [&] {
+    const double q_it = bench::median_seconds(1, [&] {
       h_it = 0;
       for (double x : xs)
         itree.overlap({x, x + width}, [&](Id, const Interval&) { return ++h_it, true; });

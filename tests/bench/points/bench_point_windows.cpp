@@ -1,7 +1,8 @@
 // bench_point_windows [N]: window queries on N points (default 1,000,000; real coastline
 // vertices and uniform points) in the loci bucket PR quadtree and kd-tree, against loci's
 // PackedRTree (Hilbert) and Boost.Geometry's rtree (packing constructor, rstar<16>) over the
-// same points. Windows are centred on data points and sized for about 100 hits; every
+// same points. Windows are centred on data points and sized for about 100 hits (the last
+// calibration round may leave the mean a little off); every
 // structure must report the same number of hits. Prints build times, queries per second and
 // each structure's speed relative to PackedRTree.
 #include <boost/geometry.hpp>
@@ -21,24 +22,33 @@ namespace {
 using namespace loci;
 namespace bgi = boost::geometry::index;
 
-std::vector<Box2> windows_for(const std::vector<Point2>& pts, std::size_t q, double hits) {
+// Windows centred on data points, their side calibrated on `ref` so that they hold about
+// `hits` points on average (real data is far denser near its points than on average).
+template <class Ref>
+std::vector<Box2> windows_for(const std::vector<Point2>& pts, const Ref& ref, std::size_t q,
+                              double hits) {
   Box2 b = Box2::empty();
   for (const auto& p : pts)
     b.expand(p);
-  // side for `hits` points at the average density; real data is denser where the windows are
-  const double side = std::sqrt(hits / double(pts.size()) * b.content());
-  std::mt19937_64 rng(5);
+  double side = std::sqrt(hits / double(pts.size()) * b.content());
   std::vector<Box2> out(q);
-  for (auto& w : out) {
-    const Point2 c = pts[rng() % pts.size()];
-    w = {{c[0] - side / 2, c[1] - side / 2}, {c[0] + side / 2, c[1] + side / 2}};
+  for (int round = 0; round < 4; ++round) {
+    std::mt19937_64 rng(5);
+    for (auto& w : out) {
+      const Point2 c = pts[rng() % pts.size()];
+      w = {{c[0] - side / 2, c[1] - side / 2}, {c[0] + side / 2, c[1] + side / 2}};
+    }
+    std::size_t got = 0;
+    for (std::size_t i = 0; i < std::min<std::size_t>(q, 2000); ++i)
+      ref.query(out[i], [&](Id, const Box2&) { return ++got, true; });
+    const double mean = double(got) / double(std::min<std::size_t>(q, 2000));
+    side *= std::sqrt(hits / std::max(mean, 1.0));
   }
   return out;
 }
 
 void run(const char* label, const std::vector<Point2>& pts) {
-  constexpr std::size_t kQueries = 100000;
-  const auto ws = windows_for(pts, kQueries, 100);
+  constexpr std::size_t kQueries = 20000;
   std::vector<Box2> boxes;
   for (const auto& p : pts)
     boxes.push_back(Box2::of_point(p));
@@ -49,6 +59,7 @@ void run(const char* label, const std::vector<Point2>& pts) {
   using Value = std::pair<Point2, std::uint32_t>;
   bgi::rtree<Value, bgi::rstar<16>> boost_tree;
   const double b_packed = bench::median_seconds(1, [&] { packed = PackedRTree2::build(boxes); });
+  const auto ws = windows_for(pts, packed, kQueries, 100);
   const double b_kd = bench::median_seconds(1, [&] { kd = KdTree2::build(pts); });
   const double b_quad = bench::median_seconds(1, [&] { quad = PrQuadtree2::build(pts, 16); });
   const double b_boost = bench::median_seconds(1, [&] {
