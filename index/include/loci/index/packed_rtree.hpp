@@ -168,8 +168,9 @@ class PackedRTree {
     return block(0, pos / NodeSize).box(int(pos % NodeSize));
   }
 
-  void order_hilbert(std::vector<Item>& items) const;
-  void order_str(std::vector<Item>& items) const;
+  // order[pos] = the builder index of the item packed at position pos.
+  void order_hilbert(std::span<const Box<D>> boxes, std::uint32_t* order) const;
+  void order_str(std::span<const Box<D>> boxes, std::uint32_t* order) const;
   void tile(Item* base, std::size_t first, std::size_t count, std::size_t cap) const;
 
   template <class Visit>
@@ -182,8 +183,9 @@ class PackedRTree {
   std::vector<std::size_t> span_;          // NodeSize^l: items covered by an entry of level l
   const Block* blocks_ = nullptr;
   const std::uint32_t* items_ = nullptr;
-  std::vector<Block> own_blocks_;
-  std::vector<std::uint32_t> own_items_;
+  // Owned storage, left uninitialised on allocation: the build writes every slot.
+  std::unique_ptr<Block[]> own_blocks_;
+  std::unique_ptr<std::uint32_t[]> own_items_;
   std::shared_ptr<const void> keep_alive_;
 };
 
@@ -213,61 +215,91 @@ PackedRTree<D, NodeSize>::PackedRTree(std::span<const Box<D>> boxes, Packing pac
   compute_levels();
   if (size_ == 0) return;
 
-  std::vector<Item> items(size_);
-  for (std::size_t i = 0; i < size_; ++i)
-    items[i] = {boxes[i].center(), std::uint32_t(i)};
+  const std::size_t slots = level_blocks(0) * NodeSize;
+  own_blocks_.reset(new Block[total_blocks()]);
+  own_items_.reset(new std::uint32_t[slots]);
+  std::uint32_t* order = own_items_.get();
   if (packing == Packing::hilbert)
-    order_hilbert(items);
+    order_hilbert(boxes, order);
   else
-    order_str(items);
+    order_str(boxes, order);
 
-  own_blocks_.resize(total_blocks());
-  own_items_.assign(level_blocks(0) * NodeSize, std::numeric_limits<std::uint32_t>::max());
-  for (auto& b : own_blocks_)
-    b.clear();
-  for (std::size_t pos = 0; pos < size_; ++pos) {
-    own_items_[pos] = items[pos].index;
-    own_blocks_[pos / NodeSize].set(int(pos % NodeSize), boxes[items[pos].index]);
+  // A gather in packed order: prefetching a few items ahead hides most of its cache misses.
+  constexpr std::size_t kAhead = 8;
+  for (std::size_t pos = 0; pos < slots; ++pos) {
+    if (pos + kAhead < size_) __builtin_prefetch(&boxes[order[pos + kAhead]]);
+    Block& block = own_blocks_[pos / NodeSize];
+    if (pos < size_) {
+      block.set(int(pos % NodeSize), boxes[order[pos]]);
+    } else {
+      block.set(int(pos % NodeSize), Box<D>::empty());
+      order[pos] = std::numeric_limits<std::uint32_t>::max();
+    }
   }
   for (int l = 1; l < levels(); ++l) {
     const std::size_t below = level_offset_[l - 1];
-    for (std::size_t e = 0; e < level_count_[l]; ++e) {
-      const int used = int(std::min<std::size_t>(NodeSize, level_count_[l - 1] - e * NodeSize));
-      own_blocks_[level_offset_[l] + e / NodeSize].set(int(e % NodeSize),
-                                                       own_blocks_[below + e].bounds(used));
+    for (std::size_t e = 0; e < level_blocks(l) * NodeSize; ++e) {
+      Block& block = own_blocks_[level_offset_[l] + e / NodeSize];
+      if (e < level_count_[l]) {
+        const int used = int(std::min<std::size_t>(NodeSize, level_count_[l - 1] - e * NodeSize));
+        block.set(int(e % NodeSize), own_blocks_[below + e].bounds(used));
+      } else {
+        block.set(int(e % NodeSize), Box<D>::empty());
+      }
     }
   }
-  blocks_ = own_blocks_.data();
-  items_ = own_items_.data();
+  blocks_ = own_blocks_.get();
+  items_ = own_items_.get();
 }
 
 template <int D, int NodeSize>
-void PackedRTree<D, NodeSize>::order_hilbert(std::vector<Item>& items) const {
+void PackedRTree<D, NodeSize>::order_hilbert(std::span<const Box<D>> boxes,
+                                             std::uint32_t* order) const {
   Box<D> extent = Box<D>::empty();
-  for (const auto& it : items)
-    extent.expand(it.c);
+  for (const auto& b : boxes)
+    extent.expand(b.center());
   constexpr double kMax = double((1u << detail::hilbert_bits<D>()) - 1);
   double scale[D];
   for (int a = 0; a < D; ++a)
     scale[a] = extent.extent(a) > 0 ? kMax / extent.extent(a) : 0.0;
-
-  std::vector<detail::KeyedIndex> keyed(items.size());
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    std::uint32_t x[D];
+  auto cell = [&](const Box<D>& b, std::uint32_t(&x)[D]) {
     for (int a = 0; a < D; ++a)
-      x[a] = static_cast<std::uint32_t>((items[i].c[a] - extent.min[a]) * scale[a]);
-    keyed[i] = {detail::hilbert_key<D>(x), std::uint32_t(i)};
+      x[a] = static_cast<std::uint32_t>((b.center(a) - extent.min[a]) * scale[a]);
+  };
+  if constexpr (D == 2) {
+    // 32-bit keys: key and index share one 64-bit word, halving the sort's memory traffic.
+    std::vector<std::uint64_t> keyed(boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      std::uint32_t x[2];
+      cell(boxes[i], x);
+      keyed[i] = (detail::hilbert_key_2d(x[0], x[1]) << 32) | i;
+    }
+    detail::radix_sort(keyed, 32, 32, [](std::uint64_t v) { return v; });
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+      order[i] = std::uint32_t(keyed[i]);
+  } else {
+    std::vector<detail::KeyedIndex> keyed(boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      std::uint32_t x[D];
+      cell(boxes[i], x);
+      keyed[i] = {detail::hilbert_key<D>(x), std::uint32_t(i)};
+    }
+    detail::radix_sort(keyed, 0, D * detail::hilbert_bits<D>(),
+                       [](const detail::KeyedIndex& k) { return k.key; });
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+      order[i] = keyed[i].index;
   }
-  detail::radix_sort(keyed, D * detail::hilbert_bits<D>());
-  std::vector<Item> sorted(items.size());
-  for (std::size_t i = 0; i < items.size(); ++i)
-    sorted[i] = items[keyed[i].index];
-  items.swap(sorted);
 }
 
 template <int D, int NodeSize>
-void PackedRTree<D, NodeSize>::order_str(std::vector<Item>& items) const {
+void PackedRTree<D, NodeSize>::order_str(std::span<const Box<D>> boxes,
+                                         std::uint32_t* order) const {
+  std::vector<Item> items(boxes.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    items[i] = {boxes[i].center(), std::uint32_t(i)};
   tile(items.data(), 0, items.size(), span_.back());
+  for (std::size_t i = 0; i < items.size(); ++i)
+    order[i] = items[i].index;
 }
 
 // Orders items[first, first + count) into groups of `cap` items (the last may be short), then

@@ -1,4 +1,4 @@
-// LSD radix sort of (key, index) pairs on the low `bits` bits of the key, 11 bits a pass.
+// LSD radix sort on a range of key bits, 11 bits a pass.
 //
 // Packing sorts a million space-filling-curve keys per build; a comparison sort spends most
 // of the build there, while three counting passes (2D keys are 32 bits) touch each pair three
@@ -16,14 +16,16 @@ struct KeyedIndex {
   std::uint32_t index;
 };
 
-inline void radix_sort(std::vector<KeyedIndex>& v, int bits) {
+// Sorts v by bits [first_bit, first_bit + bits) of key_of(element).
+template <class T, class KeyOf>
+void radix_sort(std::vector<T>& v, int first_bit, int bits, KeyOf key_of) {
   constexpr int kDigit = 11;
   constexpr std::size_t kBuckets = std::size_t(1) << kDigit;
-  std::vector<KeyedIndex> tmp(v.size());
-  for (int shift = 0; shift < bits; shift += kDigit) {
+  std::vector<T> tmp(v.size());
+  for (int shift = first_bit; shift < first_bit + bits; shift += kDigit) {
     std::array<std::size_t, kBuckets> count{};
     for (const auto& x : v)
-      ++count[(x.key >> shift) & (kBuckets - 1)];
+      ++count[(key_of(x) >> shift) & (kBuckets - 1)];
     std::size_t sum = 0;
     for (auto& c : count) {
       const std::size_t n = c;
@@ -31,9 +33,13 @@ inline void radix_sort(std::vector<KeyedIndex>& v, int bits) {
       sum += n;
     }
     for (const auto& x : v)
-      tmp[count[(x.key >> shift) & (kBuckets - 1)]++] = x;
+      tmp[count[(key_of(x) >> shift) & (kBuckets - 1)]++] = x;
     v.swap(tmp);
   }
+}
+
+inline void radix_sort(std::vector<KeyedIndex>& v, int bits) {
+  radix_sort(v, 0, bits, [](const KeyedIndex& k) { return k.key; });
 }
 
 }  // namespace loci::detail
