@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "loci/geom/error.hpp"
+#include "loci/index/detail/canonical_nodes.hpp"
 #include "loci/index/detail/interval.hpp"
 #include "loci/index/query.hpp"
 
@@ -91,13 +92,7 @@ class SegmentTree {
   // Calls f(node) for the canonical nodes of slots [first, last].
   template <class F>
   void canonical(std::size_t first, std::size_t last, F&& f) const {
-    std::size_t l = first + leaves_, r = last + leaves_ + 1;
-    while (l < r) {
-      if (l & 1) f(l++);
-      if (r & 1) f(--r);
-      l >>= 1;
-      r >>= 1;
-    }
+    detail::for_each_canonical_node(leaves_, first, last, f);
   }
   // Slot range [first, last] covered by node v.
   std::pair<std::size_t, std::size_t> node_range(std::size_t v) const {

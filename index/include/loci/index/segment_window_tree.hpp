@@ -43,6 +43,7 @@
 #include "loci/geom/box.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/geom/segment.hpp"
+#include "loci/index/detail/canonical_nodes.hpp"
 #include "loci/index/kd_tree.hpp"
 #include "loci/index/query.hpp"
 
@@ -91,13 +92,7 @@ class SlabTree {
   }
   template <class F>
   void canonical(std::size_t first, std::size_t last, F&& f) const {
-    std::size_t l = first + leaves_, r = last + leaves_ + 1;
-    while (l < r) {
-      if (l & 1) f(l++);
-      if (r & 1) f(--r);
-      l >>= 1;
-      r >>= 1;
-    }
+    detail::for_each_canonical_node(leaves_, first, last, f);
   }
   // t lies on or below s across every slab both span (exact).
   static bool ordered(const Segment<2>& t, const Segment<2>& s);
