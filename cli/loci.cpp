@@ -18,6 +18,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/io/bench.hpp"
 #include "loci/io/commands.hpp"
+#include "loci/io/layer_cells.hpp"
 
 namespace {
 
@@ -194,10 +195,20 @@ int run_draw(const Args& a) {
   o.out_path = a.get("--output");
   if (a.has("--levels")) o.max_levels = int(parse_k(a.get("--levels")));
   if (a.has("--width")) o.width = int(parse_k(a.get("--width")));
-  o.progress = progress_bar(a, "indexing");
+  if (a.has("--cells")) {
+    const std::string v = a.get("--cells");
+    char* end = nullptr;
+    const long levels = std::strtol(v.c_str(), &end, 10);
+    if (v.empty() || *end || levels < 0 || levels > RegionQuadtree::kMaxLevels)
+      throw UsageError("--cells takes a number of levels from 0 to " +
+                       std::to_string(RegionQuadtree::kMaxLevels) + ", got '" + v + "'");
+    o.cell_levels = int(levels);
+  }
+  o.progress = progress_bar(a, o.cell_levels >= 0 ? "cells" : "indexing");
   const std::size_t n = draw_index(o);
   if (!a.has("--quiet"))
-    std::fprintf(stderr, "loci: %zu nodes drawn into %s\n", n, o.out_path.c_str());
+    std::fprintf(stderr, "loci: %zu %s drawn into %s\n", n, o.cell_levels >= 0 ? "cells" : "nodes",
+                 o.out_path.c_str());
   return 0;
 }
 
@@ -280,15 +291,20 @@ const std::vector<Command>& commands() {
        "  loci clip countries.shp --bbox 5,45,15,55 -o alps.gpkg\n",
        run_clip},
       {"draw",
-       "loci draw LAYER|FILE.loci -o OUT.svg [--levels N] [--width PX]",
-       "SVG of the layer's linework and the packed index's nodes, one colour per level",
+       "loci draw LAYER|FILE.loci -o OUT.svg [--levels N | --cells L] [--width PX]",
+       "SVG of the layer's linework and the packed index's nodes, one colour per level, or "
+       "its region quadtree cells",
        {{"--output", "-o", "OUT.svg", "the drawing"},
         {"--levels", nullptr, "N", "how many levels to draw, from the root down (default 3)"},
+        {"--cells", nullptr, "L",
+         "draw the layer's region quadtree cut L times instead: polygon interiors, the cells "
+         "the linework runs through (MX cells), empty blocks"},
         {"--width", nullptr, "PX", "width in pixels (default 1200)"},
         kPer,
         kLayer,
         kQuiet},
-       "  loci draw countries.shp -o countries-index.svg --levels 2\n",
+       "  loci draw countries.shp -o countries-index.svg --levels 2\n"
+       "  loci draw countries.shp -o countries-cells.svg --cells 8\n",
        run_draw},
       {"bench",
        "loci bench LAYER [--per feature|segment] [--queries N] [-k N]",

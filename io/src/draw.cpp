@@ -1,6 +1,8 @@
 // `loci draw`: an SVG of a layer's linework under the nodes of its packed R-tree, one colour
 // per level, so that a user sees how the packing grouped their data (long thin nodes, nodes
-// straddling the antimeridian, overlap between siblings).
+// straddling the antimeridian, overlap between siblings); or, with --cells, under the layer's
+// region quadtree: inside blocks, the MX boundary cells its linework runs through, and the
+// empty blocks outlined.
 //
 // The tree's levels are recomputed from its item count (the packed layout is implicit) and a
 // node's rectangle is the union of its entries. Linework is projected to pixels with y up and
@@ -12,6 +14,7 @@
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
+#include "loci/io/layer_cells.hpp"
 
 namespace loci::io {
 namespace {
@@ -28,38 +31,24 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-}  // namespace
-
-std::size_t draw_index(const DrawOptions& options) {
-  LoadOptions load;
-  if (ends_with(options.path, ".loci")) {
-    load.layer_path = options.path.substr(0, options.path.size() - 5);
-    load.index_path = options.path;
-  } else {
-    load.layer_path = options.path;
-  }
-  load.layer_name = options.layer_name;
-  load.progress = options.progress;
-  const LayerIndex index = load_index(load);
-  const PackedRTree2* tree = index.packed();
-  if (!tree || tree->empty()) throw Error(options.path + ": nothing to draw");
-
+Frame frame_of(const Box2& world, int width) {
   Frame f;
-  f.world = tree->bounds();
-  const double w = std::max(f.world.extent(0), 1e-12), h = std::max(f.world.extent(1), 1e-12);
-  f.width = std::max(options.width, 16);
+  f.world = world;
+  const double w = std::max(world.extent(0), 1e-12), h = std::max(world.extent(1), 1e-12);
+  f.width = std::max(width, 16);
   f.scale = f.width / w;
   f.height = std::max(1, int(std::ceil(h * f.scale)));
+  return f;
+}
 
-  OutputFile out(options.out_path, stdout);
-  std::FILE* o = out.stream();
-  std::fprintf(o,
-               "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
-               "viewBox=\"0 0 %d %d\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
-               f.width, f.height, f.width, f.height);
+void write_rect(std::FILE* o, const Frame& f, const Box2& r) {
+  std::fprintf(o, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", f.x(r.min[0]),
+               f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);
+}
 
-  // Linework.
-  auto src = detail::open_layer(load.layer_path, index.layer_name());
+void write_linework(std::FILE* o, const Frame& f, const std::string& layer_path,
+                    const std::string& layer_name) {
+  auto src = detail::open_layer(layer_path, layer_name);
   std::fprintf(o, "<g fill=\"none\" stroke=\"#555\" stroke-width=\"0.5\">\n");
   for (auto& feature : *src.layer) {
     detail::for_each_curve(
@@ -79,11 +68,13 @@ std::size_t draw_index(const DrawOptions& options) {
         });
   }
   std::fprintf(o, "</g>\n");
+}
 
-  // Nodes, from the leaves' parents up to the root, coarser levels drawn last and thicker.
+// Nodes, from the leaves' parents up to the root, coarser levels drawn last and thicker.
+std::size_t write_nodes(std::FILE* o, const Frame& f, const PackedRTree2& tree, int max_levels) {
   static const char* colours[] = {"#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02"};
-  const auto blocks = tree->blocks();
-  std::vector<std::size_t> count{tree->size()}, offset{0};
+  const auto blocks = tree.blocks();
+  std::vector<std::size_t> count{tree.size()}, offset{0};
   while (true) {
     const std::size_t nb = (count.back() + PackedRTree2::node_size - 1) / PackedRTree2::node_size;
     offset.push_back(offset.back() + nb);
@@ -91,7 +82,7 @@ std::size_t draw_index(const DrawOptions& options) {
     count.push_back(nb);
   }
   const int levels = int(count.size());
-  const int first = std::max(0, levels - options.max_levels);
+  const int first = std::max(0, levels - max_levels);
   std::size_t drawn = 0;
   for (int l = first; l < levels; ++l) {
     std::fprintf(o, "<g fill=\"none\" stroke=\"%s\" stroke-width=\"%.1f\" opacity=\"0.8\">\n",
@@ -100,13 +91,64 @@ std::size_t draw_index(const DrawOptions& options) {
     for (std::size_t b = 0; b < nb; ++b) {
       const int used = int(
           std::min<std::size_t>(PackedRTree2::node_size, count[l] - b * PackedRTree2::node_size));
-      const Box2 r = blocks[offset[l] + b].bounds(used);
-      std::fprintf(o, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n",
-                   f.x(r.min[0]), f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);
+      write_rect(o, f, blocks[offset[l] + b].bounds(used));
       ++drawn;
     }
     std::fprintf(o, "</g>\n");
   }
+  return drawn;
+}
+
+// One group per cover, each leaf once: outside blocks outlined, the others filled.
+std::size_t write_cells(std::FILE* o, const Frame& f, const RegionQuadtree& cells) {
+  static const char* styles[] = {
+      "fill=\"none\" stroke=\"#bbb\" stroke-width=\"0.4\"",         // outside
+      "fill=\"#cfe8c9\" stroke=\"#7fb174\" stroke-width=\"0.4\"",   // inside
+      "fill=\"#f4a261\" stroke=\"#c4703a\" stroke-width=\"0.3\""};  // boundary
+  std::size_t drawn = 0;
+  for (const Cover c : {Cover::outside, Cover::inside, Cover::boundary}) {
+    std::fprintf(o, "<g %s>\n", styles[int(c)]);
+    cells.visit_cells([&](const QuadCell& cell) {
+      if (cell.cover != c) return;
+      write_rect(o, f, cell.box);
+      ++drawn;
+    });
+    std::fprintf(o, "</g>\n");
+  }
+  return drawn;
+}
+
+}  // namespace
+
+std::size_t draw_index(const DrawOptions& options) {
+  LoadOptions load;
+  if (ends_with(options.path, ".loci")) {
+    load.layer_path = options.path.substr(0, options.path.size() - 5);
+    load.index_path = options.path;
+  } else {
+    load.layer_path = options.path;
+  }
+  load.layer_name = options.layer_name;
+  load.progress = options.progress;
+  const bool cells = options.cell_levels >= 0;
+  if (cells) load.per = Per::segment;
+  const LayerIndex index = load_index(load);
+  const PackedRTree2* tree = index.packed();
+  if (!tree || tree->empty()) throw Error(options.path + ": nothing to draw");
+  RegionQuadtree quadtree;
+  if (cells) quadtree = layer_cells(index, options.cell_levels, options.progress);
+
+  const Frame f = frame_of(cells ? quadtree.region() : tree->bounds(), options.width);
+  OutputFile out(options.out_path, stdout);
+  std::FILE* o = out.stream();
+  std::fprintf(o,
+               "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
+               "viewBox=\"0 0 %d %d\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+               f.width, f.height, f.width, f.height);
+  std::size_t drawn = 0;
+  if (cells) drawn = write_cells(o, f, quadtree);
+  write_linework(o, f, load.layer_path, index.layer_name());
+  if (!cells) drawn = write_nodes(o, f, *tree, options.max_levels);
   std::fprintf(o, "</svg>\n");
   out.commit();
   return drawn;

@@ -213,8 +213,9 @@ void check_query(const Query& q) {
   }
 }
 
-// Features of a per-segment index whose polygons contain p by the even-odd rule: the ring
-// segments crossing the ray from p towards +x, counted per feature.
+}  // namespace
+
+// The ring segments crossing the ray from p towards +x, counted per feature.
 std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p) {
   std::vector<std::int64_t> out;
   if (!index.has_polygons() || index.size() == 0 || p[0] > index.bounds().max[0]) return out;
@@ -231,8 +232,6 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
     if (o) out.push_back(fid);
   return out;
 }
-
-}  // namespace
 
 void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
                      std::vector<Answer>& out) {

@@ -8,7 +8,8 @@
 //                    corrupt one is refused, no sidecar means building in memory
 //   query_layer      `loci query`: one query or a numbered batch, exact or --candidates
 //   clip_layer       `loci clip`: features meeting a window, cut to it, written through GDAL
-//   draw_index       `loci draw`: an SVG of the layer and the index's nodes by level
+//   draw_index       `loci draw`: an SVG of the layer and the index's nodes by level, or of
+//                    the layer's region quadtree cells
 #pragma once
 
 #include <cstdio>
@@ -102,11 +103,12 @@ struct DrawOptions {
   std::string layer_name;
   std::string out_path;
   int width = 1200;
-  int max_levels = 3;  // how many levels above the leaves to draw
+  int max_levels = 3;    // how many levels above the leaves to draw
+  int cell_levels = -1;  // >= 0: draw the layer's region quadtree, cut that often, instead
   Progress progress;
 };
 
-// Returns the number of node rectangles drawn.
+// Returns the number of node rectangles (or quadtree cells) drawn.
 std::size_t draw_index(const DrawOptions& options);
 
 }  // namespace loci::io

@@ -101,6 +101,11 @@ class LayerIndex {
   std::shared_ptr<const void> keep_alive_;
 };
 
+// Features of a per-segment index whose polygons contain p by the even-odd rule over all rings
+// of a feature; empty for a per-feature index or a layer without polygons. A point on a ring
+// may or may not count: callers test the rings themselves first.
+std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p);
+
 struct Query {
   enum class Kind : std::uint8_t { bbox, point, segment, within, nearest };
   Kind kind = Kind::bbox;
