@@ -1,0 +1,262 @@
+// PrioritySearchTree: a static set of 2D points answering three-sided queries, "every point
+// with x <= qx and y1 <= y <= y2" (query_left) and "x >= qx and y1 <= y <= y2" (query_right),
+// after McCreight, "Priority search trees", SIAM Journal on Computing 14(2), 1985 (also de
+// Berg et al., "Computational Geometry", chapter 10.2).
+//
+// Structure. One binary tree is at once a heap on x and a search tree on y. The root holds the
+// point nearest the open side (smallest x for query_left); the remaining points are cut at a
+// y rank into the two subtrees, and the node keeps the y at the cut as its split value. A
+// query walks down from the root, dropping a subtree as soon as its top point fails the x
+// test (every point below fails it too) and a child whose y-range misses [y1, y2]; a visited
+// node that passes x either reports its point or lies on one of the two search paths of y1
+// and y2, which bounds the work by the height plus the output.
+//
+// Layout. The tree is heap-shaped: node i has children 2i + 1 and 2i + 2 in one flat array,
+// so there are no child links, and the sizes of both subtrees follow from the node count
+// alone; the y cut is made at that rank. Cutting by rank, never by value, lets duplicate
+// points and equal y values land on both sides of a split; queries then enter both children
+// when [y1, y2] contains the split, so ties cost nothing in correctness. The two query sides
+// use two trees over the same points (a min-heap and a max-heap on x). The tree code lives in
+// loci::detail so that other structures can keep many small trees in one shared array (see
+// AxisParallelWindowTree).
+//
+// Invariants (checked by validate()): on each tree, no child comes before its parent in x
+// (in the heap's order); every y in a left subtree is <= the node's split <= every y in the
+// right subtree; every point is stored exactly once, with its own coordinates.
+//
+// Complexity: build O(n log n); a query O(log n + k) for k results; memory 80 bytes per
+// point. Point i of build() is reported with id i. Thread-safety: immutable after build; any
+// number of concurrent queries (they use thread-local scratch).
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <concepts>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "loci/geom/error.hpp"
+#include "loci/geom/point.hpp"
+#include "loci/index/detail/interval.hpp"
+#include "loci/index/detail/scratch.hpp"
+#include "loci/index/query.hpp"
+
+namespace loci {
+
+template <class F>
+concept PointVisitor = std::predicate < F&,
+        Id, const Point<2>
+& > ;
+
+namespace detail {
+
+// Which side of a three-sided query is open: left asks x <= qx (the tree is a min-heap on
+// x), right asks x >= qx (a max-heap).
+enum class PstSide : std::uint8_t { left, right };
+
+struct PstNode {
+  Point<2> p;
+  double split;      // y of the left subtree <= split <= y of the right subtree
+  std::uint32_t id;  // whatever the owner numbers its points by
+};
+
+template <PstSide S>
+constexpr bool pst_admits(double x, double qx) {
+  return S == PstSide::left ? x <= qx : x >= qx;
+}
+
+// Nodes in the left subtree of a heap-shaped tree of m nodes.
+inline std::size_t pst_left_size(std::size_t m) {
+  if (m <= 1) return 0;
+  const int h = std::bit_width(m) - 1;  // depth of the last level
+  const std::size_t half = std::size_t(1) << (h - 1);
+  const std::size_t last_level = m - ((std::size_t(1) << h) - 1);
+  return (half - 1) + std::min(last_level, half);
+}
+
+// Arranges `items` (reordered on the way) as a priority search tree into `out`, which has
+// the same size. Recursion depth is the tree height, log2 of the size.
+template <PstSide S>
+void build_pst(std::span<PstNode> items, std::span<PstNode> out, std::size_t at = 0) {
+  while (!items.empty()) {
+    const auto top = std::min_element(items.begin(), items.end(), [](const auto& a, const auto& b) {
+      return S == PstSide::left ? a.p[0] < b.p[0] : a.p[0] > b.p[0];
+    });
+    std::iter_swap(items.begin(), top);
+    out[at] = items[0];
+    out[at].split = items[0].p[1];
+    const std::size_t left = pst_left_size(items.size());
+    const std::span<PstNode> rest = items.subspan(1);
+    if (left == 0) return;
+    std::nth_element(rest.begin(), rest.begin() + (left - 1), rest.end(),
+                     [](const auto& a, const auto& b) { return a.p[1] < b.p[1]; });
+    out[at].split = rest[left - 1].p[1];
+    build_pst<S>(rest.first(left), out, 2 * at + 1);
+    items = rest.subspan(left);
+    at = 2 * at + 2;
+  }
+}
+
+// Calls f(node) for every node of tree t admitted by qx with y in [y1, y2]; returns false as
+// soon as f does. `stack` is the caller's scratch; it is left as it was found.
+template <PstSide S, class F>
+bool query_pst(std::span<const PstNode> t, double qx, double y1, double y2,
+               std::vector<std::uint32_t>& stack, QueryStats& s, F&& f) {
+  if (t.empty()) return true;
+  ++s.entries_tested;
+  if (!pst_admits<S>(t[0].p[0], qx)) return true;
+  const std::size_t base = stack.size();
+  stack.push_back(0);
+  while (stack.size() > base) {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    const PstNode& n = t[i];
+    ++s.nodes_visited;
+    if (y1 <= n.p[1] && n.p[1] <= y2 && !f(n)) {
+      stack.resize(base);
+      return false;
+    }
+    // children are tested before they are pushed: most fail on x, and then cost no push
+    const std::size_t c = 2 * i + 1;
+    if (c + 1 < t.size() && n.split <= y2) {
+      ++s.entries_tested;
+      if (pst_admits<S>(t[c + 1].p[0], qx)) stack.push_back(std::uint32_t(c + 1));
+    }
+    if (c < t.size() && y1 <= n.split) {
+      ++s.entries_tested;
+      if (pst_admits<S>(t[c].p[0], qx)) stack.push_back(std::uint32_t(c));
+    }
+  }
+  return true;
+}
+
+// Throws loci::Error, its message starting with `owner`, for a broken heap or split order.
+template <PstSide S>
+void validate_pst(std::span<const PstNode> t, const std::string& owner) {
+  auto fail = [&](const std::string& what, std::size_t i) {
+    throw Error(owner + what + " at node " + std::to_string(i));
+  };
+  // y-range of every subtree, children before parents
+  std::vector<double> lo(t.size()), hi(t.size());
+  for (std::size_t i = t.size(); i-- > 0;) {
+    lo[i] = hi[i] = t[i].p[1];
+    for (std::size_t c = 2 * i + 1; c <= 2 * i + 2 && c < t.size(); ++c) {
+      if (!pst_admits<S>(t[i].p[0], t[c].p[0])) fail("heap order on x broken", i);
+      lo[i] = std::min(lo[i], lo[c]);
+      hi[i] = std::max(hi[i], hi[c]);
+    }
+    if (2 * i + 1 < t.size() && !(hi[2 * i + 1] <= t[i].split))
+      fail("left subtree reaches above the y split", i);
+    if (2 * i + 2 < t.size() && !(t[i].split <= lo[2 * i + 2]))
+      fail("right subtree reaches below the y split", i);
+  }
+}
+
+}  // namespace detail
+
+class PrioritySearchTree {
+ public:
+  PrioritySearchTree() = default;
+
+  // Point i gets id i. Throws InvalidGeometry on a NaN or infinite coordinate,
+  // InvalidArgument for 2^32 - 1 points or more.
+  static PrioritySearchTree build(std::span<const Point<2>> points);
+
+  std::size_t size() const { return points_.size(); }
+  bool empty() const { return points_.empty(); }
+  const Point<2>& point(Id id) const { return points_.at(std::size_t(id)); }
+  std::size_t memory_bytes() const {
+    return points_.size() * sizeof(Point<2>) +
+           (left_.size() + right_.size()) * sizeof(detail::PstNode);
+  }
+
+  // Calls visit(id, point) for every point with x <= qx and y1 <= y <= y2; stops when it
+  // returns false. Throws InvalidGeometry for a NaN or infinite bound or y1 > y2.
+  template <PointVisitor Visit>
+  QueryStats query_left(double qx, double y1, double y2, Visit&& visit) const {
+    return run<detail::PstSide::left>(left_, qx, y1, y2, visit);
+  }
+  std::vector<Id> query_left(double qx, double y1, double y2) const {
+    std::vector<Id> out;
+    query_left(qx, y1, y2, [&](Id id, const Point<2>&) { return out.push_back(id), true; });
+    return out;
+  }
+
+  // Calls visit(id, point) for every point with x >= qx and y1 <= y <= y2; stops when it
+  // returns false. Throws InvalidGeometry for a NaN or infinite bound or y1 > y2.
+  template <PointVisitor Visit>
+  QueryStats query_right(double qx, double y1, double y2, Visit&& visit) const {
+    return run<detail::PstSide::right>(right_, qx, y1, y2, visit);
+  }
+  std::vector<Id> query_right(double qx, double y1, double y2) const {
+    std::vector<Id> out;
+    query_right(qx, y1, y2, [&](Id id, const Point<2>&) { return out.push_back(id), true; });
+    return out;
+  }
+
+  // Throws loci::Error describing the first broken invariant.
+  void validate() const;
+
+ private:
+  template <detail::PstSide S, class Visit>
+  QueryStats run(const std::vector<detail::PstNode>& t, double qx, double y1, double y2,
+                 Visit& visit) const {
+    check_coordinate(qx, "query x");
+    check_interval({y1, y2}, "query y-range");
+    QueryStats s;
+    detail::Scratch<std::uint32_t> scratch;
+    detail::query_pst<S>(t, qx, y1, y2, *scratch, s, [&](const detail::PstNode& n) {
+      ++s.results;
+      return bool(visit(Id(n.id), n.p));
+    });
+    return s;
+  }
+
+  std::vector<Point<2>> points_;        // by id
+  std::vector<detail::PstNode> left_;   // min-heap on x, for query_left
+  std::vector<detail::PstNode> right_;  // max-heap on x, for query_right
+};
+
+inline PrioritySearchTree PrioritySearchTree::build(std::span<const Point<2>> points) {
+  if (points.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw InvalidArgument("PrioritySearchTree holds at most 2^32 - 2 points");
+  PrioritySearchTree t;
+  t.points_.assign(points.begin(), points.end());
+  std::vector<detail::PstNode> items(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    check_point(points[i], ("point " + std::to_string(i)).c_str());
+    items[i] = {points[i], 0.0, std::uint32_t(i)};
+  }
+  t.left_.resize(items.size());
+  t.right_.resize(items.size());
+  detail::build_pst<detail::PstSide::left>(items, t.left_);
+  detail::build_pst<detail::PstSide::right>(items, t.right_);
+  return t;
+}
+
+inline void PrioritySearchTree::validate() const {
+  const std::string owner = "PrioritySearchTree invalid: ";
+  auto check = [&](const std::vector<detail::PstNode>& t, const char* which) {
+    if (t.size() != points_.size())
+      throw Error(owner + which + " tree holds " + std::to_string(t.size()) + " of " +
+                  std::to_string(points_.size()) + " points");
+    std::vector<bool> seen(points_.size(), false);
+    for (const detail::PstNode& n : t) {
+      if (n.id >= points_.size() || seen[n.id])
+        throw Error(owner + which + " tree stores point " + std::to_string(n.id) +
+                    " twice or out of range");
+      seen[n.id] = true;
+      if (!(n.p == points_[n.id]))
+        throw Error(owner + which + " tree moved point " + std::to_string(n.id));
+    }
+  };
+  check(left_, "left");
+  check(right_, "right");
+  detail::validate_pst<detail::PstSide::left>(left_, owner + "left tree: ");
+  detail::validate_pst<detail::PstSide::right>(right_, owner + "right tree: ");
+}
+
+}  // namespace loci
