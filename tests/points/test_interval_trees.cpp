@@ -104,6 +104,46 @@ TEST(IntervalTree, InsertEraseAgainstBruteForce) {
   EXPECT_TRUE(tree.stab(500).empty());
 }
 
+TEST(IntervalTree, BulkBuiltTreeTakesUpdates) {
+  // build() lays the tree out itself; inserts and erases must keep it a valid treap
+  std::mt19937_64 rng(22);
+  std::vector<Interval> live = make_intervals(IntervalShape::uniform, 2000, 4);
+  std::vector<Id> ids = iota_ids(live.size());
+  IntervalTree tree = IntervalTree::build(live);
+  tree.validate();
+  const auto pool = make_intervals(IntervalShape::nested, 500, 5);
+  Id next = live.size();
+  for (int step = 0; step < 3000; ++step) {
+    if (rng() % 2) {
+      const Interval iv = pool[rng() % pool.size()];
+      tree.insert(iv, next);
+      live.push_back(iv);
+      ids.push_back(next++);
+    } else if (!live.empty()) {
+      const std::size_t i = rng() % live.size();
+      ASSERT_TRUE(tree.erase(live[i], ids[i]));
+      live.erase(live.begin() + long(i));
+      ids.erase(ids.begin() + long(i));
+    }
+    if (step % 151 == 0) {
+      tree.validate();
+      const double x = query_value(rng, live);
+      ASSERT_EQ(sorted(tree.stab(x)), brute_stab(live, ids, x));
+      const Interval r{x - 5, x + 20};
+      ASSERT_EQ(sorted(tree.overlap(r)), brute_overlap(live, ids, r));
+    }
+  }
+  tree.validate();
+  EXPECT_EQ(tree.size(), live.size());
+  const std::vector<Interval> bad = {{0, 1}, {2, 3}, {5, 4}};
+  try {
+    IntervalTree::build(bad);
+    ADD_FAILURE() << "inverted interval accepted";
+  } catch (const InvalidGeometry& e) {
+    EXPECT_NE(std::string(e.what()).find("interval 2"), std::string::npos) << e.what();
+  }
+}
+
 TEST(IntervalTree, VisitorStopsEarly) {
   const std::vector<Interval> ivs(50, Interval{0, 10});
   const auto tree = IntervalTree::build(ivs);

@@ -7,7 +7,9 @@
 // thanks to the order on lo, every right subtree once a node starts right of it. Balance comes
 // from treap priorities (Seidel and Aragon, "Randomized Search Trees", Algorithmica 1996)
 // drawn from a fixed-seed hash of an insertion counter, so the same operations always build
-// the same tree. Nodes live in one pool indexed by 32-bit integers with a free list.
+// the same tree. Nodes live in one pool indexed by 32-bit integers with a free list. build()
+// makes the balanced tree of a whole set at once, in pre-order in the pool, so that the many
+// subtrees a query enters are read in memory order rather than scattered by insertion order.
 //
 // Typical uses: route mileposts (which features cover kilometre 12.3?), time ranges of
 // reports (which reports were valid between t1 and t2?).
@@ -24,7 +26,9 @@
 // access.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <span>
 #include <string>
@@ -43,13 +47,11 @@ class IntervalTree {
   IntervalTree() = default;
 
   // Builds from intervals; interval i gets id i. Throws InvalidGeometry on a bad interval.
-  static IntervalTree build(std::span<const Interval> intervals) {
-    IntervalTree t;
-    t.nodes_.reserve(intervals.size());
-    for (std::size_t i = 0; i < intervals.size(); ++i)
-      t.insert(intervals[i], Id(i));
-    return t;
-  }
+  // The tree comes out perfectly balanced and laid out in pre-order (a node, then its left
+  // subtree, then its right), so that a query reads memory mostly forwards; treap priorities
+  // are drawn as for insertions and handed out shallowest node first, so later insertions
+  // and erasures keep it a treap.
+  static IntervalTree build(std::span<const Interval> intervals);
 
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
@@ -124,12 +126,16 @@ class IntervalTree {
     return std::tie(a.lo, a.hi, ia) < std::tie(b.lo, b.hi, ib);
   }
 
-  std::uint32_t allocate(const Interval& iv, Id id) {
-    // splitmix64 of a counter: reproducible priorities without a generator object
+  // splitmix64 of a counter: reproducible priorities without a generator object
+  std::uint32_t next_priority() {
     std::uint64_t z = (++inserted_) * 0x9e3779b97f4a7c15ull;
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    const Node node{iv, iv.hi, id, kNil, kNil, std::uint32_t(z >> 32)};
+    return std::uint32_t(z >> 32);
+  }
+
+  std::uint32_t allocate(const Interval& iv, Id id) {
+    const Node node{iv, iv.hi, id, kNil, kNil, next_priority()};
     if (free_ != kNil) {
       const std::uint32_t n = free_;
       free_ = nodes_[n].left;
@@ -232,9 +238,10 @@ class IntervalTree {
         ++s.results;
         if (!visit(x.id, x.iv)) return s;
       }
-      if (x.left != kNil) stack.push_back(x.left);
-      // the right subtree starts at or after x.iv.lo
+      // the right subtree starts at or after x.iv.lo; the left one is taken first, as laid
+      // out by build()
       if (x.right != kNil && x.iv.lo <= b) stack.push_back(x.right);
+      if (x.left != kNil) stack.push_back(x.left);
     }
     return s;
   }
@@ -245,6 +252,54 @@ class IntervalTree {
   std::size_t size_ = 0;
   std::uint64_t inserted_ = 0;
 };
+
+inline IntervalTree IntervalTree::build(std::span<const Interval> intervals) {
+  if (intervals.size() >= kNil - 1)
+    throw InvalidArgument("IntervalTree holds at most 2^32 - 2 intervals");
+  for (std::size_t i = 0; i < intervals.size(); ++i)
+    check_interval(intervals[i], ("interval " + std::to_string(i)).c_str());
+  const std::size_t n = intervals.size();
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i)
+    order[i] = std::uint32_t(i);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return key_less(intervals[a], a, intervals[b], b);
+  });
+  IntervalTree t;
+  t.nodes_.resize(n);
+  std::vector<std::uint8_t> depth(n);
+  std::uint32_t next = 0;
+  // sorted range [lo, hi) becomes the subtree at the next free slot; recursion depth log2(n)
+  auto place = [&](auto& self, std::size_t lo, std::size_t hi, std::uint8_t d) -> std::uint32_t {
+    if (lo == hi) return kNil;
+    const std::size_t mid = lo + (hi - lo) / 2;
+    const std::uint32_t slot = next++, k = order[mid];
+    depth[slot] = d;
+    const std::uint32_t left = self(self, lo, mid, std::uint8_t(d + 1));
+    const std::uint32_t right = self(self, mid + 1, hi, std::uint8_t(d + 1));
+    t.nodes_[slot] = Node{intervals[k], intervals[k].hi, Id(k), left, right, 0};
+    t.pull(slot);
+    return slot;
+  };
+  t.root_ = place(place, 0, n, 0);
+  t.size_ = n;
+  // the largest priorities to the shallowest nodes: a heap, whatever the draws
+  std::vector<std::uint32_t> prio(n);
+  for (auto& p : prio)
+    p = t.next_priority();
+  std::sort(prio.begin(), prio.end(), std::greater<>());
+  std::vector<std::uint32_t> by_depth(n);
+  std::vector<std::size_t> start(65, 0);
+  for (std::uint8_t d : depth)
+    ++start[d + 1];
+  for (std::size_t d = 1; d < start.size(); ++d)
+    start[d] += start[d - 1];
+  for (std::uint32_t v = 0; v < n; ++v)
+    by_depth[start[depth[v]]++] = v;
+  for (std::size_t r = 0; r < n; ++r)
+    t.nodes_[by_depth[r]].prio = prio[r];
+  return t;
+}
 
 inline void IntervalTree::validate() const {
   auto fail = [](const std::string& what) { throw Error("IntervalTree invalid: " + what); };
