@@ -37,10 +37,10 @@
 // coordinates; the priority search trees are in heap and split order; the endpoint tree holds
 // 2n points.
 //
-// Complexity: build O(n log n); memory O(n) (about 200 bytes per segment with the endpoint
-// tree). The crossing part of a query costs O(log^2 n + k); the endpoint part is a k-d tree
-// window query, O(sqrt(n) + k) in the worst case, where the book's range tree would give
-// O(log^2 n + k) with O(n log n) memory, but the k-d tree is faster on map data.
+// Complexity: build O(n log n); memory O(n), about 230 bytes per segment of which the endpoint
+// tree takes half. The crossing part of a query costs O(log^2 n + k); the endpoint part is a
+// k-d tree window query, O(sqrt(n) + k) in the worst case (the book's range tree would give
+// O(log^2 n + k) at the price of O(n log n) memory).
 // Thread-safety: immutable after build; any number of concurrent queries.
 #pragma once
 
@@ -97,8 +97,12 @@ class CenteredIntervalTree {
  private:
   static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
+  // 40 bytes. lo_min and hi_max repeat the roots of the node's two trees so that a walk
+  // passes a node whose trees cannot answer without touching them.
   struct Node {
     double mid;           // median x of the endpoints of the segments the node was built from
+    double lo_min;        // smallest left end x of the stored segments
+    double hi_max;        // largest right end x
     std::uint32_t left;   // segments ending before mid; kNone when there are none
     std::uint32_t right;  // segments starting after mid
     std::uint32_t begin;  // the node's trees: [begin, end) of by_lo_ and of by_hi_
@@ -165,7 +169,7 @@ inline std::uint32_t CenteredIntervalTree::build_at(std::span<Held> held, std::v
 
   const std::uint32_t v = std::uint32_t(nodes_.size());
   const std::uint32_t begin = std::uint32_t(by_lo_.size());
-  nodes_.push_back({mid, kNone, kNone, begin, std::uint32_t(begin + n_here)});
+  nodes_.push_back({mid, 0.0, 0.0, kNone, kNone, begin, std::uint32_t(begin + n_here)});
   by_lo_.resize(begin + n_here);
   by_hi_.resize(begin + n_here);
   items.clear();
@@ -176,6 +180,8 @@ inline std::uint32_t CenteredIntervalTree::build_at(std::span<Held> held, std::v
   for (auto it = here_begin; it != here_end; ++it)
     items.push_back({{it->hi, it->y}, 0.0, it->id});
   build_pst<PstSide::right>(items, std::span<PstNode>(by_hi_).subspan(begin, n_here));
+  nodes_[v].lo_min = by_lo_[begin].p[0];
+  nodes_[v].hi_max = by_hi_[begin].p[0];
 
   const std::uint32_t l = build_at(held.first(n_left), ends, items);
   const std::uint32_t r = build_at(held.subspan(n_left + n_here), ends, items);
@@ -193,10 +199,12 @@ bool CenteredIntervalTree::stab(double x, double y1, double y2, std::vector<std:
     const Node& n = nodes_[v];
     ++s.nodes_visited;
     if (x < n.mid) {
-      if (!query_pst<PstSide::left>(lo_tree(n), x, y1, y2, stack, s, report)) return false;
+      if (n.lo_min <= x && !query_pst<PstSide::left>(lo_tree(n), x, y1, y2, stack, s, report))
+        return false;
       v = n.left;
     } else if (x > n.mid) {
-      if (!query_pst<PstSide::right>(hi_tree(n), x, y1, y2, stack, s, report)) return false;
+      if (n.hi_max >= x && !query_pst<PstSide::right>(hi_tree(n), x, y1, y2, stack, s, report))
+        return false;
       v = n.right;
     } else {
       // every segment here contains x, and every segment below misses it
@@ -233,6 +241,8 @@ inline void CenteredIntervalTree::validate(std::span<const Segment<2>> segs,
     if (n.begin != expected_begin || !(n.begin < n.end) || n.end > by_lo_.size())
       fail("stored runs do not tile the arrays in preorder" + at);
     expected_begin = n.end;
+    if (n.lo_min != by_lo_[n.begin].p[0] || n.hi_max != by_hi_[n.begin].p[0])
+      fail("lo_min or hi_max differs from the root of its tree" + at);
     for (std::uint32_t j = n.begin; j < n.end; ++j) {
       for (const PstNode* e : {&by_lo_[j], &by_hi_[j]}) {
         if (e->id >= segs.size() || !holds(segs[e->id], swap_))
