@@ -55,10 +55,9 @@
 #include "loci/geom/error.hpp"
 #include "loci/geom/segment.hpp"
 #include "loci/index/detail/scratch.hpp"
-#include "loci/index/kd_tree.hpp"
+#include "loci/index/detail/segment_endpoints.hpp"
 #include "loci/index/priority_search_tree.hpp"
 #include "loci/index/query.hpp"
-#include "loci/index/segment_window_tree.hpp"
 
 namespace loci {
 
@@ -281,34 +280,23 @@ class AxisParallelWindowTree {
   // Segment i gets id i. Throws InvalidGeometry on a NaN or infinite coordinate or a segment
   // that is neither horizontal nor vertical, InvalidArgument for 2^31 - 1 segments or more.
   static AxisParallelWindowTree build(std::span<const Segment<2>> segments) {
-    if (segments.size() >= 0x7fffffffu)
-      throw InvalidArgument("AxisParallelWindowTree holds at most 2^31 - 2 segments");
     AxisParallelWindowTree t;
-    std::vector<Point<2>> ends;
-    ends.reserve(2 * segments.size());
-    for (std::size_t i = 0; i < segments.size(); ++i) {
-      const Segment<2>& s = segments[i];
-      const std::string what = "segment " + std::to_string(i);
-      check_segment(s, what.c_str());
-      if (s.a[0] != s.b[0] && s.a[1] != s.b[1])
-        throw InvalidGeometry(what + " is not axis-parallel: " + to_string(s.a) + " - " +
-                              to_string(s.b));
-      ends.push_back(s.a);
-      ends.push_back(s.b);
-    }
-    t.segs_.assign(segments.begin(), segments.end());
-    t.ends_ = KdTree<2>::build(ends);
+    t.ends_ = detail::SegmentEndpoints(
+        segments, "AxisParallelWindowTree", [](std::size_t i, const Segment<2>& s) {
+          if (s.a[0] != s.b[0] && s.a[1] != s.b[1])
+            throw InvalidGeometry("segment " + std::to_string(i) + " is not axis-parallel: " +
+                                  to_string(s.a) + " - " + to_string(s.b));
+        });
     t.horizontal_ = detail::CenteredIntervalTree(segments, false);
     t.vertical_ = detail::CenteredIntervalTree(segments, true);
     return t;
   }
 
-  std::size_t size() const { return segs_.size(); }
-  bool empty() const { return segs_.empty(); }
-  const Segment<2>& segment(Id id) const { return segs_.at(std::size_t(id)); }
+  std::size_t size() const { return ends_.segments().size(); }
+  bool empty() const { return size() == 0; }
+  const Segment<2>& segment(Id id) const { return ends_.segment(id); }
   std::size_t memory_bytes() const {
-    return segs_.size() * sizeof(Segment<2>) + ends_.memory_bytes() + horizontal_.memory_bytes() +
-           vertical_.memory_bytes();
+    return ends_.memory_bytes() + horizontal_.memory_bytes() + vertical_.memory_bytes();
   }
 
   // Calls visit(id, segment) once for every segment meeting the closed window; stops when it
@@ -323,18 +311,13 @@ class AxisParallelWindowTree {
 
   // Throws loci::Error describing the first broken invariant.
   void validate() const {
-    ends_.validate();
-    if (ends_.size() != 2 * segs_.size())
-      throw Error("AxisParallelWindowTree invalid: endpoint tree holds " +
-                  std::to_string(ends_.size()) + " points for " + std::to_string(segs_.size()) +
-                  " segments");
-    horizontal_.validate(segs_, "horizontal tree");
-    vertical_.validate(segs_, "vertical tree");
+    ends_.validate("AxisParallelWindowTree");
+    horizontal_.validate(ends_.segments(), "horizontal tree");
+    vertical_.validate(ends_.segments(), "vertical tree");
   }
 
  private:
-  std::vector<Segment<2>> segs_;
-  KdTree<2> ends_;                           // endpoint 2i + e is endpoint e of segment i
+  detail::SegmentEndpoints ends_;            // the segments, and their endpoints in a kd-tree
   detail::CenteredIntervalTree horizontal_;  // walked along the window's left edge
   detail::CenteredIntervalTree vertical_;    // on (y, x): walked along the bottom edge
 };
@@ -343,21 +326,12 @@ template <SegmentVisitor Visit>
 QueryStats AxisParallelWindowTree::query(const Box<2>& w, Visit&& visit) const {
   check_box(w, "query window");
   QueryStats s;
-  if (segs_.empty()) return s;
-  bool go = true;
-  const QueryStats ks = ends_.query(w, [&](Id e, const Box<2>&) {
-    const std::size_t i = std::size_t(e / 2);
-    if (e % 2 == 1 && intersects(w, segs_[i].a)) return true;
-    ++s.results;
-    return go = visit(Id(i), segs_[i]);
-  });
-  s.nodes_visited += ks.nodes_visited;
-  s.entries_tested += ks.entries_tested;
-  if (!go) return s;
+  if (empty()) return s;
+  if (!ends_.report_inside(w, s, visit)) return s;
 
   // The walks also meet segments with an endpoint in W; those were reported above.
   auto crossing = [&](std::size_t i) {
-    const Segment<2>& g = segs_[i];
+    const Segment<2>& g = ends_.segments()[i];
     if (intersects(w, g.a) || intersects(w, g.b)) return true;
     ++s.results;
     return bool(visit(Id(i), g));

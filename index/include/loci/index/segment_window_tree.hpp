@@ -44,15 +44,10 @@
 #include "loci/geom/error.hpp"
 #include "loci/geom/segment.hpp"
 #include "loci/index/detail/canonical_nodes.hpp"
-#include "loci/index/kd_tree.hpp"
+#include "loci/index/detail/segment_endpoints.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci {
-
-template <class F>
-concept SegmentVisitor = std::predicate < F&,
-        Id, const Segment<2>
-& > ;
 
 namespace detail {
 
@@ -283,29 +278,18 @@ class SegmentWindowTree {
 
   // Segment i gets id i. Throws InvalidGeometry on a NaN or infinite coordinate.
   static SegmentWindowTree build(std::span<const Segment<2>> segments) {
-    if (segments.size() >= 0x7fffffffu)
-      throw InvalidArgument("SegmentWindowTree holds at most 2^31 - 1 segments");
     SegmentWindowTree t;
-    t.segs_.assign(segments.begin(), segments.end());
-    std::vector<Point<2>> ends;
-    ends.reserve(2 * segments.size());
-    for (std::size_t i = 0; i < segments.size(); ++i) {
-      check_segment(segments[i], ("segment " + std::to_string(i)).c_str());
-      ends.push_back(segments[i].a);
-      ends.push_back(segments[i].b);
-    }
-    t.ends_ = KdTree<2>::build(ends);
+    t.ends_ = detail::SegmentEndpoints(segments, "SegmentWindowTree", [](std::size_t, auto&) {});
     t.by_x_ = detail::SlabTree(segments, false);
     t.by_y_ = detail::SlabTree(segments, true);
     return t;
   }
 
-  std::size_t size() const { return segs_.size(); }
-  bool empty() const { return segs_.empty(); }
-  const Segment<2>& segment(Id id) const { return segs_.at(std::size_t(id)); }
+  std::size_t size() const { return ends_.segments().size(); }
+  bool empty() const { return size() == 0; }
+  const Segment<2>& segment(Id id) const { return ends_.segment(id); }
   std::size_t memory_bytes() const {
-    return segs_.size() * sizeof(Segment<2>) + ends_.memory_bytes() + by_x_.memory_bytes() +
-           by_y_.memory_bytes();
+    return ends_.memory_bytes() + by_x_.memory_bytes() + by_y_.memory_bytes();
   }
 
   // Calls visit(id, segment) once for every segment meeting the closed window; stops when it
@@ -320,35 +304,25 @@ class SegmentWindowTree {
 
   // Throws loci::Error describing the first broken invariant.
   void validate() const {
-    ends_.validate();
-    if (ends_.size() != 2 * segs_.size()) throw Error("SegmentWindowTree invalid: endpoints");
+    ends_.validate("SegmentWindowTree");
     by_x_.validate();
     by_y_.validate();
   }
 
  private:
-  std::vector<Segment<2>> segs_;
-  KdTree<2> ends_;         // endpoint 2i + e is endpoint e of segment i
-  detail::SlabTree by_x_;  // for the left and right edges
-  detail::SlabTree by_y_;  // on (y, x): for the bottom and top edges
+  detail::SegmentEndpoints ends_;  // the segments, and their endpoints in a kd-tree
+  detail::SlabTree by_x_;          // for the left and right edges
+  detail::SlabTree by_y_;          // on (y, x): for the bottom and top edges
 };
 
 template <SegmentVisitor Visit>
 QueryStats SegmentWindowTree::query(const Box<2>& w, Visit&& visit) const {
   check_box(w, "query window");
   QueryStats s;
-  if (segs_.empty()) return s;
-  bool go = true;
+  if (empty()) return s;
   // 1. segments with an endpoint inside: reported through the first such endpoint
-  const QueryStats ks = ends_.query(w, [&](Id e, const Box<2>&) {
-    const std::size_t i = std::size_t(e / 2);
-    if (e % 2 == 1 && intersects(w, segs_[i].a)) return true;
-    ++s.results;
-    return go = visit(Id(i), segs_[i]);
-  });
-  s.nodes_visited += ks.nodes_visited;
-  s.entries_tested += ks.entries_tested;
-  if (!go) return s;
+  if (!ends_.report_inside(w, s, visit)) return s;
+  const auto segs = ends_.segments();
 
   // 2. segments crossing the boundary with both endpoints outside, through the first edge
   const Segment<2> left{{w.min[0], w.min[1]}, {w.min[0], w.max[1]}};
@@ -357,33 +331,33 @@ QueryStats SegmentWindowTree::query(const Box<2>& w, Visit&& visit) const {
   auto outside = [&](const Segment<2>& g) { return !intersects(w, g.a) && !intersects(w, g.b); };
   auto report = [&](std::size_t i) {
     ++s.results;
-    return go = visit(Id(i), segs_[i]);
+    return bool(visit(Id(i), segs[i]));
   };
   if (!by_x_.stab(
           w.min[0], w.min[1], w.max[1],
-          [&](std::size_t i) { return !outside(segs_[i]) || report(i); }, s))
+          [&](std::size_t i) { return !outside(segs[i]) || report(i); }, s))
     return s;
   if (!by_x_.stab(
           w.max[0], w.min[1], w.max[1],
           [&](std::size_t i) {
-            const Segment<2>& g = segs_[i];
+            const Segment<2>& g = segs[i];
             return !outside(g) || intersects(g, left) || report(i);
           },
           s))
     return s;
   // an edge's slab tree may not hold a segment that meets it (axis-parallel ones)
   auto earlier_x = [&](std::size_t i) {
-    const Segment<2>& g = segs_[i];
+    const Segment<2>& g = segs[i];
     return by_x_.holds(i) && (intersects(g, left) || intersects(g, right));
   };
   if (!by_y_.stab(
           w.min[1], w.min[0], w.max[0],
-          [&](std::size_t i) { return !outside(segs_[i]) || earlier_x(i) || report(i); }, s))
+          [&](std::size_t i) { return !outside(segs[i]) || earlier_x(i) || report(i); }, s))
     return s;
   by_y_.stab(
       w.max[1], w.min[0], w.max[0],
       [&](std::size_t i) {
-        return !outside(segs_[i]) || earlier_x(i) || intersects(segs_[i], bottom) || report(i);
+        return !outside(segs[i]) || earlier_x(i) || intersects(segs[i], bottom) || report(i);
       },
       s);
   return s;
