@@ -10,24 +10,15 @@
 #include "loci/index/axis_parallel_window_tree.hpp"
 #include "loci/index/segment_window_tree.hpp"
 #include "loci/io/layer_cells.hpp"
+#include "support/brute_force.hpp"
+#include "support/segment_data.hpp"
 
 using namespace loci;
+using namespace loci::test;
 
 namespace {
 
 const std::string kSample = std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson";
-
-std::vector<Id> brute(const std::vector<Segment2>& segs, const Box2& w) {
-  std::vector<Id> out;
-  for (std::size_t i = 0; i < segs.size(); ++i)
-    if (intersects(w, segs[i])) out.push_back(i);
-  return out;
-}
-
-std::vector<Id> sorted(std::vector<Id> v) {
-  std::sort(v.begin(), v.end());
-  return v;
-}
 
 // Windows centred on the data, of sides from nothing to a fifth of the extent.
 std::vector<Box2> windows(const std::vector<Segment2>& segs, const Box2& ext, std::size_t n) {
@@ -57,7 +48,7 @@ TEST(LayerWindowing, SegmentWindowTreeOnTheSample) {
   tree.validate();
   std::size_t hits = 0;
   for (const Box2& w : windows(segs, ext, 200)) {
-    const auto want = brute(segs, w);
+    const auto want = brute_segments(segs, w);
     ASSERT_EQ(sorted(tree.query(w)), want) << to_string(w);
     hits += want.size();
   }
@@ -86,7 +77,7 @@ TEST(LayerWindowing, AxisParallelWindowTreeOnTheSampleCellOutlines) {
     ws.push_back(cells.cell_box(rng() % 32, rng() % 32, 5));
   std::size_t hits = 0;
   for (const Box2& w : ws) {
-    const auto want = brute(segs, w);
+    const auto want = brute_segments(segs, w);
     ASSERT_EQ(sorted(tree.query(w)), want) << to_string(w);
     hits += want.size();
   }

@@ -12,18 +12,12 @@
 #include "loci/index/segment_window_tree.hpp"
 #include "support/brute_force.hpp"
 #include "support/random_data.hpp"
+#include "support/segment_data.hpp"
 
 using namespace loci;
 using namespace loci::test;
 
 namespace {
-
-std::vector<Id> brute_segments(const std::vector<Segment2>& segs, const Box2& w) {
-  std::vector<Id> out;
-  for (std::size_t i = 0; i < segs.size(); ++i)
-    if (intersects(w, segs[i])) out.push_back(i);
-  return out;
-}
 
 enum class Layer {
   uniform,
@@ -137,25 +131,6 @@ std::vector<Segment2> make_layer(Layer layer, std::size_t n, std::uint64_t seed)
   return out;
 }
 
-Box2 make_window(std::mt19937_64& rng, const std::vector<Segment2>& segs, bool grid) {
-  if (grid) {
-    auto g = [&] { return double(rng() % 45) - 2; };
-    double x0 = g(), x1 = g(), y0 = g(), y1 = g();
-    if (rng() % 8 == 0) x1 = x0;  // zero width
-    if (rng() % 8 == 0) y1 = y0;  // zero height
-    return {{std::min(x0, x1), std::min(y0, y1)}, {std::max(x0, x1), std::max(y0, y1)}};
-  }
-  if (rng() % 2) {
-    // a corner or an edge on an endpoint of some segment
-    const Segment2& s = segs[rng() % segs.size()];
-    const Point2 c = rng() % 2 ? s.a : s.b;
-    const double wx = double(rng() % 60), wy = double(rng() % 60);
-    return {{c[0] - (rng() % 2 ? wx : 0), c[1] - (rng() % 2 ? wy : 0)},
-            {c[0] + (rng() % 2 ? wx : 0), c[1] + (rng() % 2 ? wy : 0)}};
-  }
-  return random_window<2>(rng, 120);
-}
-
 class Layers : public ::testing::TestWithParam<Layer> {};
 
 TEST_P(Layers, MatchesBruteForceAndSegmentWindowTree) {
@@ -168,7 +143,7 @@ TEST_P(Layers, MatchesBruteForceAndSegmentWindowTree) {
   std::mt19937_64 rng(23);
   std::size_t hits = 0;
   for (int q = 0; q < 300; ++q) {
-    const Box2 w = make_window(rng, segs, grid);
+    const Box2 w = segment_window(rng, segs, grid);
     const auto expected = brute_segments(segs, w);
     std::vector<Id> got;
     const QueryStats s = tree.query(w, [&](Id id, const Segment2& g) {

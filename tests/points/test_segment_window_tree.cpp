@@ -10,18 +10,12 @@
 #include "loci/index/segment_window_tree.hpp"
 #include "support/brute_force.hpp"
 #include "support/random_data.hpp"
+#include "support/segment_data.hpp"
 
 using namespace loci;
 using namespace loci::test;
 
 namespace {
-
-std::vector<Id> brute_segments(const std::vector<Segment2>& segs, const Box2& w) {
-  std::vector<Id> out;
-  for (std::size_t i = 0; i < segs.size(); ++i)
-    if (intersects(w, segs[i])) out.push_back(i);
-  return out;
-}
 
 enum class Layer { short_random, long_crossing, polyline, grid_degenerate, axis_parallel };
 
@@ -107,24 +101,6 @@ std::vector<Segment2> make_layer(Layer layer, std::size_t n, std::uint64_t seed)
   return out;
 }
 
-Box2 make_window(std::mt19937_64& rng, const std::vector<Segment2>& segs, bool grid) {
-  if (grid) {
-    auto g = [&] { return double(rng() % 43) - 1; };
-    double x0 = g(), x1 = g(), y0 = g(), y1 = g();
-    if (rng() % 8 == 0) x1 = x0;  // zero-width windows too
-    return {{std::min(x0, x1), std::min(y0, y1)}, {std::max(x0, x1), std::max(y0, y1)}};
-  }
-  if (rng() % 2) {
-    // a corner on an endpoint of some segment
-    const Segment2& s = segs[rng() % segs.size()];
-    const Point2 c = rng() % 2 ? s.a : s.b;
-    const double wx = double(rng() % 60), wy = double(rng() % 60);
-    return {{c[0] - (rng() % 2 ? wx : 0), c[1] - (rng() % 2 ? wy : 0)},
-            {c[0] + (rng() % 2 ? wx : 0), c[1] + (rng() % 2 ? wy : 0)}};
-  }
-  return random_window<2>(rng, 120);
-}
-
 class Layers : public ::testing::TestWithParam<Layer> {};
 
 TEST_P(Layers, MatchesBruteForce) {
@@ -135,7 +111,7 @@ TEST_P(Layers, MatchesBruteForce) {
   std::mt19937_64 rng(23);
   std::size_t hits = 0;
   for (int q = 0; q < 300; ++q) {
-    const Box2 w = make_window(rng, segs, grid);
+    const Box2 w = segment_window(rng, segs, grid);
     const auto expected = brute_segments(segs, w);
     const auto got = tree.query(w);
     ASSERT_EQ(got.size(), expected.size()) << to_string(w) << " (a duplicate or a miss)";
