@@ -4,8 +4,8 @@
 // region quadtree: inside blocks, the MX boundary cells its linework runs through, and the
 // empty blocks outlined.
 //
-// The tree's levels are recomputed from its item count (the packed layout is implicit) and a
-// node's rectangle is the union of its entries. Linework is projected to pixels with y up and
+// The tree's levels come from its implicit layout (PackedRTree::level) and a node's rectangle
+// is the union of its entries. Linework is projected to pixels with y up and
 // rounded to a tenth of a pixel; consecutive points that round together are dropped, which
 // keeps a drawing of a million-segment layer a few megabytes.
 #include <cmath>
@@ -74,24 +74,17 @@ void write_linework(std::FILE* o, const Frame& f, const std::string& layer_path,
 std::size_t write_nodes(std::FILE* o, const Frame& f, const PackedRTree2& tree, int max_levels) {
   static const char* colours[] = {"#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02"};
   const auto blocks = tree.blocks();
-  std::vector<std::size_t> count{tree.size()}, offset{0};
-  while (true) {
-    const std::size_t nb = (count.back() + PackedRTree2::node_size - 1) / PackedRTree2::node_size;
-    offset.push_back(offset.back() + nb);
-    if (nb == 1) break;
-    count.push_back(nb);
-  }
-  const int levels = int(count.size());
+  const int levels = tree.levels();
   const int first = std::max(0, levels - max_levels);
   std::size_t drawn = 0;
   for (int l = first; l < levels; ++l) {
     std::fprintf(o, "<g fill=\"none\" stroke=\"%s\" stroke-width=\"%.1f\" opacity=\"0.8\">\n",
                  colours[(levels - 1 - l) % 6], 0.6 + 0.6 * (l - first));
-    const std::size_t nb = offset[l + 1] - offset[l];
-    for (std::size_t b = 0; b < nb; ++b) {
-      const int used = int(
-          std::min<std::size_t>(PackedRTree2::node_size, count[l] - b * PackedRTree2::node_size));
-      write_rect(o, f, blocks[offset[l] + b].bounds(used));
+    const auto& level = tree.level(l);
+    for (std::size_t b = 0; b < level.blocks; ++b) {
+      const int used = int(std::min<std::size_t>(PackedRTree2::node_size,
+                                                 level.entries - b * PackedRTree2::node_size));
+      write_rect(o, f, blocks[level.first_block + b].bounds(used));
       ++drawn;
     }
     std::fprintf(o, "</g>\n");

@@ -78,18 +78,6 @@ std::uint64_t avalanche(std::uint64_t h) {
   return h;
 }
 
-// The number of blocks a packed tree of `n` items has; mirrors PackedRTree's level layout.
-std::uint64_t blocks_for(std::uint64_t n, std::uint64_t node) {
-  if (n == 0) return 0;
-  std::uint64_t total = 0;
-  for (std::uint64_t count = n;;) {
-    const std::uint64_t b = (count + node - 1) / node;
-    total += b;
-    if (b == 1) return total;
-    count = b;
-  }
-}
-
 struct Mapping {
   const std::byte* data = nullptr;
   std::size_t size = 0;
@@ -307,7 +295,8 @@ Sidecar Sidecar::open(const std::string& path) {
       h.dimension != 2 || h.node_size != PackedRTree2::node_size || h.packing > 1 || h.per > 1)
     throw refuse("index of a structure this loci does not read");
   const std::uint64_t node = PackedRTree2::node_size;
-  const std::uint64_t expect_blocks = blocks_for(h.item_count, node);
+  const std::uint64_t expect_blocks =
+      h.item_count >= (1ull << 32) ? 0 : PackedRTree2::block_count(std::size_t(h.item_count));
   const std::uint64_t expect_slots =
       h.item_count == 0 ? 0 : (h.item_count + node - 1) / node * node;
   using Block = PackedRTree2::Block;

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "loci/index/detail/interval.hpp"
+#include "loci/index/query.hpp"
 
 namespace loci::test {
 

@@ -36,7 +36,7 @@
 #include <vector>
 
 #include "loci/geom/error.hpp"
-#include "loci/index/detail/interval.hpp"
+#include "loci/index/detail/node_pool.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/query.hpp"
 
@@ -59,8 +59,6 @@ class IntervalTree {
   // Throws InvalidGeometry on a NaN, infinite or inverted interval.
   void insert(const Interval& iv, Id id) {
     check_interval(iv);
-    if (nodes_.size() >= kNil - 1 && free_ == kNil)
-      throw InvalidArgument("IntervalTree holds at most 2^32 - 2 intervals");
     const std::uint32_t n = allocate(iv, id);
     root_ = insert_at(root_, n);
     ++size_;
@@ -77,7 +75,7 @@ class IntervalTree {
 
   void clear() {
     nodes_.clear();
-    root_ = free_ = kNil;
+    root_ = kNone;
     size_ = 0;
   }
 
@@ -89,9 +87,7 @@ class IntervalTree {
     return walk(x, x, visit);
   }
   std::vector<Id> stab(double x) const {
-    std::vector<Id> out;
-    stab(x, [&](Id id, const Interval&) { return out.push_back(id), true; });
-    return out;
+    return collect_ids([&](auto&& v) { return stab(x, v); });
   }
 
   // Calls visit(id, interval) for every interval meeting the closed range q.
@@ -102,24 +98,20 @@ class IntervalTree {
     return walk(q.lo, q.hi, visit);
   }
   std::vector<Id> overlap(const Interval& q) const {
-    std::vector<Id> out;
-    overlap(q, [&](Id id, const Interval&) { return out.push_back(id), true; });
-    return out;
+    return collect_ids([&](auto&& v) { return overlap(q, v); });
   }
 
   // Throws loci::Error describing the first broken invariant.
   void validate() const;
 
  private:
-  static constexpr std::uint32_t kNil = std::numeric_limits<std::uint32_t>::max();
-
-  struct Node {
-    Interval iv;
-    double max_hi;
-    Id id;
-    std::uint32_t left;  // also the next free node while on the free list
-    std::uint32_t right;
-    std::uint32_t prio;
+  struct Node {           // 48 bytes
+    Interval iv;          // 16: the entry
+    double max_hi;        // 8: largest hi in the subtree, what lets a query skip it
+    Id id;                // 8: the entry's id
+    std::uint32_t left;   // 4: lower keys; next free node while on the pool's free list
+    std::uint32_t right;  // 4: higher keys
+    std::uint32_t prio;   // 4: treap priority, at least the children's
   };
 
   static bool key_less(const Interval& a, Id ia, const Interval& b, Id ib) {
@@ -135,22 +127,16 @@ class IntervalTree {
   }
 
   std::uint32_t allocate(const Interval& iv, Id id) {
-    const Node node{iv, iv.hi, id, kNil, kNil, next_priority()};
-    if (free_ != kNil) {
-      const std::uint32_t n = free_;
-      free_ = nodes_[n].left;
-      nodes_[n] = node;
-      return n;
-    }
-    nodes_.push_back(node);
-    return std::uint32_t(nodes_.size() - 1);
+    const std::uint32_t n = nodes_.allocate("IntervalTree");
+    nodes_[n] = Node{iv, iv.hi, id, kNone, kNone, next_priority()};
+    return n;
   }
 
   void pull(std::uint32_t n) {
     Node& x = nodes_[n];
     x.max_hi = x.iv.hi;
-    if (x.left != kNil) x.max_hi = std::max(x.max_hi, nodes_[x.left].max_hi);
-    if (x.right != kNil) x.max_hi = std::max(x.max_hi, nodes_[x.right].max_hi);
+    if (x.left != kNone) x.max_hi = std::max(x.max_hi, nodes_[x.left].max_hi);
+    if (x.right != kNone) x.max_hi = std::max(x.max_hi, nodes_[x.right].max_hi);
   }
 
   std::uint32_t rotate_right(std::uint32_t n) {
@@ -172,7 +158,7 @@ class IntervalTree {
 
   // Recursion depth is the tree height, O(log n) expected.
   std::uint32_t insert_at(std::uint32_t t, std::uint32_t n) {
-    if (t == kNil) return n;
+    if (t == kNone) return n;
     const Node& x = nodes_[n];
     if (key_less(x.iv, x.id, nodes_[t].iv, nodes_[t].id)) {
       const std::uint32_t l = insert_at(nodes_[t].left, n);
@@ -189,13 +175,12 @@ class IntervalTree {
   }
 
   std::uint32_t erase_at(std::uint32_t t, const Interval& iv, Id id, bool& found) {
-    if (t == kNil) return kNil;
+    if (t == kNone) return kNone;
     Node& x = nodes_[t];
     if (x.iv == iv && x.id == id) {
       found = true;
       const std::uint32_t merged = merge(x.left, x.right);
-      x.left = free_;
-      free_ = t;
+      nodes_.release(t);
       return merged;
     }
     if (key_less(iv, id, x.iv, x.id))
@@ -208,8 +193,8 @@ class IntervalTree {
 
   // Joins two treaps whose keys are ordered a < b.
   std::uint32_t merge(std::uint32_t a, std::uint32_t b) {
-    if (a == kNil) return b;
-    if (b == kNil) return a;
+    if (a == kNone) return b;
+    if (b == kNone) return a;
     if (nodes_[a].prio > nodes_[b].prio) {
       nodes_[a].right = merge(nodes_[a].right, b);
       pull(a);
@@ -224,7 +209,7 @@ class IntervalTree {
   template <class Visit>
   QueryStats walk(double a, double b, Visit& visit) const {
     QueryStats s;
-    if (root_ == kNil) return s;
+    if (root_ == kNone) return s;
     detail::Scratch<std::uint32_t> scratch;
     auto& stack = *scratch;
     stack.push_back(root_);
@@ -240,21 +225,20 @@ class IntervalTree {
       }
       // the right subtree starts at or after x.iv.lo; the left one is taken first, as laid
       // out by build()
-      if (x.right != kNil && x.iv.lo <= b) stack.push_back(x.right);
-      if (x.left != kNil) stack.push_back(x.left);
+      if (x.right != kNone && x.iv.lo <= b) stack.push_back(x.right);
+      if (x.left != kNone) stack.push_back(x.left);
     }
     return s;
   }
 
-  std::vector<Node> nodes_;
-  std::uint32_t root_ = kNil;
-  std::uint32_t free_ = kNil;
+  detail::NodePool<Node, &Node::left> nodes_;
+  std::uint32_t root_ = kNone;
   std::size_t size_ = 0;
   std::uint64_t inserted_ = 0;
 };
 
 inline IntervalTree IntervalTree::build(std::span<const Interval> intervals) {
-  if (intervals.size() >= kNil - 1)
+  if (intervals.size() >= kNone - 1)
     throw InvalidArgument("IntervalTree holds at most 2^32 - 2 intervals");
   for (std::size_t i = 0; i < intervals.size(); ++i)
     check_interval(intervals[i], ("interval " + std::to_string(i)).c_str());
@@ -266,14 +250,13 @@ inline IntervalTree IntervalTree::build(std::span<const Interval> intervals) {
     return key_less(intervals[a], a, intervals[b], b);
   });
   IntervalTree t;
-  t.nodes_.resize(n);
+  t.nodes_.reserve(n);
   std::vector<std::uint8_t> depth(n);
-  std::uint32_t next = 0;
   // sorted range [lo, hi) becomes the subtree at the next free slot; recursion depth log2(n)
   auto place = [&](auto& self, std::size_t lo, std::size_t hi, std::uint8_t d) -> std::uint32_t {
-    if (lo == hi) return kNil;
+    if (lo == hi) return kNone;
     const std::size_t mid = lo + (hi - lo) / 2;
-    const std::uint32_t slot = next++, k = order[mid];
+    const std::uint32_t slot = t.nodes_.allocate("IntervalTree"), k = order[mid];
     depth[slot] = d;
     const std::uint32_t left = self(self, lo, mid, std::uint8_t(d + 1));
     const std::uint32_t right = self(self, mid + 1, hi, std::uint8_t(d + 1));
@@ -304,14 +287,15 @@ inline IntervalTree IntervalTree::build(std::span<const Interval> intervals) {
 inline void IntervalTree::validate() const {
   auto fail = [](const std::string& what) { throw Error("IntervalTree invalid: " + what); };
   std::vector<bool> seen(nodes_.size(), false);
+  if (!nodes_.validate_free(seen)) fail("free list corrupt");
   std::size_t count = 0;
   const Node* prev = nullptr;
   // in-order traversal with an explicit stack
   std::vector<std::uint32_t> stack;
   std::uint32_t cur = root_;
-  while (cur != kNil || !stack.empty()) {
-    while (cur != kNil) {
-      if (cur >= nodes_.size()) fail("child index out of range");
+  while (cur != kNone || !stack.empty()) {
+    while (cur != kNone) {
+      if (!nodes_.contains(cur)) fail("child index out of range");
       if (seen[cur]) fail("node " + std::to_string(cur) + " reachable twice");
       seen[cur] = true;
       stack.push_back(cur);
@@ -325,7 +309,7 @@ inline void IntervalTree::validate() const {
     if (prev && key_less(x.iv, x.id, prev->iv, prev->id)) fail("in-order sequence not sorted");
     double m = x.iv.hi;
     for (std::uint32_t c : {x.left, x.right}) {
-      if (c == kNil) continue;
+      if (c == kNone) continue;
       if (nodes_[c].prio > x.prio) fail("heap order broken at node " + std::to_string(n));
       m = std::max(m, nodes_[c].max_hi);
     }
@@ -335,13 +319,9 @@ inline void IntervalTree::validate() const {
   }
   if (count != size_)
     fail("node count " + std::to_string(count) + " != size " + std::to_string(size_));
-  std::size_t free_count = 0;
-  for (std::uint32_t f = free_; f != kNil; f = nodes_[f].left) {
-    if (f >= nodes_.size() || seen[f]) fail("free list corrupt");
-    seen[f] = true;
-    ++free_count;
-  }
-  if (count + free_count != nodes_.size()) fail("nodes leaked from the pool");
+  if (count != nodes_.in_use()) fail("nodes leaked from the pool");
 }
+
+static_assert(IntervalIndex<IntervalTree>);
 
 }  // namespace loci

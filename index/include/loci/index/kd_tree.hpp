@@ -45,6 +45,7 @@
 #include "loci/geom/box.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/best_first.hpp"
+#include "loci/index/detail/node_pool.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/query.hpp"
 
@@ -88,10 +89,7 @@ class KdTree {
   KdSplit split() const { return split_; }
   Box<D> bounds() const { return empty() ? Box<D>::empty() : nodes_[root_].box; }
   int height() const { return root_ == kNone ? 0 : height_of(root_); }
-  std::size_t memory_bytes() const {
-    return nodes_.capacity() * sizeof(Node) + points_.capacity() * sizeof(Point<D>) +
-           ids_.capacity() * sizeof(Id);
-  }
+  std::size_t memory_bytes() const { return nodes_.memory_bytes() + leaves_.memory_bytes(); }
 
   // Throws InvalidGeometry on a NaN or infinite coordinate.
   void insert(const Point<D>& p, Id id);
@@ -103,9 +101,7 @@ class KdTree {
   template <WindowVisitor<D> Visit>
   QueryStats query(const Box<D>& window, Visit&& visit) const;
   std::vector<Id> query(const Box<D>& window) const {
-    std::vector<Id> out;
-    query(window, [&](Id id, const Box<D>&) { return out.push_back(id), true; });
-    return out;
+    return collect_ids([&](auto&& v) { return query(window, v); });
   }
 
   // Calls visit(id, box, distance) for each point at distance <= r from p, in no particular
@@ -113,9 +109,7 @@ class KdTree {
   template <NearestVisitor<D> Visit>
   QueryStats radius(const Point<D>& p, double r, Visit&& visit) const;
   std::vector<Neighbor> radius(const Point<D>& p, double r) const {
-    std::vector<Neighbor> out;
-    radius(p, r, [&](Id id, const Box<D>&, double d) { return out.push_back({id, d}), true; });
-    return out;
+    return collect_neighbors([&](auto&& v) { return radius(p, r, v); });
   }
 
   // Calls visit(id, box, distance) for the k points nearest to p, nearest first.
@@ -123,64 +117,41 @@ class KdTree {
   template <NearestVisitor<D> Visit>
   QueryStats nearest(const Point<D>& p, std::size_t k, Visit&& visit) const;
   std::vector<Neighbor> nearest(const Point<D>& p, std::size_t k) const {
-    std::vector<Neighbor> out;
-    nearest(p, k, [&](Id id, const Box<D>&, double d) { return out.push_back({id, d}), true; });
-    return out;
+    return collect_neighbors([&](auto&& v) { return nearest(p, k, v); });
   }
 
   // Throws loci::Error describing the first broken invariant.
   void validate() const;
 
  private:
-  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-
   struct Item {
     Point<D> p;
     Id id;
   };
 
-  struct Node {
-    Box<D> box;           // contains every point of the subtree
-    double split;         // internal: left <= split <= right on `axis`
-    std::uint32_t left;   // kNone for a leaf; next free node while on the free list
-    std::uint32_t right;  // leaf: its slot in the point pool
-    std::uint32_t size;   // points in the subtree
-    std::uint32_t axis;
+  struct Node {           // 16 D + 24 bytes
+    Box<D> box;           // 16 D: contains every point of the subtree
+    double split;         // 8: internal: left <= split <= right on `axis`
+    std::uint32_t left;   // 4: kNone for a leaf; next free node while on the pool's free list
+    std::uint32_t right;  // 4: leaf: its bucket in leaves_
+    std::uint32_t size;   // 4: points in the subtree
+    std::uint32_t axis;   // 4: internal: the axis of the split
     bool leaf() const { return left == kNone; }
+  };
+  // The points of one leaf, kept apart from the nodes so that a leaf scan reads only them.
+  struct Leaf {               // (8 D + 8) Bucket + 8 bytes
+    Point<D> p[Bucket];       // the first `size` (of the owning node) are in use
+    Id id[Bucket];            // p[i]'s id
+    std::uint32_t next_free;  // next free bucket while on the pool's free list
   };
 
   KdTree(std::vector<Item>&& items, KdSplit split) : split_(split) {
     if (items.size() >= kNone) throw InvalidArgument("KdTree holds at most 2^32 - 2 points");
     if (items.empty()) return;
     nodes_.reserve(2 * (items.size() / (Bucket / 2) + 1));
-    points_.reserve((items.size() / (Bucket / 2) + 1) * Bucket);
-    ids_.reserve(points_.capacity());
-    root_ = allocate_node();
+    leaves_.reserve(items.size() / (Bucket / 2) + 1);
+    root_ = nodes_.allocate("KdTree");
     build_at(root_, items.data(), items.size());
-  }
-
-  std::uint32_t allocate_node() {
-    if (free_node_ != kNone) {
-      const std::uint32_t n = free_node_;
-      free_node_ = nodes_[n].left;
-      return n;
-    }
-    nodes_.push_back({});
-    return std::uint32_t(nodes_.size() - 1);
-  }
-  std::uint32_t allocate_slot() {
-    if (free_slot_ != kNone) {
-      const std::uint32_t s = free_slot_;
-      free_slot_ = std::uint32_t(ids_[std::size_t(s) * Bucket]);
-      return s;
-    }
-    points_.resize(points_.size() + Bucket);
-    ids_.resize(ids_.size() + Bucket);
-    return std::uint32_t(points_.size() / Bucket - 1);
-  }
-  void free_slot(std::uint32_t s) {
-    ids_[std::size_t(s) * Bucket] = free_slot_;
-    free_slot_ = s;
   }
 
   // Builds the subtree of items[0, n) into node `at`; the node's old contents are ignored.
@@ -211,12 +182,9 @@ class KdTree {
   template <class Visit>
   bool report_subtree(std::uint32_t n, Visit& visit, QueryStats& s) const;
 
-  std::vector<Node> nodes_;
-  std::vector<Point<D>> points_;  // Bucket entries per slot
-  std::vector<Id> ids_;           // first id of a free slot holds the next free slot
+  detail::NodePool<Node, &Node::left> nodes_;
+  detail::NodePool<Leaf, &Leaf::next_free> leaves_;
   std::uint32_t root_ = kNone;
-  std::uint32_t free_node_ = kNone;
-  std::uint32_t free_slot_ = kNone;
   KdSplit split_ = KdSplit::median;
 };
 
@@ -250,11 +218,12 @@ template <int D, int Bucket>
 void KdTree<D, Bucket>::build_at(std::uint32_t at, Item* items, std::size_t n) {
   if (n <= std::size_t(Bucket)) {
     Box<D> box = Box<D>::empty();
-    const std::uint32_t slot = allocate_slot();
+    const std::uint32_t slot = leaves_.allocate("KdTree");
+    Leaf& leaf = leaves_[slot];
     for (std::size_t i = 0; i < n; ++i) {
       box.expand(items[i].p);
-      points_[std::size_t(slot) * Bucket + i] = items[i].p;
-      ids_[std::size_t(slot) * Bucket + i] = items[i].id;
+      leaf.p[i] = items[i].p;
+      leaf.id[i] = items[i].id;
     }
     nodes_[at] = Node{box, 0.0, kNone, slot, std::uint32_t(n), 0};
     return;
@@ -267,11 +236,11 @@ void KdTree<D, Bucket>::build_at(std::uint32_t at, Item* items, std::size_t n) {
     if (box.extent(a) > box.extent(axis)) axis = a;
   const std::size_t cut = choose_cut(items, n, axis, box);
   const double split = items[cut].p[axis];
-  const std::uint32_t l = allocate_node();
+  const std::uint32_t l = nodes_.allocate("KdTree");
   build_at(l, items, cut);
-  const std::uint32_t r = allocate_node();
+  const std::uint32_t r = nodes_.allocate("KdTree");
   build_at(r, items + cut, n - cut);
-  // children first: allocate_node() may have moved the pool
+  // children first: allocating may have moved the pool
   nodes_[at] = Node{
       merged(nodes_[l].box, nodes_[r].box), split, l, r, std::uint32_t(n), std::uint32_t(axis)};
 }
@@ -280,16 +249,15 @@ template <int D, int Bucket>
 void KdTree<D, Bucket>::collect(std::uint32_t n, std::vector<Item>& out) {
   const Node x = nodes_[n];
   if (x.leaf()) {
-    const std::size_t base = std::size_t(x.right) * Bucket;
+    const Leaf& leaf = leaves_[x.right];
     for (std::size_t i = 0; i < x.size; ++i)
-      out.push_back({points_[base + i], ids_[base + i]});
-    free_slot(x.right);
+      out.push_back({leaf.p[i], leaf.id[i]});
+    leaves_.release(x.right);
     return;
   }
   for (std::uint32_t c : {x.left, x.right}) {
     collect(c, out);
-    nodes_[c].left = free_node_;
-    free_node_ = c;
+    nodes_.release(c);
   }
 }
 
@@ -297,7 +265,7 @@ template <int D, int Bucket>
 void KdTree<D, Bucket>::insert(const Point<D>& p, Id id) {
   check_point(p, "inserted point");
   if (root_ == kNone) {
-    root_ = allocate_node();
+    root_ = nodes_.allocate("KdTree");
     Item it{p, id};
     build_at(root_, &it, 1);
     return;
@@ -319,9 +287,8 @@ void KdTree<D, Bucket>::insert(const Point<D>& p, Id id) {
   }
   Node& leaf = nodes_[n];
   if (leaf.size <= Bucket) {
-    const std::size_t at = std::size_t(leaf.right) * Bucket + leaf.size - 1;
-    points_[at] = p;
-    ids_[at] = id;
+    leaves_[leaf.right].p[leaf.size - 1] = p;
+    leaves_[leaf.right].id[leaf.size - 1] = id;
   } else {
     std::vector<Item> items;
     items.reserve(Bucket + 1);
@@ -338,11 +305,11 @@ bool KdTree<D, Bucket>::erase_at(std::uint32_t n, const Point<D>& p, Id id) {
   Node& x = nodes_[n];
   if (!intersects(x.box, p)) return false;
   if (x.leaf()) {
-    const std::size_t base = std::size_t(x.right) * Bucket;
+    Leaf& leaf = leaves_[x.right];
     for (std::size_t i = 0; i < x.size; ++i) {
-      if (ids_[base + i] == id && points_[base + i] == p) {
-        points_[base + i] = points_[base + x.size - 1];
-        ids_[base + i] = ids_[base + x.size - 1];
+      if (leaf.id[i] == id && leaf.p[i] == p) {
+        leaf.p[i] = leaf.p[x.size - 1];
+        leaf.id[i] = leaf.id[x.size - 1];
         --x.size;
         return true;
       }
@@ -362,9 +329,8 @@ bool KdTree<D, Bucket>::erase(const Point<D>& p, Id id) {
   if (root_ == kNone || !erase_at(root_, p, id)) return false;
   if (nodes_[root_].size == 0) {
     nodes_.clear();
-    points_.clear();
-    ids_.clear();
-    root_ = free_node_ = free_slot_ = kNone;
+    leaves_.clear();
+    root_ = kNone;
     return true;
   }
   rebalance(p);
@@ -395,12 +361,11 @@ template <int D, int Bucket>
 template <class Visit>
 bool KdTree<D, Bucket>::report_subtree(std::uint32_t n, Visit& visit, QueryStats& s) const {
   const Node& x = nodes_[n];
-  ++s.nodes_visited;
   if (!x.leaf()) return report_subtree(x.left, visit, s) && report_subtree(x.right, visit, s);
-  const std::size_t base = std::size_t(x.right) * Bucket;
+  const Leaf& leaf = leaves_[x.right];
   for (std::size_t i = 0; i < x.size; ++i) {
     ++s.results;
-    if (!visit(ids_[base + i], Box<D>::of_point(points_[base + i]))) return false;
+    if (!visit(leaf.id[i], Box<D>::of_point(leaf.p[i]))) return false;
   }
   return true;
 }
@@ -430,12 +395,12 @@ QueryStats KdTree<D, Bucket>::query(const Box<D>& window, Visit&& visit) const {
       stack.push_back(x.left);
       continue;
     }
-    const std::size_t base = std::size_t(x.right) * Bucket;
+    const Leaf& leaf = leaves_[x.right];
     for (std::size_t i = 0; i < x.size; ++i) {
       ++s.entries_tested;
-      if (!intersects(window, points_[base + i])) continue;
+      if (!intersects(window, leaf.p[i])) continue;
       ++s.results;
-      if (!visit(ids_[base + i], Box<D>::of_point(points_[base + i]))) return s;
+      if (!visit(leaf.id[i], Box<D>::of_point(leaf.p[i]))) return s;
     }
   }
   return s;
@@ -464,13 +429,13 @@ QueryStats KdTree<D, Bucket>::radius(const Point<D>& p, double r, Visit&& visit)
       stack.push_back(x.left);
       continue;
     }
-    const std::size_t base = std::size_t(x.right) * Bucket;
+    const Leaf& leaf = leaves_[x.right];
     for (std::size_t i = 0; i < x.size; ++i) {
       ++s.entries_tested;
-      const double d2 = squared_distance(p, points_[base + i]);
+      const double d2 = squared_distance(p, leaf.p[i]);
       if (d2 > r2) continue;
       ++s.results;
-      if (!visit(ids_[base + i], Box<D>::of_point(points_[base + i]), std::sqrt(d2))) return s;
+      if (!visit(leaf.id[i], Box<D>::of_point(leaf.p[i]), std::sqrt(d2))) return s;
     }
   }
   return s;
@@ -501,12 +466,13 @@ QueryStats KdTree<D, Bucket>::nearest(const Point<D>& p, std::size_t k, Visit&& 
     }
     const Node& x = nodes_[n];
     const std::size_t base = std::size_t(x.right) * Bucket;
+    const Leaf& leaf = leaves_[x.right];
     for (std::size_t i = 0; i < x.size; ++i)
-      q.push_entry(squared_distance(p, points_[base + i]), base + i, ids_[base + i]);
+      q.push_entry(squared_distance(p, leaf.p[i]), base + i, leaf.id[i]);
     return tested + x.size;
   };
   auto report = [&](Id id, std::uint64_t pos, double d) {
-    return visit(id, Box<D>::of_point(points_[pos]), d);
+    return visit(id, Box<D>::of_point(leaves_[std::uint32_t(pos / Bucket)].p[pos % Bucket]), d);
   };
   return detail::best_first(root_, k, expand, report);
 }
@@ -515,11 +481,13 @@ template <int D, int Bucket>
 void KdTree<D, Bucket>::validate() const {
   auto fail = [](const std::string& what) { throw Error("KdTree invalid: " + what); };
   if (root_ == kNone) {
-    if (!nodes_.empty()) fail("empty tree with nodes");
+    if (nodes_.size() != 0) fail("empty tree with nodes");
     return;
   }
   std::vector<bool> node_seen(nodes_.size(), false);
-  std::vector<bool> slot_seen(points_.size() / Bucket, false);
+  std::vector<bool> slot_seen(leaves_.size(), false);
+  if (!nodes_.validate_free(node_seen)) fail("free node list corrupt");
+  if (!leaves_.validate_free(slot_seen)) fail("free bucket list corrupt");
   std::vector<std::uint32_t> stack{root_};
   while (!stack.empty()) {
     const std::uint32_t n = stack.back();
@@ -532,7 +500,7 @@ void KdTree<D, Bucket>::validate() const {
       slot_seen[x.right] = true;
       if (x.size > Bucket) fail("leaf " + std::to_string(n) + " over capacity");
       for (std::size_t i = 0; i < x.size; ++i)
-        if (!intersects(x.box, points_[std::size_t(x.right) * Bucket + i]))
+        if (!intersects(x.box, leaves_[x.right].p[i]))
           fail("point outside its leaf's box at node " + std::to_string(n));
       continue;
     }
@@ -554,7 +522,7 @@ void KdTree<D, Bucket>::validate() const {
         continue;
       }
       for (std::size_t i = 0; i < y.size; ++i)
-        if (points_[std::size_t(y.right) * Bucket + i][a] > x.split)
+        if (leaves_[y.right].p[i][a] > x.split)
           fail("left point beyond the split at node " + std::to_string(n));
     }
     sub.push_back(x.right);
@@ -567,23 +535,17 @@ void KdTree<D, Bucket>::validate() const {
         continue;
       }
       for (std::size_t i = 0; i < y.size; ++i)
-        if (points_[std::size_t(y.right) * Bucket + i][a] < x.split)
+        if (leaves_[y.right].p[i][a] < x.split)
           fail("right point before the split at node " + std::to_string(n));
     }
     stack.push_back(x.left);
     stack.push_back(x.right);
   }
-  for (std::uint32_t f = free_node_; f != kNone; f = nodes_[f].left) {
-    if (f >= nodes_.size() || node_seen[f]) fail("free node list corrupt");
-    node_seen[f] = true;
-  }
   if (std::count(node_seen.begin(), node_seen.end(), false) != 0) fail("nodes leaked");
-  for (std::uint32_t f = free_slot_; f != kNone; f = std::uint32_t(ids_[std::size_t(f) * Bucket])) {
-    if (f >= slot_seen.size() || slot_seen[f]) fail("free slot list corrupt");
-    slot_seen[f] = true;
-  }
   if (std::count(slot_seen.begin(), slot_seen.end(), false) != 0) fail("slots leaked");
 }
+
+static_assert(DynamicPointIndex<KdTree<2>> && NearestIndex<KdTree<2>>);
 
 using KdTree2 = KdTree<2>;
 using KdTree3 = KdTree<3>;

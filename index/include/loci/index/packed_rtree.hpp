@@ -101,7 +101,8 @@ class PackedRTree {
     t.size_ = size;
     t.packing_ = packing;
     t.compute_levels();
-    if (blocks.size() != t.total_blocks() || item_indices.size() != t.level_blocks(0) * NodeSize)
+    const std::size_t slots = size == 0 ? 0 : t.level_blocks(0) * NodeSize;
+    if (blocks.size() != t.total_blocks() || item_indices.size() != slots)
       throw Error("packed R-tree arrays do not match its item count");
     t.blocks_ = blocks.data();
     t.items_ = item_indices.data();
@@ -112,12 +113,40 @@ class PackedRTree {
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
   Packing packing() const { return packing_; }
-  int levels() const { return static_cast<int>(level_count_.size()); }
+  int levels() const { return static_cast<int>(levels_.size()); }
   Box<D> bounds() const {
-    return empty() ? Box<D>::empty() : root_block().bounds(int(level_count_.back()));
+    return empty() ? Box<D>::empty() : root_block().bounds(int(levels_.back().entries));
   }
   // Box of item id (its builder index).
   Box<D> item_box(Id id) const;
+
+  // The implicit layout. Level l (0 = the items, levels() - 1 = the root) holds `entries`
+  // boxes in `blocks` blocks, the first at blocks()[first_block]; entry e of level l covers
+  // the items [e * span, (e + 1) * span) in packed order.
+  struct Level {
+    std::size_t entries;
+    std::size_t first_block;
+    std::size_t blocks;
+    std::size_t span;
+  };
+  // The levels of a tree of `items` items (none when it is empty): what a file holding one
+  // must contain.
+  static std::vector<Level> layout(std::size_t items) {
+    std::vector<Level> out;
+    for (std::size_t count = items, first = 0, span = 1; count > 0; span *= NodeSize) {
+      const std::size_t nblocks = (count + NodeSize - 1) / NodeSize;
+      out.push_back({count, first, nblocks, span});
+      if (nblocks == 1) break;
+      first += nblocks;
+      count = nblocks;
+    }
+    return out;
+  }
+  static std::size_t block_count(std::size_t items) {
+    const auto l = layout(items);
+    return l.empty() ? 0 : l.back().first_block + l.back().blocks;
+  }
+  const Level& level(int l) const { return levels_[std::size_t(l)]; }
 
   std::span<const Block> blocks() const { return {blocks_, total_blocks()}; }
   std::span<const std::uint32_t> item_indices() const {
@@ -132,10 +161,7 @@ class PackedRTree {
   template <WindowVisitor<D> Visit>
   QueryStats query(const Box<D>& window, Visit&& visit, Relation rel = Relation::intersects) const;
   std::vector<Id> query(const Box<D>& window, Relation rel = Relation::intersects) const {
-    std::vector<Id> out;
-    query(
-        window, [&](Id id, const Box<D>&) { return out.push_back(id), true; }, rel);
-    return out;
+    return collect_ids([&](auto&& v) { return query(window, v, rel); });
   }
 
   // Calls visit(id, box, distance) for the k items nearest to p, nearest first; stops when it
@@ -143,9 +169,7 @@ class PackedRTree {
   template <NearestVisitor<D> Visit>
   QueryStats nearest(const Point<D>& p, std::size_t k, Visit&& visit) const;
   std::vector<Neighbor> nearest(const Point<D>& p, std::size_t k) const {
-    std::vector<Neighbor> out;
-    nearest(p, k, [&](Id id, const Box<D>&, double d) { return out.push_back({id, d}), true; });
-    return out;
+    return collect_neighbors([&](auto&& v) { return nearest(p, k, v); });
   }
 
   // Throws loci::Error describing the first broken invariant.
@@ -159,10 +183,12 @@ class PackedRTree {
     std::uint32_t index;
   };
 
-  void compute_levels();
-  std::size_t level_blocks(int l) const { return (level_count_[l] + NodeSize - 1) / NodeSize; }
-  std::size_t total_blocks() const { return level_offset_.empty() ? 0 : level_offset_.back(); }
-  const Block& block(int level, std::size_t b) const { return blocks_[level_offset_[level] + b]; }
+  void compute_levels() { levels_ = layout(size_); }
+  std::size_t level_blocks(int l) const { return level(l).blocks; }
+  std::size_t total_blocks() const {
+    return levels_.empty() ? 0 : levels_.back().first_block + levels_.back().blocks;
+  }
+  const Block& block(int l, std::size_t b) const { return blocks_[level(l).first_block + b]; }
   const Block& root_block() const { return blocks_[total_blocks() - 1]; }
   Box<D> leaf_box(std::size_t pos) const {
     return block(0, pos / NodeSize).box(int(pos % NodeSize));
@@ -178,9 +204,7 @@ class PackedRTree {
 
   std::size_t size_ = 0;
   Packing packing_ = Packing::hilbert;
-  std::vector<std::size_t> level_count_;   // entries per level, level 0 = items
-  std::vector<std::size_t> level_offset_;  // first block of each level; last = total blocks
-  std::vector<std::size_t> span_;          // NodeSize^l: items covered by an entry of level l
+  std::vector<Level> levels_;  // layout(size_)
   const Block* blocks_ = nullptr;
   const std::uint32_t* items_ = nullptr;
   // Owned storage, left uninitialised on allocation: the build writes every slot.
@@ -188,26 +212,6 @@ class PackedRTree {
   std::unique_ptr<std::uint32_t[]> own_items_;
   std::shared_ptr<const void> keep_alive_;
 };
-
-template <int D, int NodeSize>
-void PackedRTree<D, NodeSize>::compute_levels() {
-  level_count_.clear();
-  level_offset_.clear();
-  span_.clear();
-  if (size_ == 0) return;
-  std::size_t count = size_, offset = 0, span = 1;
-  for (;;) {
-    level_count_.push_back(count);
-    level_offset_.push_back(offset);
-    span_.push_back(span);
-    const std::size_t nblocks = (count + NodeSize - 1) / NodeSize;
-    offset += nblocks;
-    if (nblocks == 1) break;
-    count = nblocks;
-    span *= NodeSize;
-  }
-  level_offset_.push_back(offset);
-}
 
 template <int D, int NodeSize>
 PackedRTree<D, NodeSize>::PackedRTree(std::span<const Box<D>> boxes, Packing packing)
@@ -237,11 +241,11 @@ PackedRTree<D, NodeSize>::PackedRTree(std::span<const Box<D>> boxes, Packing pac
     }
   }
   for (int l = 1; l < levels(); ++l) {
-    const std::size_t below = level_offset_[l - 1];
+    const std::size_t below = level(l - 1).first_block;
     for (std::size_t e = 0; e < level_blocks(l) * NodeSize; ++e) {
-      Block& block = own_blocks_[level_offset_[l] + e / NodeSize];
-      if (e < level_count_[l]) {
-        const int used = int(std::min<std::size_t>(NodeSize, level_count_[l - 1] - e * NodeSize));
+      Block& block = own_blocks_[level(l).first_block + e / NodeSize];
+      if (e < level(l).entries) {
+        const int used = int(std::min<std::size_t>(NodeSize, level(l - 1).entries - e * NodeSize));
         block.set(int(e % NodeSize), own_blocks_[below + e].bounds(used));
       } else {
         block.set(int(e % NodeSize), Box<D>::empty());
@@ -258,32 +262,19 @@ void PackedRTree<D, NodeSize>::order_hilbert(std::span<const Box<D>> boxes,
   Box<D> extent = Box<D>::empty();
   for (const auto& b : boxes)
     extent.expand(b.center());
-  constexpr double kMax = double((1u << detail::hilbert_bits<D>()) - 1);
-  double scale[D];
-  for (int a = 0; a < D; ++a)
-    scale[a] = extent.extent(a) > 0 ? kMax / extent.extent(a) : 0.0;
-  auto cell = [&](const Box<D>& b, std::uint32_t(&x)[D]) {
-    for (int a = 0; a < D; ++a)
-      x[a] = static_cast<std::uint32_t>((b.center(a) - extent.min[a]) * scale[a]);
-  };
+  const detail::HilbertGrid<D> grid(extent);
   if constexpr (D == 2) {
     // 32-bit keys: key and index share one 64-bit word, halving the sort's memory traffic.
     std::vector<std::uint64_t> keyed(boxes.size());
-    for (std::size_t i = 0; i < boxes.size(); ++i) {
-      std::uint32_t x[2];
-      cell(boxes[i], x);
-      keyed[i] = (detail::hilbert_key_2d(x[0], x[1]) << 32) | i;
-    }
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+      keyed[i] = (grid.key(boxes[i].center()) << 32) | i;
     detail::radix_sort(keyed, 32, 32, [](std::uint64_t v) { return v; });
     for (std::size_t i = 0; i < boxes.size(); ++i)
       order[i] = std::uint32_t(keyed[i]);
   } else {
     std::vector<detail::KeyedIndex> keyed(boxes.size());
-    for (std::size_t i = 0; i < boxes.size(); ++i) {
-      std::uint32_t x[D];
-      cell(boxes[i], x);
-      keyed[i] = {detail::hilbert_key<D>(x), std::uint32_t(i)};
-    }
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+      keyed[i] = {grid.key(boxes[i].center()), std::uint32_t(i)};
     detail::radix_sort(keyed, 0, D * detail::hilbert_bits<D>(),
                        [](const detail::KeyedIndex& k) { return k.key; });
     for (std::size_t i = 0; i < boxes.size(); ++i)
@@ -297,7 +288,7 @@ void PackedRTree<D, NodeSize>::order_str(std::span<const Box<D>> boxes,
   std::vector<Item> items(boxes.size());
   for (std::size_t i = 0; i < boxes.size(); ++i)
     items[i] = {boxes[i].center(), std::uint32_t(i)};
-  tile(items.data(), 0, items.size(), span_.back());
+  tile(items.data(), 0, items.size(), levels_.back().span);
   for (std::size_t i = 0; i < items.size(); ++i)
     order[i] = items[i].index;
 }
@@ -355,7 +346,7 @@ QueryStats PackedRTree<D, NodeSize>::query(const Box<D>& window, Visit&& visit,
     const std::size_t b = std::size_t(top & 0xffffffffu);
     const Block& node = block(level, b);
     ++s.nodes_visited;
-    s.entries_tested += NodeSize;
+    s.entries_tested += std::min<std::size_t>(NodeSize, this->level(level).entries - b * NodeSize);
     auto hits = rel == Relation::contains ? node.containing(window) : node.intersecting(window);
     if (!hits) continue;
     const std::size_t base = b * NodeSize;
@@ -372,7 +363,8 @@ QueryStats PackedRTree<D, NodeSize>::query(const Box<D>& window, Visit&& visit,
     hits &= ~inside;
     while (inside) {
       const std::size_t e = base + detail::pop_lowest(inside);
-      if (!report_run(e * span_[level], (e + 1) * span_[level], visit, s)) return s;
+      const std::size_t span = this->level(level).span;
+      if (!report_run(e * span, (e + 1) * span, visit, s)) return s;
     }
     while (hits) {
       const std::size_t e = base + detail::pop_lowest(hits);
@@ -394,7 +386,7 @@ QueryStats PackedRTree<D, NodeSize>::nearest(const Point<D>& p, std::size_t k,
     const int level = int(ref >> 32);
     const std::size_t b = std::size_t(ref & 0xffffffffu);
     const std::size_t base = b * NodeSize;
-    const int used = int(std::min<std::size_t>(NodeSize, level_count_[level] - base));
+    const int used = int(std::min<std::size_t>(NodeSize, this->level(level).entries - base));
     double d2[NodeSize];
     block(level, b).squared_distances(p, d2);
     if (level == 0)
@@ -416,14 +408,14 @@ void PackedRTree<D, NodeSize>::validate() const {
     if (total_blocks() != 0) fail("empty tree with nodes");
     return;
   }
-  if (level_count_.back() > std::size_t(NodeSize)) fail("root level has more than one node");
+  if (levels_.back().entries > std::size_t(NodeSize)) fail("root level has more than one node");
   for (int l = 0; l < levels(); ++l) {
     for (std::size_t b = 0; b < level_blocks(l); ++b) {
       const Block& node = block(l, b);
       for (int i = 0; i < NodeSize; ++i) {
         const std::size_t e = b * NodeSize + i;
         const Box<D> box = node.box(i);
-        if (e >= level_count_[l]) {
+        if (e >= level(l).entries) {
           if (!(box == Box<D>::empty()))
             fail("unused slot is not empty at level " + std::to_string(l));
           continue;
@@ -431,7 +423,8 @@ void PackedRTree<D, NodeSize>::validate() const {
         if (box.is_empty())
           fail("empty entry " + std::to_string(e) + " at level " + std::to_string(l));
         if (l > 0) {
-          const int used = int(std::min<std::size_t>(NodeSize, level_count_[l - 1] - e * NodeSize));
+          const int used =
+              int(std::min<std::size_t>(NodeSize, level(l - 1).entries - e * NodeSize));
           if (!(block(l - 1, e).bounds(used) == box))
             fail("entry " + std::to_string(e) + " at level " + std::to_string(l) +
                  " is not the union of its node");
@@ -446,6 +439,8 @@ void PackedRTree<D, NodeSize>::validate() const {
     seen[id] = true;
   }
 }
+
+static_assert(BoxIndex<PackedRTree<2>> && NearestIndex<PackedRTree<2>>);
 
 using PackedRTree2 = PackedRTree<2>;
 using PackedRTree3 = PackedRTree<3>;

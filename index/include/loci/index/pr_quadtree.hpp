@@ -52,6 +52,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/best_first.hpp"
 #include "loci/index/detail/hilbert.hpp"
+#include "loci/index/detail/node_pool.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/query.hpp"
 
@@ -73,7 +74,7 @@ class PrQuadtree {
       : bucket_(bucket), max_depth_(max_depth) {
     check_parameters();
     check_box(region, "quadtree region");
-    nodes_.push_back(leaf_node(cube(region), 0));
+    make_root(cube(region));
   }
 
   // Point i gets id i; the region is the points' bounding box. Throws InvalidGeometry on a NaN
@@ -93,30 +94,22 @@ class PrQuadtree {
     // inserting along a Hilbert curve puts each leaf's entries, and each subtree's nodes,
     // next to each other in the pools: window queries then read memory in order
     std::vector<std::pair<std::uint64_t, std::uint32_t>> order(points.size());
-    constexpr double kCells = double((1u << detail::hilbert_bits<D>()) - 1);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      std::uint32_t g[D];
-      for (int a = 0; a < D; ++a) {
-        const double e = region.extent(a);
-        g[a] = e > 0 ? std::uint32_t((points[i][a] - region.min[a]) / e * kCells) : 0;
-      }
-      order[i] = {detail::hilbert_key<D>(g), std::uint32_t(i)};
-    }
+    const detail::HilbertGrid<D> grid(region);
+    for (std::size_t i = 0; i < points.size(); ++i)
+      order[i] = {grid.key(points[i]), std::uint32_t(i)};
     std::sort(order.begin(), order.end());
     for (const auto& [key, i] : order)
       t.insert(points[i], Id(i));
     return t;
   }
 
-  std::size_t size() const { return nodes_.empty() ? 0 : nodes_[0].count; }
+  std::size_t size() const { return nodes_.size() == 0 ? 0 : nodes_[0].count; }
   bool empty() const { return size() == 0; }
   std::uint32_t bucket() const { return bucket_; }
   int max_depth() const { return max_depth_; }
-  Box<D> region() const { return nodes_.empty() ? Box<D>::empty() : nodes_[0].region; }
+  Box<D> region() const { return nodes_.size() == 0 ? Box<D>::empty() : nodes_[0].region; }
   int height() const;
-  std::size_t memory_bytes() const {
-    return nodes_.capacity() * sizeof(Node) + entries_.capacity() * sizeof(Entry);
-  }
+  std::size_t memory_bytes() const { return nodes_.memory_bytes() + entries_.memory_bytes(); }
 
   // Throws InvalidGeometry on a NaN or infinite coordinate.
   void insert(const Point<D>& p, Id id);
@@ -128,9 +121,7 @@ class PrQuadtree {
   template <WindowVisitor<D> Visit>
   QueryStats query(const Box<D>& window, Visit&& visit) const;
   std::vector<Id> query(const Box<D>& window) const {
-    std::vector<Id> out;
-    query(window, [&](Id id, const Box<D>&) { return out.push_back(id), true; });
-    return out;
+    return collect_ids([&](auto&& v) { return query(window, v); });
   }
 
   // Calls visit(id, box, distance) for the k points nearest to p, nearest first.
@@ -138,16 +129,14 @@ class PrQuadtree {
   template <NearestVisitor<D> Visit>
   QueryStats nearest(const Point<D>& p, std::size_t k, Visit&& visit) const;
   std::vector<Neighbor> nearest(const Point<D>& p, std::size_t k) const {
-    std::vector<Neighbor> out;
-    nearest(p, k, [&](Id id, const Box<D>&, double d) { return out.push_back({id, d}), true; });
-    return out;
+    return collect_neighbors([&](auto&& v) { return nearest(p, k, v); });
   }
 
   // Calls f(region, depth, count, is_leaf) for every node, parents before children: the cells
   // a map draws.
   template <class F>
   void visit_cells(F&& f) const {
-    if (nodes_.empty()) return;
+    if (nodes_.size() == 0) return;
     std::vector<std::uint32_t> stack{0};
     while (!stack.empty()) {
       const Node& x = nodes_[stack.back()];
@@ -163,21 +152,28 @@ class PrQuadtree {
   void validate() const;
 
  private:
-  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-
-  struct Node {
-    Box<D> region;
-    std::uint32_t child;  // first of fan_out children, kNone for a leaf; free list link
-    std::uint32_t first;  // leaf: head of its entry list
-    std::uint32_t count;  // points in the subtree
-    std::uint32_t depth;
+  struct Node {           // 16 D + 16 bytes
+    Box<D> region;        // 16 D: the cell; children's are cut from it at its centre
+    std::uint32_t child;  // 4: first of fan_out children, kNone for a leaf; pool free link
+    std::uint32_t first;  // 4: leaf: head of its entry list
+    std::uint32_t count;  // 4: points in the subtree
+    std::uint32_t depth;  // 4: 0 at the root
     bool leaf() const { return child == kNone; }
   };
-  struct Entry {
-    Point<D> p;
-    Id id;
-    std::uint32_t next;  // next entry of the same leaf, or of the free list
+  struct Entry {         // 8 D + 16 bytes
+    Point<D> p;          // 8 D: the point
+    Id id;               // 8: its id
+    std::uint32_t next;  // 4: next entry of the same leaf, or of the pool's free list
   };
+
+  // The root is node 0, the first of a run of fan_out whose other nodes stay unused, so that
+  // every later run holds exactly one node's children.
+  void make_root(const Box<D>& region) {
+    nodes_.allocate("PrQuadtree");
+    for (int c = 1; c < fan_out; ++c)
+      nodes_[std::uint32_t(c)] = leaf_node(Box<D>::empty(), 0);
+    nodes_[0] = leaf_node(region, 0);
+  }
 
   static Node leaf_node(const Box<D>& region, std::uint32_t depth) {
     return Node{region, kNone, kNone, 0, depth};
@@ -229,8 +225,12 @@ class PrQuadtree {
   }
   bool must_stay_leaf(const Node& x) const;
 
-  std::uint32_t allocate_group();
-  std::uint32_t allocate_entry(const Point<D>& p, Id id);
+  std::uint32_t allocate_group() { return nodes_.allocate("PrQuadtree"); }
+  std::uint32_t allocate_entry(const Point<D>& p, Id id) {
+    const std::uint32_t e = entries_.allocate("PrQuadtree entry");
+    entries_[e] = {p, id, kNone};
+    return e;
+  }
   void grow_towards(const Point<D>& p);
   void split(std::uint32_t n);
   // Moves every entry of n's subtree into n's list and frees its descendants.
@@ -239,36 +239,9 @@ class PrQuadtree {
 
   std::uint32_t bucket_;
   int max_depth_;
-  std::vector<Node> nodes_;  // node 0 is the root
-  std::vector<Entry> entries_;
-  std::uint32_t free_group_ = kNone;
-  std::uint32_t free_entry_ = kNone;
+  detail::NodePool<Node, &Node::child, fan_out> nodes_;  // runs of fan_out siblings
+  detail::NodePool<Entry, &Entry::next> entries_;
 };
-
-template <int D>
-std::uint32_t PrQuadtree<D>::allocate_group() {
-  if (free_group_ != kNone) {
-    const std::uint32_t g = free_group_;
-    free_group_ = nodes_[g].child;
-    return g;
-  }
-  if (nodes_.size() + fan_out >= kNone) throw InvalidArgument("quadtree node pool is full");
-  nodes_.resize(nodes_.size() + fan_out);
-  return std::uint32_t(nodes_.size() - fan_out);
-}
-
-template <int D>
-std::uint32_t PrQuadtree<D>::allocate_entry(const Point<D>& p, Id id) {
-  if (free_entry_ != kNone) {
-    const std::uint32_t e = free_entry_;
-    free_entry_ = entries_[e].next;
-    entries_[e] = {p, id, kNone};
-    return e;
-  }
-  if (entries_.size() >= kNone - 1) throw InvalidArgument("quadtree holds at most 2^32 - 2 points");
-  entries_.push_back({p, id, kNone});
-  return std::uint32_t(entries_.size() - 1);
-}
 
 template <int D>
 bool PrQuadtree<D>::must_stay_leaf(const Node& x) const {
@@ -306,8 +279,8 @@ void PrQuadtree<D>::grow_towards(const Point<D>& p) {
       continue;
     }
     const std::uint32_t g = allocate_group();
-    for (Node& x : nodes_)
-      ++x.depth;  // rare (once per doubling), so a pass over the pool is fine
+    for (std::uint32_t n = 0; n < nodes_.size(); ++n)
+      ++nodes_[n].depth;  // rare (once per doubling), so a pass over the pool is fine
     // cut the grown region at the old root's corner so that the old root is a child exactly
     Point<D> cut;
     for (int a = 0; a < D; ++a)
@@ -354,7 +327,7 @@ void PrQuadtree<D>::split(std::uint32_t n) {
 template <int D>
 void PrQuadtree<D>::insert(const Point<D>& p, Id id) {
   check_point(p, "inserted point");
-  if (nodes_.empty()) nodes_.push_back(leaf_node(Box<D>{p, p}, 0));
+  if (nodes_.size() == 0) make_root(Box<D>{p, p});
   grow_towards(p);
   const std::uint32_t e = allocate_entry(p, id);
   std::uint32_t n = 0;
@@ -383,8 +356,7 @@ void PrQuadtree<D>::gather(std::uint32_t n, std::uint32_t& head) {
   }
   for (int c = 0; c < fan_out; ++c)
     gather(x.child + std::uint32_t(c), head);
-  nodes_[x.child].child = free_group_;
-  free_group_ = x.child;
+  nodes_.release(x.child);
 }
 
 template <int D>
@@ -398,7 +370,7 @@ void PrQuadtree<D>::collapse(std::uint32_t n) {
 template <int D>
 bool PrQuadtree<D>::erase(const Point<D>& p, Id id) {
   check_point(p, "erased point");
-  if (nodes_.empty() || !intersects(nodes_[0].region, p)) return false;
+  if (nodes_.size() == 0 || !intersects(nodes_[0].region, p)) return false;
   detail::Scratch<std::uint32_t> scratch;
   auto& path = *scratch;
   std::uint32_t n = 0;
@@ -413,8 +385,7 @@ bool PrQuadtree<D>::erase(const Point<D>& p, Id id) {
   if (*link == kNone) return false;
   const std::uint32_t e = *link;
   *link = entries_[e].next;
-  entries_[e].next = free_entry_;
-  free_entry_ = e;
+  entries_.release(e);
   for (std::uint32_t m : path)
     --nodes_[m].count;
   for (std::uint32_t m : path)  // the highest internal node that no longer needs children
@@ -452,8 +423,8 @@ QueryStats PrQuadtree<D>::query(const Box<D>& window, Visit&& visit) const {
       ++s.entries_tested;
       if (!intersects(x.region, window)) continue;
       inside = contains(window, x.region);
+      if (!inside) ++s.nodes_visited;
     }
-    ++s.nodes_visited;
     if (!x.leaf()) {
       for (int c = fan_out - 1; c >= 0; --c)
         if (nodes_[x.child + c].count)
@@ -504,13 +475,16 @@ QueryStats PrQuadtree<D>::nearest(const Point<D>& p, std::size_t k, Visit&& visi
 template <int D>
 void PrQuadtree<D>::validate() const {
   auto fail = [](const std::string& what) { throw Error("PrQuadtree invalid: " + what); };
-  if (nodes_.empty()) {
-    if (!entries_.empty()) fail("entries without nodes");
+  if (nodes_.size() == 0) {
+    if (entries_.size() != 0) fail("entries without nodes");
     return;
   }
   std::vector<bool> node_seen(nodes_.size(), false), entry_seen(entries_.size(), false);
+  if (!nodes_.validate_free(node_seen)) fail("free group list corrupt");
+  if (!entries_.validate_free(entry_seen)) fail("free entry list corrupt");
   std::vector<std::uint32_t> stack{0};
-  node_seen[0] = true;
+  for (int c = 0; c < fan_out; ++c)  // the root and the unused rest of its run
+    node_seen[std::uint32_t(c)] = true;
   while (!stack.empty()) {
     const std::uint32_t n = stack.back();
     stack.pop_back();
@@ -553,19 +527,11 @@ void PrQuadtree<D>::validate() const {
     }
     if (sum != x.count) fail("counts do not add up" + at);
   }
-  for (std::uint32_t g = free_group_; g != kNone; g = nodes_[g].child) {
-    for (int c = 0; c < fan_out; ++c) {
-      if (g + c >= nodes_.size() || node_seen[g + c]) fail("free group list corrupt");
-      node_seen[g + c] = true;
-    }
-  }
   if (std::count(node_seen.begin(), node_seen.end(), false)) fail("nodes leaked");
-  for (std::uint32_t e = free_entry_; e != kNone; e = entries_[e].next) {
-    if (e >= entries_.size() || entry_seen[e]) fail("free entry list corrupt");
-    entry_seen[e] = true;
-  }
   if (std::count(entry_seen.begin(), entry_seen.end(), false)) fail("entries leaked");
 }
+
+static_assert(DynamicPointIndex<PrQuadtree<2>> && NearestIndex<PrQuadtree<2>>);
 
 using PrQuadtree2 = PrQuadtree<2>;
 using Octree = PrQuadtree<3>;

@@ -81,7 +81,7 @@ struct QuadCell {
 };
 
 template <class F>
-concept CellVisitor = std::predicate<F&, const QuadCell&>;
+concept CellVisitor = Visitor<F, const QuadCell&>;
 
 template <class F>
 concept CellClassifier = std::is_invocable_r_v<Cover, F&, const Box2&>;

@@ -16,8 +16,11 @@
 
 #include <algorithm>
 #include <limits>
+#include <span>
+#include <utility>
 
 #include "loci/index/detail/dynamic_rtree.hpp"
+#include "loci/index/detail/split_groups.hpp"
 
 namespace loci {
 
@@ -28,16 +31,7 @@ struct RStarInsertion {
   static int choose_subtree(const detail::SoaBoxes<D, M>& boxes, int count, int level,
                             const Box<D>& b) {
     if (level == 1) return least_overlap_growth(boxes, count, b);
-    int best = 0;
-    double best_grow = std::numeric_limits<double>::infinity(), best_content = best_grow;
-    for (int i = 0; i < count; ++i) {
-      const Box<D> c = boxes.box(i);
-      const double content = c.content();
-      const double grow = merged(c, b).content() - content;
-      if (grow < best_grow || (grow == best_grow && content < best_content))
-        best = i, best_grow = grow, best_content = content;
-    }
-    return best;
+    return detail::least_enlargement(boxes, count, b);
   }
 
   template <int D>
@@ -152,7 +146,51 @@ int RStarInsertion::split(Entry<D>* e, int n, int min_fill) {
 }
 
 template <int D, int M = 16>
-using RStarTree = detail::DynamicRTree<D, M, RStarInsertion>;
+class RStarTree : private detail::DynamicRTree<D, M, RStarInsertion> {
+  using Base = detail::DynamicRTree<D, M, RStarInsertion>;
+
+ public:
+  static constexpr int dimension = D;
+  static constexpr int max_entries = M;
+  static constexpr int min_entries = Base::min_entries;  // 40% of M
+
+  RStarTree() = default;
+
+  // Builds a tree from (box, id) pairs by top-down STR tiling with near-equal node sizes, so
+  // every node respects the minimum fill. Throws InvalidGeometry on a bad box.
+  static RStarTree bulk_load(std::span<const std::pair<Box<D>, Id>> entries) {
+    return RStarTree(Base::bulk_load(entries));
+  }
+
+  using Base::bounds;  // the root's box
+  using Base::empty;
+  using Base::height;        // levels, 1 for a lone leaf
+  using Base::memory_bytes;  // the node pool's capacity
+  using Base::size;
+
+  // insert(box, id): throws InvalidGeometry on a NaN, infinite or inverted box.
+  // erase(box, id): removes one entry with exactly this box and id; false when there is none.
+  // update(old_box, new_box, id): erase then insert; false (and no change) when not there.
+  using Base::erase;
+  using Base::insert;
+  using Base::update;
+
+  // query(window, visit, relation = intersects) -> QueryStats: visit(id, box) for each entry
+  // in the relation with the window, until it returns false; query(window, relation) ->
+  // std::vector<Id>. nearest(p, k, visit) -> QueryStats: visit(id, box, distance) for the k
+  // entries nearest p, nearest first; nearest(p, k) -> std::vector<Neighbor>. Throw
+  // InvalidGeometry on a bad window or point, InvalidArgument for k = 0.
+  using Base::nearest;
+  using Base::query;
+
+  // Throws loci::Error describing the first broken invariant.
+  using Base::validate;
+
+ private:
+  explicit RStarTree(Base&& tree) : Base(std::move(tree)) {}
+};
+
+static_assert(DynamicBoxIndex<RStarTree<2>> && NearestIndex<RStarTree<2>>);
 
 using RStarTree2 = RStarTree<2>;
 using RStarTree3 = RStarTree<3>;

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
+#include <utility>
 
 #include "loci/index/detail/dynamic_rtree.hpp"
 #include "loci/index/detail/split_groups.hpp"
@@ -131,16 +133,7 @@ struct GuttmanInsertion {
   template <int D, int M>
   static int choose_subtree(const detail::SoaBoxes<D, M>& boxes, int count, int /*level*/,
                             const Box<D>& b) {
-    int best = 0;
-    double best_grow = std::numeric_limits<double>::infinity(), best_content = best_grow;
-    for (int i = 0; i < count; ++i) {
-      const Box<D> c = boxes.box(i);
-      const double content = c.content();
-      const double grow = merged(c, b).content() - content;
-      if (grow < best_grow || (grow == best_grow && content < best_content))
-        best = i, best_grow = grow, best_content = content;
-    }
-    return best;
+    return detail::least_enlargement(boxes, count, b);
   }
 
   template <int D>
@@ -150,7 +143,51 @@ struct GuttmanInsertion {
 };
 
 template <int D, class Split = QuadraticSplit, int M = 16>
-using RTree = detail::DynamicRTree<D, M, GuttmanInsertion<Split>>;
+class RTree : private detail::DynamicRTree<D, M, GuttmanInsertion<Split>> {
+  using Base = detail::DynamicRTree<D, M, GuttmanInsertion<Split>>;
+
+ public:
+  static constexpr int dimension = D;
+  static constexpr int max_entries = M;
+  static constexpr int min_entries = Base::min_entries;  // 40% of M
+
+  RTree() = default;
+
+  // Builds a tree from (box, id) pairs by top-down STR tiling with near-equal node sizes, so
+  // every node respects the minimum fill. Throws InvalidGeometry on a bad box.
+  static RTree bulk_load(std::span<const std::pair<Box<D>, Id>> entries) {
+    return RTree(Base::bulk_load(entries));
+  }
+
+  using Base::bounds;  // the root's box
+  using Base::empty;
+  using Base::height;        // levels, 1 for a lone leaf
+  using Base::memory_bytes;  // the node pool's capacity
+  using Base::size;
+
+  // insert(box, id): throws InvalidGeometry on a NaN, infinite or inverted box.
+  // erase(box, id): removes one entry with exactly this box and id; false when there is none.
+  // update(old_box, new_box, id): erase then insert; false (and no change) when not there.
+  using Base::erase;
+  using Base::insert;
+  using Base::update;
+
+  // query(window, visit, relation = intersects) -> QueryStats: visit(id, box) for each entry
+  // in the relation with the window, until it returns false; query(window, relation) ->
+  // std::vector<Id>. nearest(p, k, visit) -> QueryStats: visit(id, box, distance) for the k
+  // entries nearest p, nearest first; nearest(p, k) -> std::vector<Neighbor>. Throw
+  // InvalidGeometry on a bad window or point, InvalidArgument for k = 0.
+  using Base::nearest;
+  using Base::query;
+
+  // Throws loci::Error describing the first broken invariant.
+  using Base::validate;
+
+ private:
+  explicit RTree(Base&& tree) : Base(std::move(tree)) {}
+};
+
+static_assert(DynamicBoxIndex<RTree<2>> && NearestIndex<RTree<2>>);
 
 using RTree2 = RTree<2>;
 using RTree3 = RTree<3>;

@@ -32,7 +32,6 @@
 
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/canonical_nodes.hpp"
-#include "loci/index/detail/interval.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci {

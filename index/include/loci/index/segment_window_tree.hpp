@@ -45,6 +45,7 @@
 #include "loci/geom/segment.hpp"
 #include "loci/index/detail/canonical_nodes.hpp"
 #include "loci/index/detail/segment_endpoints.hpp"
+#include "loci/index/kd_tree.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci {
@@ -279,7 +280,8 @@ class SegmentWindowTree {
   // Segment i gets id i. Throws InvalidGeometry on a NaN or infinite coordinate.
   static SegmentWindowTree build(std::span<const Segment<2>> segments) {
     SegmentWindowTree t;
-    t.ends_ = detail::SegmentEndpoints(segments, "SegmentWindowTree", [](std::size_t, auto&) {});
+    t.ends_ = detail::SegmentEndpoints<KdTree<2>>(segments, "SegmentWindowTree",
+                                                  [](std::size_t, auto&) {});
     t.by_x_ = detail::SlabTree(segments, false);
     t.by_y_ = detail::SlabTree(segments, true);
     return t;
@@ -310,9 +312,9 @@ class SegmentWindowTree {
   }
 
  private:
-  detail::SegmentEndpoints ends_;  // the segments, and their endpoints in a kd-tree
-  detail::SlabTree by_x_;          // for the left and right edges
-  detail::SlabTree by_y_;          // on (y, x): for the bottom and top edges
+  detail::SegmentEndpoints<KdTree<2>> ends_;  // the segments, and their endpoints in a kd-tree
+  detail::SlabTree by_x_;                     // for the left and right edges
+  detail::SlabTree by_y_;                     // on (y, x): for the bottom and top edges
 };
 
 template <SegmentVisitor Visit>

@@ -6,8 +6,9 @@
 // reinsertion. Those three decisions come from `Policy`; the node pool, insertion, deletion
 // with condensing, bulk loading, queries and validation live here once.
 //
-// Representation. Nodes sit in one std::vector addressed by 32-bit indices, with a free list
-// of released nodes, so a tree is copied, moved or saved as plain arrays. A node keeps its
+// Representation. Nodes sit in a NodePool addressed by 32-bit indices, released nodes on a free
+// list threaded through their parent links, so a tree is copied, moved or saved as plain
+// arrays. A node keeps its
 // children's boxes structure-of-arrays (SoaBoxes), the child slots (a node index, or the
 // entry's id in a leaf), its parent, its entry count and its level (0 = leaf). Each entry's
 // box is exactly the union of its child's entries: insertion enlarges boxes on the way down,
@@ -15,7 +16,8 @@
 //
 // Invariants (validate()): every non-root node holds between min_entries and M entries; the
 // root is a leaf or has at least two entries; levels decrease by one from parent to child;
-// parent links match; entry boxes are tight; the leaves hold size() entries.
+// parent links match; entry boxes are tight; the leaves hold size() entries; every node of the
+// pool is reachable once or free once.
 //
 // Thread-safety: const member functions may run concurrently; insert, erase and update need
 // exclusive access.
@@ -32,18 +34,13 @@
 #include "loci/geom/box.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/best_first.hpp"
+#include "loci/index/detail/node_pool.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/detail/soa_boxes.hpp"
 #include "loci/index/detail/str_partition.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci {
-
-template <int D>
-struct Entry {
-  Box<D> box;
-  std::uint64_t slot;  // the id in a leaf, the child node's index above
-};
 
 namespace detail {
 
@@ -56,12 +53,12 @@ class DynamicRTree {
   // 40% of M: the value Beckmann et al. found best for the R*-tree, used for both variants.
   static constexpr int min_entries = std::max(2, M * 2 / 5);
 
-  struct Node {
-    SoaBoxes<D, M> boxes;
-    std::uint64_t slot[M];
-    std::uint32_t parent;
-    std::uint16_t count;
-    std::uint16_t level;
+  struct Node {             // (16 D + 8) M + 8 bytes
+    SoaBoxes<D, M> boxes;   // 16 D M: children's boxes, unused slots empty
+    std::uint64_t slot[M];  // 8 M: the entry's id in a leaf, the child's index above
+    std::uint32_t parent;   // 4: kNone at the root; next free node while on the free list
+    std::uint16_t count;    // 2: slots in use
+    std::uint16_t level;    // 2: 0 for a leaf
   };
 
   DynamicRTree() { root_ = new_node(0); }
@@ -74,9 +71,7 @@ class DynamicRTree {
   bool empty() const { return size_ == 0; }
   int height() const { return node(root_).level + 1; }
   Box<D> bounds() const { return node(root_).boxes.bounds(node(root_).count); }
-  std::size_t memory_bytes() const {
-    return nodes_.capacity() * sizeof(Node) + free_.capacity() * sizeof(std::uint32_t);
-  }
+  std::size_t memory_bytes() const { return nodes_.memory_bytes(); }
 
   // Throws InvalidGeometry on a NaN, infinite or inverted box.
   void insert(const Box<D>& box, Id id) {
@@ -98,33 +93,23 @@ class DynamicRTree {
   template <WindowVisitor<D> Visit>
   QueryStats query(const Box<D>& window, Visit&& visit, Relation rel = Relation::intersects) const;
   std::vector<Id> query(const Box<D>& window, Relation rel = Relation::intersects) const {
-    std::vector<Id> out;
-    query(
-        window, [&](Id id, const Box<D>&) { return out.push_back(id), true; }, rel);
-    return out;
+    return collect_ids([&](auto&& v) { return query(window, v, rel); });
   }
 
   template <NearestVisitor<D> Visit>
   QueryStats nearest(const Point<D>& p, std::size_t k, Visit&& visit) const;
   std::vector<Neighbor> nearest(const Point<D>& p, std::size_t k) const {
-    std::vector<Neighbor> out;
-    nearest(p, k, [&](Id id, const Box<D>&, double d) { return out.push_back({id, d}), true; });
-    return out;
+    return collect_neighbors([&](auto&& v) { return nearest(p, k, v); });
   }
 
   // Throws loci::Error describing the first broken invariant.
   void validate() const;
 
-  // For policies and tests.
-  const Node& node(std::uint32_t n) const { return nodes_[n]; }
-  std::uint32_t root() const { return root_; }
-
  private:
-  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-
+  const Node& node(std::uint32_t n) const { return nodes_[n]; }
   Node& node(std::uint32_t n) { return nodes_[n]; }
   std::uint32_t new_node(int level);
-  void free_node(std::uint32_t n) { free_.push_back(n); }
+  void free_node(std::uint32_t n) { nodes_.release(n); }
   int slot_of(std::uint32_t parent, std::uint32_t child) const;
   Entry<D> entry(std::uint32_t n, int i) const { return {node(n).boxes.box(i), node(n).slot[i]}; }
   void append(std::uint32_t n, const Entry<D>& e);
@@ -144,8 +129,7 @@ class DynamicRTree {
   };
   std::uint32_t bulk_node(BulkItem* first, std::size_t count, int level, std::size_t cap);
 
-  std::vector<Node> nodes_;
-  std::vector<std::uint32_t> free_;
+  NodePool<Node, &Node::parent> nodes_;
   std::uint32_t root_ = kNone;
   std::size_t size_ = 0;
   std::uint64_t reinserted_levels_ = 0;  // R*: levels already treated by reinsertion
@@ -153,15 +137,7 @@ class DynamicRTree {
 
 template <int D, int M, class P>
 std::uint32_t DynamicRTree<D, M, P>::new_node(int level) {
-  std::uint32_t n;
-  if (!free_.empty()) {
-    n = free_.back();
-    free_.pop_back();
-  } else {
-    if (nodes_.size() >= kNone) throw Error("R-tree node pool exhausted");
-    n = std::uint32_t(nodes_.size());
-    nodes_.emplace_back();
-  }
+  const std::uint32_t n = nodes_.allocate("R-tree");
   Node& nd = nodes_[n];
   nd.boxes.clear();
   nd.parent = kNone;
@@ -451,6 +427,11 @@ void DynamicRTree<D, M, P>::validate() const {
   if (root_ == kNone || node(root_).parent != kNone) fail("bad root");
   if (node(root_).level > 0 && node(root_).count < 2) fail("inner root with fewer than 2 entries");
   std::size_t items = 0;
+  std::vector<bool> seen(nodes_.size(), false);
+  if (!nodes_.validate_free(seen)) fail("free list corrupt");
+  if (seen[root_]) fail("root is on the free list");
+  seen[root_] = true;
+  std::size_t reachable = 1;
   std::vector<std::uint32_t> stack{root_};
   while (!stack.empty()) {
     const std::uint32_t n = stack.back();
@@ -470,14 +451,17 @@ void DynamicRTree<D, M, P>::validate() const {
     }
     for (int i = 0; i < nd.count; ++i) {
       const auto c = std::uint32_t(nd.slot[i]);
-      if (c >= nodes_.size()) fail(where + " points outside the pool");
+      if (!nodes_.contains(c) || seen[c]) fail(where + " points outside the pool or twice");
+      seen[c] = true;
       const Node& ch = node(c);
       if (ch.parent != n) fail(where + " child's parent link is wrong");
       if (ch.level + 1 != nd.level) fail(where + " child level is not one below");
       if (!(ch.boxes.bounds(ch.count) == nd.boxes.box(i))) fail(where + " entry box is not tight");
       stack.push_back(c);
+      ++reachable;
     }
   }
+  if (reachable != nodes_.in_use()) fail("nodes leaked from the pool");
   if (items != size_)
     fail("leaves hold " + std::to_string(items) + " entries, size() is " + std::to_string(size_));
 }

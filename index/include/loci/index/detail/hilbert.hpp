@@ -17,6 +17,8 @@
 #include <array>
 #include <cstdint>
 
+#include "loci/geom/box.hpp"
+
 namespace loci::detail {
 
 template <int D>
@@ -132,5 +134,31 @@ std::uint64_t hilbert_key(std::uint32_t (&x)[D]) {
   else
     return hilbert_key_generic<D>(x);
 }
+
+}  // namespace loci::detail
+
+namespace loci::detail {
+
+// Keys of points on the 2^hilbert_bits<D>() grid laid over `extent` (what packing and
+// quadtree building sort by). A flat axis maps to cell 0.
+template <int D>
+class HilbertGrid {
+ public:
+  explicit HilbertGrid(const Box<D>& extent) : min_(extent.min) {
+    constexpr double kMax = double((1u << hilbert_bits<D>()) - 1);
+    for (int a = 0; a < D; ++a)
+      scale_[a] = extent.extent(a) > 0 ? kMax / extent.extent(a) : 0.0;
+  }
+  std::uint64_t key(const Point<D>& p) const {
+    std::uint32_t x[D];
+    for (int a = 0; a < D; ++a)
+      x[a] = static_cast<std::uint32_t>((p[a] - min_[a]) * scale_[a]);
+    return hilbert_key<D>(x);
+  }
+
+ private:
+  Point<D> min_;
+  double scale_[D];
+};
 
 }  // namespace loci::detail

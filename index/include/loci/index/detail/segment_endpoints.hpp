@@ -1,8 +1,8 @@
-// What the windowing structures for map segments share: the segments themselves, a KdTree
-// over their 2n endpoints (endpoint 2i + e is endpoint e of segment i), and the first half of
-// every windowing query: each segment with an endpoint inside the window is reported once,
-// through its first endpoint inside. What remains for a structure is the segments that cross
-// the window with both endpoints outside.
+// What the windowing structures for map segments share: the segments themselves, a point
+// index (the structure's choice: KdTree<2> today) over their 2n endpoints (endpoint 2i + e is
+// endpoint e of segment i), and the first half of every windowing query: each segment with an
+// endpoint inside the window is reported once, through its first endpoint inside. What remains for
+// a structure is the segments that cross the window with both endpoints outside.
 #pragma once
 
 #include <concepts>
@@ -13,21 +13,14 @@
 
 #include "loci/geom/error.hpp"
 #include "loci/geom/segment.hpp"
-#include "loci/index/kd_tree.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci {
 
-// A segment visitor is called as `bool visit(Id id, const Segment<2>& s)` and returns false to
-// stop the query.
-template <class F>
-concept SegmentVisitor = std::predicate < F&,
-        Id, const Segment<2>
-& > ;
-
 namespace detail {
 
-class SegmentEndpoints {
+template <PointIndex Ends>
+requires(Ends::dimension == 2) class SegmentEndpoints {
  public:
   SegmentEndpoints() = default;
 
@@ -47,7 +40,7 @@ class SegmentEndpoints {
       ends.push_back(segments[i].b);
     }
     segs_.assign(segments.begin(), segments.end());
-    ends_ = KdTree<2>::build(ends);
+    ends_ = Ends::build(ends);
   }
 
   std::span<const Segment<2>> segments() const { return segs_; }
@@ -84,7 +77,7 @@ class SegmentEndpoints {
 
  private:
   std::vector<Segment<2>> segs_;
-  KdTree<2> ends_;
+  Ends ends_;
 };
 
 }  // namespace detail
