@@ -93,9 +93,7 @@ class AxisParallelWindowTree {
   template <SegmentVisitor Visit>
   QueryStats query(const Box<2>& w, Visit&& visit) const;
   std::vector<Id> query(const Box<2>& w) const {
-    std::vector<Id> out;
-    query(w, [&](Id id, const Segment<2>&) { return out.push_back(id), true; });
-    return out;
+    return collect_ids([&](auto&& v) { return query(w, v); });
   }
 
   // Throws loci::Error describing the first broken invariant.

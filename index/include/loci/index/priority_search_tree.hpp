@@ -69,9 +69,7 @@ class PrioritySearchTree {
     return run<detail::PstSide::left>(left_, qx, y1, y2, visit);
   }
   std::vector<Id> query_left(double qx, double y1, double y2) const {
-    std::vector<Id> out;
-    query_left(qx, y1, y2, [&](Id id, const Point<2>&) { return out.push_back(id), true; });
-    return out;
+    return collect_ids([&](auto&& v) { return query_left(qx, y1, y2, v); });
   }
 
   // Calls visit(id, point) for every point with x >= qx and y1 <= y <= y2; stops when it
@@ -81,9 +79,7 @@ class PrioritySearchTree {
     return run<detail::PstSide::right>(right_, qx, y1, y2, visit);
   }
   std::vector<Id> query_right(double qx, double y1, double y2) const {
-    std::vector<Id> out;
-    query_right(qx, y1, y2, [&](Id id, const Point<2>&) { return out.push_back(id), true; });
-    return out;
+    return collect_ids([&](auto&& v) { return query_right(qx, y1, y2, v); });
   }
 
   // Throws loci::Error describing the first broken invariant.
