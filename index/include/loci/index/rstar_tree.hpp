@@ -11,16 +11,17 @@
 // - Split: the axis is the one whose sorted distributions have the least total margin; the
 //   distribution along it is the one with least overlap between the two groups (ties: least
 //   total area). Prefix and suffix bounds make each axis O(M) after sorting.
-// Deletion, bulk loading, queries and thread-safety: see detail/dynamic_rtree.hpp.
+// The API is BasicRTree's (rtree.hpp); deletion, bulk loading and queries are shared with
+// Guttman's tree (detail/dynamic_rtree.hpp). Thread-safety: const member functions may run
+// concurrently; insert, erase and update need exclusive access.
 #pragma once
 
 #include <algorithm>
 #include <limits>
-#include <span>
-#include <utility>
 
 #include "loci/index/detail/dynamic_rtree.hpp"
 #include "loci/index/detail/split_groups.hpp"
+#include "loci/index/rtree.hpp"
 
 namespace loci {
 
@@ -145,50 +146,9 @@ int RStarInsertion::split(Entry<D>* e, int n, int min_fill) {
   return best_first;
 }
 
+// The API is BasicRTree's (rtree.hpp).
 template <int D, int M = 16>
-class RStarTree : private detail::DynamicRTree<D, M, RStarInsertion> {
-  using Base = detail::DynamicRTree<D, M, RStarInsertion>;
-
- public:
-  static constexpr int dimension = D;
-  static constexpr int max_entries = M;
-  static constexpr int min_entries = Base::min_entries;  // 40% of M
-
-  RStarTree() = default;
-
-  // Builds a tree from (box, id) pairs by top-down STR tiling with near-equal node sizes, so
-  // every node respects the minimum fill. Throws InvalidGeometry on a bad box.
-  static RStarTree bulk_load(std::span<const std::pair<Box<D>, Id>> entries) {
-    return RStarTree(Base::bulk_load(entries));
-  }
-
-  using Base::bounds;  // the root's box
-  using Base::empty;
-  using Base::height;        // levels, 1 for a lone leaf
-  using Base::memory_bytes;  // the node pool's capacity
-  using Base::size;
-
-  // insert(box, id): throws InvalidGeometry on a NaN, infinite or inverted box.
-  // erase(box, id): removes one entry with exactly this box and id; false when there is none.
-  // update(old_box, new_box, id): erase then insert; false (and no change) when not there.
-  using Base::erase;
-  using Base::insert;
-  using Base::update;
-
-  // query(window, visit, relation = intersects) -> QueryStats: visit(id, box) for each entry
-  // in the relation with the window, until it returns false; query(window, relation) ->
-  // std::vector<Id>. nearest(p, k, visit) -> QueryStats: visit(id, box, distance) for the k
-  // entries nearest p, nearest first; nearest(p, k) -> std::vector<Neighbor>. Throw
-  // InvalidGeometry on a bad window or point, InvalidArgument for k = 0.
-  using Base::nearest;
-  using Base::query;
-
-  // Throws loci::Error describing the first broken invariant.
-  using Base::validate;
-
- private:
-  explicit RStarTree(Base&& tree) : Base(std::move(tree)) {}
-};
+using RStarTree = BasicRTree<D, M, RStarInsertion>;
 
 static_assert(DynamicBoxIndex<RStarTree<2>> && NearestIndex<RStarTree<2>>);
 

@@ -7,7 +7,9 @@
 // - LinearSplit picks as seeds the pair with the greatest normalised separation along any
 //   axis, then assigns the others in order to the group needing least enlargement; O(M).
 // Both respect the minimum fill by handing the rest to a group that would fall short.
-// Deletion, bulk loading, queries and thread-safety: see detail/dynamic_rtree.hpp.
+// The API is BasicRTree's, below; deletion, bulk loading and queries are shared with the
+// R*-tree (detail/dynamic_rtree.hpp). Thread-safety: const member functions may run
+// concurrently; insert, erase and update need exclusive access.
 #pragma once
 
 #include <algorithm>
@@ -142,21 +144,25 @@ struct GuttmanInsertion {
   }
 };
 
-template <int D, class Split = QuadraticSplit, int M = 16>
-class RTree : private detail::DynamicRTree<D, M, GuttmanInsertion<Split>> {
-  using Base = detail::DynamicRTree<D, M, GuttmanInsertion<Split>>;
+// BasicRTree<D, M, Policy>: an insertion-built R-tree of node capacity M whose subtree choice,
+// split and overflow treatment come from Policy (GuttmanInsertion<Split> here,
+// RStarInsertion in rstar_tree.hpp). This is the API of RTree and RStarTree; the machinery
+// shared by every policy is detail/dynamic_rtree.hpp.
+template <int D, int M, class Policy>
+class BasicRTree : private detail::DynamicRTree<D, M, Policy> {
+  using Base = detail::DynamicRTree<D, M, Policy>;
 
  public:
   static constexpr int dimension = D;
   static constexpr int max_entries = M;
   static constexpr int min_entries = Base::min_entries;  // 40% of M
 
-  RTree() = default;
+  BasicRTree() = default;
 
   // Builds a tree from (box, id) pairs by top-down STR tiling with near-equal node sizes, so
   // every node respects the minimum fill. Throws InvalidGeometry on a bad box.
-  static RTree bulk_load(std::span<const std::pair<Box<D>, Id>> entries) {
-    return RTree(Base::bulk_load(entries));
+  static BasicRTree bulk_load(std::span<const std::pair<Box<D>, Id>> entries) {
+    return BasicRTree(Base::bulk_load(entries));
   }
 
   using Base::bounds;  // the root's box
@@ -184,8 +190,11 @@ class RTree : private detail::DynamicRTree<D, M, GuttmanInsertion<Split>> {
   using Base::validate;
 
  private:
-  explicit RTree(Base&& tree) : Base(std::move(tree)) {}
+  explicit BasicRTree(Base&& tree) : Base(std::move(tree)) {}
 };
+
+template <int D, class Split = QuadraticSplit, int M = 16>
+using RTree = BasicRTree<D, M, GuttmanInsertion<Split>>;
 
 static_assert(DynamicBoxIndex<RTree<2>> && NearestIndex<RTree<2>>);
 
