@@ -1,0 +1,151 @@
+// Many threads query the same built indexes at once, every answer checked against brute force.
+// Built indexes are immutable and const queries of dynamic ones may run concurrently (each
+// header's thread-safety contract); this suite is what the ThreadSanitizer build of CI runs, so
+// a data race in a query path (a shared scratch buffer, a lazily built member) fails it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "loci/index/interval_tree.hpp"
+#include "loci/index/kd_tree.hpp"
+#include "loci/index/packed_rtree.hpp"
+#include "loci/index/pr_quadtree.hpp"
+#include "loci/index/rstar_tree.hpp"
+#include "loci/index/segment_tree.hpp"
+#include "loci/index/segment_window_tree.hpp"
+#include "support/random_data.hpp"
+
+namespace loci::test {
+namespace {
+
+constexpr int kThreads = 8;
+constexpr int kQueriesPerThread = 300;
+
+// Runs check(thread, rng) kQueriesPerThread times on each of kThreads threads at once and
+// returns how many checks failed; a thread's queries come from its own fixed seed.
+template <class Check>
+std::size_t hammer(Check check) {
+  std::atomic<std::size_t> failures{0};
+  std::atomic<int> ready{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      std::mt19937_64 rng(1000 + t);
+      ++ready;
+      while (ready.load() < kThreads) {
+      }  // start together, so that queries overlap
+      for (int q = 0; q < kQueriesPerThread; ++q)
+        if (!check(rng)) ++failures;
+    });
+  for (auto& th : threads)
+    th.join();
+  return failures.load();
+}
+
+std::vector<Id> sorted_ids(std::vector<Id> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+template <int D>
+std::vector<Id> brute(const std::vector<Box<D>>& boxes, const Box<D>& w) {
+  std::vector<Id> out;
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    if (intersects(boxes[i], w)) out.push_back(Id(i));
+  return out;
+}
+
+template <int D>
+double kth_distance(const std::vector<Box<D>>& boxes, const Point<D>& p, std::size_t k) {
+  std::vector<double> d;
+  for (const auto& b : boxes)
+    d.push_back(std::sqrt(squared_distance(p, b)));
+  std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(k - 1), d.end());
+  return d[k - 1];
+}
+
+// Window and nearest-10 answers of a box index against brute force.
+template <class Tree>
+bool box_query_is_exact(const Tree& tree, const std::vector<Box<2>>& boxes, std::mt19937_64& rng) {
+  const Box<2> w = random_window<2>(rng);
+  if (sorted_ids(tree.query(w)) != brute(boxes, w)) return false;
+  const Point<2> p = random_point<2>(rng);
+  const auto near = tree.nearest(p, 10);
+  return near.size() == 10 && near.back().distance == kth_distance(boxes, p, 10);
+}
+
+TEST(ConcurrentQueries, PackedRTreeAndRStarTree) {
+  const auto boxes = make_boxes<2>(Shape::clustered, 8000, 7);
+  const auto packed = PackedRTree2::build(boxes);
+  RStarTree2 rstar;
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    rstar.insert(boxes[i], Id(i));
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return box_query_is_exact(packed, boxes, rng); }),
+            0u);
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return box_query_is_exact(rstar, boxes, rng); }),
+            0u);
+}
+
+TEST(ConcurrentQueries, PointStructures) {
+  std::mt19937_64 gen(11);
+  std::vector<Point<2>> points(8000);
+  std::vector<Box<2>> as_boxes;
+  for (auto& p : points) {
+    p = random_point<2>(gen);
+    as_boxes.push_back(Box<2>::of_point(p));
+  }
+  const auto kd = KdTree2::build(points);
+  const auto quad = PrQuadtree2::build(points, 8);
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return box_query_is_exact(kd, as_boxes, rng); }),
+            0u);
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return box_query_is_exact(quad, as_boxes, rng); }),
+            0u);
+}
+
+TEST(ConcurrentQueries, IntervalAndSegmentTrees) {
+  std::mt19937_64 gen(13);
+  std::uniform_real_distribution<double> u(0, 1000), len(0, 20);
+  std::vector<Interval> intervals(20000);
+  for (auto& iv : intervals) {
+    iv.lo = u(gen);
+    iv.hi = iv.lo + len(gen);
+  }
+  const auto itree = IntervalTree::build(intervals);
+  const auto stree = SegmentTree::build(intervals);
+  auto stab_is_exact = [&](const auto& tree, std::mt19937_64& rng) {
+    const double x = std::uniform_real_distribution<double>(-10, 1030)(rng);
+    std::vector<Id> ref;
+    for (std::size_t i = 0; i < intervals.size(); ++i)
+      if (intervals[i].contains(x)) ref.push_back(Id(i));
+    return sorted_ids(tree.stab(x)) == ref;
+  };
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return stab_is_exact(itree, rng); }), 0u);
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return stab_is_exact(stree, rng); }), 0u);
+}
+
+TEST(ConcurrentQueries, SegmentWindowTree) {
+  std::mt19937_64 gen(17);
+  std::uniform_real_distribution<double> step(-15, 15);
+  std::vector<Segment<2>> segs(20000);
+  for (auto& s : segs) {
+    s.a = random_point<2>(gen);
+    s.b = {s.a[0] + step(gen), s.a[1] + step(gen)};
+  }
+  const auto tree = SegmentWindowTree::build(segs);
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) {
+              const Box<2> w = random_window<2>(rng);
+              std::vector<Id> ref;
+              for (std::size_t i = 0; i < segs.size(); ++i)
+                if (intersects(w, segs[i])) ref.push_back(Id(i));
+              return sorted_ids(tree.query(w)) == ref;
+            }),
+            0u);
+}
+
+}  // namespace
+}  // namespace loci::test
