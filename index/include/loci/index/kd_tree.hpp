@@ -120,10 +120,20 @@ class KdTree {
     return collect_neighbors([&](auto&& v) { return nearest(p, k, v); });
   }
 
+  // Calls visit(id, box, distance) for the points in increasing distance from p, one at a
+  // time, until it returns false (distance browsing: nothing is fixed in advance, each answer
+  // costs what it takes to find it). Throws InvalidGeometry for a bad point.
+  template <NearestVisitor<D> Visit>
+  QueryStats browse(const Point<D>& p, Visit&& visit) const;
+
   // Throws loci::Error describing the first broken invariant.
   void validate() const;
 
  private:
+  // Runs walk(root, expand, report), detail::best_first or detail::browse, with this
+  // tree's expansion around p.
+  template <class Visit, class Walk>
+  QueryStats walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const;
   struct Item {
     Point<D> p;
     Id id;
@@ -447,6 +457,24 @@ QueryStats KdTree<D, Bucket>::nearest(const Point<D>& p, std::size_t k, Visit&& 
   check_point(p, "query point");
   if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
   if (root_ == kNone) return {};
+  return walk_nearest(p, visit, [k](std::uint64_t root, auto& expand, auto& report) {
+    return detail::best_first(root, k, expand, report);
+  });
+}
+
+template <int D, int Bucket>
+template <NearestVisitor<D> Visit>
+QueryStats KdTree<D, Bucket>::browse(const Point<D>& p, Visit&& visit) const {
+  check_point(p, "query point");
+  if (root_ == kNone) return {};
+  return walk_nearest(p, visit, [](std::uint64_t root, auto& expand, auto& report) {
+    return detail::browse(root, expand, report);
+  });
+}
+
+template <int D, int Bucket>
+template <class Visit, class Walk>
+QueryStats KdTree<D, Bucket>::walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const {
   // `q` is best_first's sink, which drops whatever lies beyond the k-th best entry so far.
   // An expansion walks down the nearer child to a leaf and queues only the farther siblings:
   // half the queue operations of queueing both, and the best candidates are found first.
@@ -474,7 +502,7 @@ QueryStats KdTree<D, Bucket>::nearest(const Point<D>& p, std::size_t k, Visit&& 
   auto report = [&](Id id, std::uint64_t pos, double d) {
     return visit(id, Box<D>::of_point(leaves_[std::uint32_t(pos / Bucket)].p[pos % Bucket]), d);
   };
-  return detail::best_first(root_, k, expand, report);
+  return walk(root_, expand, report);
 }
 
 template <int D, int Bucket>

@@ -172,10 +172,20 @@ class PackedRTree {
     return collect_neighbors([&](auto&& v) { return nearest(p, k, v); });
   }
 
+  // Calls visit(id, box, distance) for the items in increasing distance from p, one at a
+  // time, until it returns false (distance browsing: nothing is fixed in advance, each answer
+  // costs what it takes to find it). Throws InvalidGeometry for a bad point.
+  template <NearestVisitor<D> Visit>
+  QueryStats browse(const Point<D>& p, Visit&& visit) const;
+
   // Throws loci::Error describing the first broken invariant.
   void validate() const;
 
  private:
+  // Runs walk(root, expand, report), detail::best_first or detail::browse, with this
+  // tree's expansion around p.
+  template <class Visit, class Walk>
+  QueryStats walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const;
   PackedRTree(std::span<const Box<D>> boxes, Packing packing);
 
   struct Item {
@@ -382,7 +392,26 @@ QueryStats PackedRTree<D, NodeSize>::nearest(const Point<D>& p, std::size_t k,
   check_point(p, "query point");
   if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
   if (empty()) return {};
-  auto expand = [&](std::uint64_t ref, detail::BestFirstSink& sink) -> std::size_t {
+  return walk_nearest(p, visit, [k](std::uint64_t root, auto& expand, auto& report) {
+    return detail::best_first(root, k, expand, report);
+  });
+}
+
+template <int D, int NodeSize>
+template <NearestVisitor<D> Visit>
+QueryStats PackedRTree<D, NodeSize>::browse(const Point<D>& p, Visit&& visit) const {
+  check_point(p, "query point");
+  if (empty()) return {};
+  return walk_nearest(p, visit, [](std::uint64_t root, auto& expand, auto& report) {
+    return detail::browse(root, expand, report);
+  });
+}
+
+template <int D, int NodeSize>
+template <class Visit, class Walk>
+QueryStats PackedRTree<D, NodeSize>::walk_nearest(const Point<D>& p, Visit& visit,
+                                                  Walk&& walk) const {
+  auto expand = [&](std::uint64_t ref, auto& sink) -> std::size_t {
     const int level = int(ref >> 32);
     const std::size_t b = std::size_t(ref & 0xffffffffu);
     const std::size_t base = b * NodeSize;
@@ -398,7 +427,7 @@ QueryStats PackedRTree<D, NodeSize>::nearest(const Point<D>& p, std::size_t k,
     return std::size_t(used);
   };
   auto report = [&](Id id, std::uint64_t pos, double d) { return visit(id, leaf_box(pos), d); };
-  return detail::best_first(std::uint64_t(levels() - 1) << 32, k, expand, report);
+  return walk(std::uint64_t(levels() - 1) << 32, expand, report);
 }
 
 template <int D, int NodeSize>

@@ -132,6 +132,12 @@ class PrQuadtree {
     return collect_neighbors([&](auto&& v) { return nearest(p, k, v); });
   }
 
+  // Calls visit(id, box, distance) for the points in increasing distance from p, one at a
+  // time, until it returns false (distance browsing: nothing is fixed in advance, each answer
+  // costs what it takes to find it). Throws InvalidGeometry for a bad point.
+  template <NearestVisitor<D> Visit>
+  QueryStats browse(const Point<D>& p, Visit&& visit) const;
+
   // Calls f(region, depth, count, is_leaf) for every node, parents before children: the cells
   // a map draws.
   template <class F>
@@ -152,6 +158,10 @@ class PrQuadtree {
   void validate() const;
 
  private:
+  // Runs walk(root, expand, report), detail::best_first or detail::browse, with this
+  // tree's expansion around p.
+  template <class Visit, class Walk>
+  QueryStats walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const;
   struct Node {           // 16 D + 16 bytes
     Box<D> region;        // 16 D: the cell; children's are cut from it at its centre
     std::uint32_t child;  // 4: first of fan_out children, kNone for a leaf; pool free link
@@ -450,6 +460,24 @@ QueryStats PrQuadtree<D>::nearest(const Point<D>& p, std::size_t k, Visit&& visi
   check_point(p, "query point");
   if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
   if (empty()) return {};
+  return walk_nearest(p, visit, [k](std::uint64_t root, auto& expand, auto& report) {
+    return detail::best_first(root, k, expand, report);
+  });
+}
+
+template <int D>
+template <NearestVisitor<D> Visit>
+QueryStats PrQuadtree<D>::browse(const Point<D>& p, Visit&& visit) const {
+  check_point(p, "query point");
+  if (empty()) return {};
+  return walk_nearest(p, visit, [](std::uint64_t root, auto& expand, auto& report) {
+    return detail::browse(root, expand, report);
+  });
+}
+
+template <int D>
+template <class Visit, class Walk>
+QueryStats PrQuadtree<D>::walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const {
   auto expand = [&](std::uint64_t ref, auto& q) -> std::size_t {
     const Node& x = nodes_[std::uint32_t(ref)];
     std::size_t tested = 0;
@@ -469,7 +497,7 @@ QueryStats PrQuadtree<D>::nearest(const Point<D>& p, std::size_t k, Visit&& visi
   auto report = [&](Id id, std::uint64_t e, double d) {
     return visit(id, Box<D>::of_point(entries_[e].p), d);
   };
-  return detail::best_first(0, k, expand, report);
+  return walk(0, expand, report);
 }
 
 template <int D>

@@ -222,12 +222,13 @@ concept PointIndex = Index<T> && requires(const T& t, const Box<T::dimension>& w
   { t.query(w) } -> std::same_as<std::vector<Id>>;
 };
 
-// Answers nearest-n queries, nearest first.
+// Answers nearest-n queries, nearest first, and browses entries by increasing distance.
 template <class T>
 concept NearestIndex = Index<T> &&
     requires(const T& t, const Point<T::dimension>& p, std::size_t k) {
   { t.nearest(p, k, detail::NearestProbe<T::dimension>{}) } -> std::same_as<QueryStats>;
   { t.nearest(p, k) } -> std::same_as<std::vector<Neighbor>>;
+  { t.browse(p, detail::NearestProbe<T::dimension>{}) } -> std::same_as<QueryStats>;
 };
 
 // A box index that takes insertions and erasures at any time.

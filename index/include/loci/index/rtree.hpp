@@ -183,6 +183,7 @@ class BasicRTree : private detail::DynamicRTree<D, M, Policy> {
   // std::vector<Id>. nearest(p, k, visit) -> QueryStats: visit(id, box, distance) for the k
   // entries nearest p, nearest first; nearest(p, k) -> std::vector<Neighbor>. Throw
   // InvalidGeometry on a bad window or point, InvalidArgument for k = 0.
+  using Base::browse;
   using Base::nearest;
   using Base::query;
 

@@ -1,5 +1,6 @@
 // Best-first nearest-neighbour traversal (Hjaltason and Samet, "Distance Browsing in Spatial
-// Databases", TODS 1999), shared by every tree.
+// Databases", TODS 1999), shared by every tree, in two forms: best_first() for a fixed k and
+// browse() for an incremental walk that stops when its visitor does.
 //
 // Subtrees wait in a priority queue keyed by the squared distance from the query point to
 // their boxes and are expanded nearest first. Entries do not enter that queue: they go to a
@@ -179,6 +180,76 @@ QueryStats best_first(std::uint64_t root_ref, std::size_t k, Expand&& expand, Vi
   for (const QueueItem& e : best) {
     ++stats.results;
     if (!visit(e.id, e.ref, std::sqrt(e.d2))) break;
+  }
+  return stats;
+}
+
+// Distance browsing. Here nodes and entries do share one priority queue, as in Hjaltason and
+// Samet's incremental algorithm: an entry popped from the queue is nearer than everything still
+// waiting (a subtree's key is a lower bound on all it holds), so it is reported at once, and
+// the caller decides after each answer whether it wants another. That is what a query whose k
+// is not known in advance needs: the layer queries refine candidates by exact geometry and stop
+// when the next box distance exceeds the k-th exact distance. At equal keys entries come before
+// subtrees, so answers are not held back by ties. There is no bound to prune with: the sink
+// takes everything it is handed.
+struct BrowseItem {
+  double d2;
+  std::uint64_t ref;
+  Id id;
+  bool subtree;
+};
+
+struct BrowseNearerFirst {
+  bool operator()(const BrowseItem& a, const BrowseItem& b) const {
+    return a.d2 != b.d2 ? a.d2 > b.d2 : a.subtree && !b.subtree;
+  }
+};
+
+class BrowseSink {
+ public:
+  explicit BrowseSink(std::vector<BrowseItem>& queue) : queue_(queue) {}
+
+  void push_subtree(double d2, std::uint64_t ref) { push({d2, ref, 0, true}); }
+  void push_entry(double d2, std::uint64_t ref, Id id) { push({d2, ref, id, false}); }
+  template <class RefOf>
+  void push_subtrees(const double* d2, int count, RefOf ref_of) {
+    for (int i = 0; i < count; ++i)
+      push_subtree(d2[i], ref_of(i));
+  }
+  template <class RefOf, class IdOf>
+  void push_entries(const double* d2, int count, RefOf ref_of, IdOf id_of) {
+    for (int i = 0; i < count; ++i)
+      push_entry(d2[i], ref_of(i), id_of(i));
+  }
+
+ private:
+  void push(const BrowseItem& item) {
+    queue_.push_back(item);
+    std::push_heap(queue_.begin(), queue_.end(), BrowseNearerFirst{});
+  }
+  std::vector<BrowseItem>& queue_;
+};
+
+// Reports entries in increasing distance from the point `expand` measures against, starting
+// from subtree `root_ref`, until `visit(id, ref, distance)` returns false or the tree is done.
+template <class Expand, class Visit>
+QueryStats browse(std::uint64_t root_ref, Expand&& expand, Visit&& visit) {
+  QueryStats stats;
+  Scratch<BrowseItem> scratch;
+  auto& queue = *scratch;
+  BrowseSink sink(queue);
+  queue.push_back({0.0, root_ref, 0, true});
+  while (!queue.empty()) {
+    std::pop_heap(queue.begin(), queue.end(), BrowseNearerFirst{});
+    const BrowseItem top = queue.back();
+    queue.pop_back();
+    if (top.subtree) {
+      ++stats.nodes_visited;
+      stats.entries_tested += expand(top.ref, sink);
+      continue;
+    }
+    ++stats.results;
+    if (!visit(top.id, top.ref, std::sqrt(top.d2))) break;
   }
   return stats;
 }

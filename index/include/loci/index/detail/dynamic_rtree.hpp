@@ -102,10 +102,20 @@ class DynamicRTree {
     return collect_neighbors([&](auto&& v) { return nearest(p, k, v); });
   }
 
+  // Calls visit(id, box, distance) for the entries in increasing distance from p, one at a
+  // time, until it returns false (distance browsing: nothing is fixed in advance, each answer
+  // costs what it takes to find it). Throws InvalidGeometry for a bad point.
+  template <NearestVisitor<D> Visit>
+  QueryStats browse(const Point<D>& p, Visit&& visit) const;
+
   // Throws loci::Error describing the first broken invariant.
   void validate() const;
 
  private:
+  // Runs walk(root, expand, report), detail::best_first or detail::browse, with this
+  // tree's expansion around p.
+  template <class Visit, class Walk>
+  QueryStats walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const;
   const Node& node(std::uint32_t n) const { return nodes_[n]; }
   Node& node(std::uint32_t n) { return nodes_[n]; }
   std::uint32_t new_node(int level);
@@ -404,7 +414,25 @@ QueryStats DynamicRTree<D, M, P>::nearest(const Point<D>& p, std::size_t k, Visi
   check_point(p, "query point");
   if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
   if (empty()) return {};
-  auto expand = [&](std::uint64_t ref, BestFirstSink& sink) -> std::size_t {
+  return walk_nearest(p, visit, [k](std::uint64_t root, auto& expand, auto& report) {
+    return detail::best_first(root, k, expand, report);
+  });
+}
+
+template <int D, int M, class P>
+template <NearestVisitor<D> Visit>
+QueryStats DynamicRTree<D, M, P>::browse(const Point<D>& p, Visit&& visit) const {
+  check_point(p, "query point");
+  if (empty()) return {};
+  return walk_nearest(p, visit, [](std::uint64_t root, auto& expand, auto& report) {
+    return detail::browse(root, expand, report);
+  });
+}
+
+template <int D, int M, class P>
+template <class Visit, class Walk>
+QueryStats DynamicRTree<D, M, P>::walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const {
+  auto expand = [&](std::uint64_t ref, auto& sink) -> std::size_t {
     const Node& nd = node(std::uint32_t(ref));
     double d2[M];
     nd.boxes.squared_distances(p, d2);
@@ -418,7 +446,7 @@ QueryStats DynamicRTree<D, M, P>::nearest(const Point<D>& p, std::size_t k, Visi
   auto report = [&](Id id, std::uint64_t ref, double d) {
     return visit(id, node(std::uint32_t(ref / M)).boxes.box(int(ref % M)), d);
   };
-  return best_first(root_, k, expand, report);
+  return walk(root_, expand, report);
 }
 
 template <int D, int M, class P>
