@@ -1,0 +1,25 @@
+// Fuzz target: the sidecar loader. Any bytes handed to Sidecar::open must be refused with a
+// loci::Error or give an index whose queries stay inside the mapping; seeds are real sidecars.
+#include <cstdint>
+#include <string>
+
+#include "fuzz_support.hpp"
+#include "loci/io/sidecar.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static const std::string path = loci::fuzz::scratch_path(".loci");
+  loci::fuzz::write_file(path, data, size);
+  try {
+    const auto sidecar = loci::io::Sidecar::open(path);
+    const auto& tree = sidecar.tree();
+    const auto records = sidecar.records();
+    std::size_t seen = 0;
+    tree.query(sidecar.info().bounds, [&](loci::Id id, const loci::Box2&) {
+      if (id < records.size()) seen += records[id].fid & 1;
+      return true;
+    });
+    tree.nearest({0, 0}, 3);
+  } catch (const loci::Error&) {
+  }
+  return 0;
+}
