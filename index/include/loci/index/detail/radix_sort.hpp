@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -36,6 +37,13 @@ void radix_sort(std::vector<T>& v, int first_bit, int bits, KeyOf key_of) {
       tmp[count[(key_of(x) >> shift) & (kBuckets - 1)]++] = x;
     v.swap(tmp);
   }
+}
+
+// A 64-bit key whose unsigned order is the order of the doubles (no NaN): negative numbers
+// have every bit flipped, the others only the sign bit.
+inline std::uint64_t ordered_key(double x) {
+  const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
+  return bits >> 63 ? ~bits : bits | (std::uint64_t(1) << 63);
 }
 
 inline void radix_sort(std::vector<KeyedIndex>& v, int bits) {
