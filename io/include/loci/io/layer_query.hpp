@@ -19,9 +19,10 @@
 // meeting it is found by crossing parity along a horizontal ray, itself an index query, with
 // the even-odd rule over all rings of the feature.
 //
-// Nearest-n is best first over entry boxes with exact distances: a feature is final once its
-// exact distance is no larger than the box distance of the next entry, since every entry not
-// yet seen is at least that far. --candidates answers from boxes alone.
+// Nearest-n browses entry boxes by increasing distance (the trees' browse()) and refines with
+// exact distances: a feature is final once its exact distance is no larger than the box
+// distance of the next entry, since every entry not yet seen is at least that far, and the
+// walk stops there. --candidates answers from boxes alone.
 // Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry and belongs to one
 // thread.
 #pragma once
@@ -69,20 +70,20 @@ class LayerIndex {
   template <class Visit>
   void window(const Box2& w, Visit&& visit) const {
     std::visit(
-        [&](const auto& t) {
+        [&]<BoxIndex Tree>(const Tree& t) {
           t.query(w, [&](Id id, const Box2& b) {
             return id < records_.size() ? visit(records_[id], b) : true;
           });
         },
         tree_);
   }
-  // visit(record, box, box_distance) for entries nearest first; returning false stops.
+  // visit(record, box, box_distance) for entries nearest first, found one at a time (distance
+  // browsing: the work done is what the answers the caller takes need); returning false stops.
   template <class Visit>
   void browse(const Point2& p, Visit&& visit) const {
-    if (records_.empty()) return;
     std::visit(
-        [&](const auto& t) {
-          t.nearest(p, records_.size(), [&](Id id, const Box2& b, double d) {
+        [&]<NearestIndex Tree>(const Tree& t) {
+          t.browse(p, [&](Id id, const Box2& b, double d) {
             return id < records_.size() ? visit(records_[id], b, d) : true;
           });
         },
