@@ -20,6 +20,12 @@
 #include "loci/index/segment_window_tree.hpp"
 #include "support/random_data.hpp"
 
+#ifdef LOCI_HAVE_IO
+#include <unistd.h>
+
+#include "loci/io/sidecar.hpp"
+#endif
+
 namespace loci::test {
 namespace {
 
@@ -146,6 +152,39 @@ TEST(ConcurrentQueries, SegmentWindowTree) {
             }),
             0u);
 }
+
+#ifdef LOCI_HAVE_IO
+// One memory-mapped sidecar, its tree and records read by every thread at once.
+TEST(ConcurrentQueries, MappedSidecar) {
+  const auto boxes = make_boxes<2>(Shape::uniform, 8000, 19);
+  const auto tree = PackedRTree2::build(boxes);
+  std::vector<io::ItemRecord> records(boxes.size());
+  for (std::size_t i = 0; i < records.size(); ++i)
+    records[i] = {std::int64_t(1000 + i), 0, 0};
+  io::SidecarInfo info;
+  info.layer_name = "boxes";
+  info.items = boxes.size();
+  info.bounds = tree.bounds();
+  const std::string path = "/tmp/loci-concurrency-" + std::to_string(::getpid()) + ".loci";
+  io::write_sidecar(path, tree, records, info);
+  const auto sidecar = io::Sidecar::open(path);
+  ::unlink(path.c_str());
+  const auto& mapped = sidecar.tree();
+  const auto mapped_records = sidecar.records();
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) {
+              if (!box_query_is_exact(mapped, boxes, rng)) return false;
+              const Box<2> w = random_window<2>(rng);
+              bool fids_ok = true;
+              mapped.query(w, [&](Id id, const Box<2>&) {
+                fids_ok &=
+                    id < mapped_records.size() && mapped_records[id].fid == std::int64_t(1000 + id);
+                return true;
+              });
+              return fids_ok;
+            }),
+            0u);
+}
+#endif
 
 }  // namespace
 }  // namespace loci::test
