@@ -18,6 +18,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/io/bench.hpp"
 #include "loci/io/commands.hpp"
+#include "loci/io/intersections.hpp"
 #include "loci/io/layer_cells.hpp"
 
 namespace {
@@ -187,6 +188,25 @@ int run_clip(const Args& a) {
   return 0;
 }
 
+int run_intersections(const Args& a) {
+  if (a.positional.empty() || a.positional.size() > 2)
+    throw UsageError(
+        "loci intersections needs LAYER and optionally LAYER2 (see loci "
+        "intersections --help)");
+  IntersectionsOptions o;
+  o.layer_path = a.positional[0];
+  o.layer_name = a.get("--layer");
+  if (a.positional.size() == 2) o.other_path = a.positional[1];
+  o.other_name = a.get("--layer2");
+  o.format = parse_format(a.get("--format", "csv"));
+  o.pairs_only = a.has("--pairs-only");
+  o.out_path = a.get("--output");
+  const std::size_t n = write_intersections(o, stdout);
+  if (!a.has("--quiet") && !o.out_path.empty())
+    std::fprintf(stderr, "loci: %zu rows written into %s\n", n, o.out_path.c_str());
+  return 0;
+}
+
 int run_draw(const Args& a) {
   DrawOptions o;
   o.path = layer_arg(a, "draw");
@@ -290,6 +310,19 @@ const std::vector<Command>& commands() {
         kQuiet},
        "  loci clip countries.shp --bbox 5,45,15,55 -o alps.gpkg\n",
        run_clip},
+      {"intersections",
+       "loci intersections LAYER [LAYER2] [-f csv|geojson] [--pairs-only] [-o OUT]",
+       "where the layer's linework meets itself, or LAYER2's: feature pairs and points",
+       {{"--format", "-f", "csv|geojson",
+         "CSV `fid_a,fid_b,x,y` (default) or GeoJSON points with both FIDs"},
+        {"--pairs-only", nullptr, nullptr, "only the feature pairs (`fid_a,fid_b`)"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        kLayer,
+        {"--layer2", nullptr, "NAME", "layer of LAYER2 (default: its first)"},
+        kQuiet},
+       "  loci intersections roads.shp rivers.shp -f csv\n"
+       "  loci intersections coastline.geojson --pairs-only\n",
+       run_intersections},
       {"draw",
        "loci draw LAYER|FILE.loci -o OUT.svg [--levels N | --cells L] [--width PX]",
        "SVG of the layer's linework and the packed index's nodes, one colour per level, or "
@@ -336,7 +369,7 @@ void print_help() {
       "usage: loci COMMAND [options]\n\n"
       "Spatial indexes for map layers (any vector layer GDAL opens).\n\ncommands:\n");
   for (const auto& c : commands())
-    std::printf("  %-7s %s\n", c.name, c.summary);
+    std::printf("  %-13s %s\n", c.name, c.summary);
   std::printf(
       "\nloci COMMAND --help documents every option of COMMAND.\n"
       "Exit status 0 on success, 1 on failure with one line 'loci: error: ...' on stderr.\n\n"

@@ -1,0 +1,120 @@
+// `loci intersections` (see intersections.hpp).
+#include "loci/io/intersections.hpp"
+
+#include <algorithm>
+#include <span>
+
+#include "loci/geom/error.hpp"
+#include "loci/index/segment_intersections.hpp"
+#include "loci/io/layer_reader.hpp"
+
+namespace loci::io {
+
+namespace {
+
+// The segments of a layer in reading order, and for each the first and last segment of its
+// line or ring, which is what adjacency needs.
+struct Linework {
+  std::vector<Segment2> segs;
+  std::vector<std::int64_t> fid;
+  std::vector<std::uint32_t> first, last;
+
+  Linework(const std::string& path, const std::string& layer) {
+    const std::vector<SegmentRecord> recs = read_segments(path, layer);
+    segs.reserve(recs.size());
+    fid.reserve(recs.size());
+    for (const SegmentRecord& r : recs) {
+      segs.push_back(r.segment);
+      fid.push_back(r.fid);
+    }
+    first.resize(recs.size());
+    last.resize(recs.size());
+    for (std::size_t i = 0; i < recs.size();) {
+      std::size_t j = i;
+      while (j + 1 < recs.size() && recs[j + 1].fid == recs[i].fid &&
+             recs[j + 1].part == recs[i].part)
+        ++j;
+      for (std::size_t k = i; k <= j; ++k)
+        first[k] = std::uint32_t(i), last[k] = std::uint32_t(j);
+      i = j + 1;
+    }
+  }
+
+  // Consecutive segments of one line or ring, the closing pair of a closed one included.
+  bool adjacent(Id i, Id j) const {
+    if (first[i] != first[j]) return false;
+    if (i + 1 == j || j + 1 == i) return true;
+    const Id lo = std::min(i, j), hi = std::max(i, j);
+    return lo == first[i] && hi == last[i] && segs[lo].a == segs[hi].b;
+  }
+};
+
+void add_rows(std::int64_t a, std::int64_t b, const SegmentIntersection& x,
+              std::vector<IntersectionRow>& rows) {
+  rows.push_back({a, b, x.a});
+  if (x.kind == SegmentMeet::overlap) rows.push_back({a, b, x.b});
+}
+
+}  // namespace
+
+std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
+  std::vector<IntersectionRow> rows;
+  const Linework left(o.layer_path, o.layer_name);
+  if (o.other_path.empty()) {
+    segment_intersections(
+        std::span<const Segment2>(left.segs), [&](Id i, Id j) { return left.adjacent(i, j); },
+        [&](Id i, Id j, const SegmentIntersection& x) {
+          add_rows(std::min(left.fid[i], left.fid[j]), std::max(left.fid[i], left.fid[j]), x, rows);
+          return true;
+        });
+  } else {
+    const Linework right(o.other_path, o.other_name);
+    segment_intersections(std::span<const Segment2>(left.segs),
+                          std::span<const Segment2>(right.segs),
+                          [&](Id i, Id j, const SegmentIntersection& x) {
+                            add_rows(left.fid[i], right.fid[j], x, rows);
+                            return true;
+                          });
+  }
+  if (o.pairs_only)
+    for (auto& r : rows)
+      r.p = {0, 0};
+  std::sort(rows.begin(), rows.end());
+  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  return rows;
+}
+
+std::size_t write_intersections(const IntersectionsOptions& o, std::FILE* fallback) {
+  if (o.format == Format::ids)
+    throw InvalidArgument("loci intersections writes csv or geojson, not ids");
+  const std::vector<IntersectionRow> rows = find_intersections(o);
+  OutputFile out(o.out_path, fallback);
+  std::FILE* f = out.stream();
+  if (o.format == Format::csv) {
+    std::fputs(o.pairs_only ? "fid_a,fid_b\n" : "fid_a,fid_b,x,y\n", f);
+    for (const auto& r : rows) {
+      if (o.pairs_only)
+        std::fprintf(f, "%lld,%lld\n", (long long)r.fid_a, (long long)r.fid_b);
+      else
+        std::fprintf(f, "%lld,%lld,%.17g,%.17g\n", (long long)r.fid_a, (long long)r.fid_b, r.p[0],
+                     r.p[1]);
+    }
+  } else {
+    std::fputs("{\"type\":\"FeatureCollection\",\"features\":[", f);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const auto& r = rows[k];
+      std::fprintf(f, "%s\n{\"type\":\"Feature\",\"properties\":{\"fid_a\":%lld,\"fid_b\":%lld},",
+                   k ? "," : "", (long long)r.fid_a, (long long)r.fid_b);
+      if (o.pairs_only)
+        std::fputs("\"geometry\":null}", f);
+      else
+        std::fprintf(f, "\"geometry\":{\"type\":\"Point\",\"coordinates\":[%.17g,%.17g]}}", r.p[0],
+                     r.p[1]);
+    }
+    std::fputs("\n]}\n", f);
+  }
+  out.commit();
+  return rows.size();
+}
+
+}  // namespace loci::io
