@@ -15,6 +15,7 @@ namespace loci::io {
 std::size_t clip_layer(const ClipOptions& options) {
   if (!OGRGeometryFactory::haveGEOS()) throw Error("clipping needs GDAL built with GEOS");
   check_box(options.window, "bbox");
+  refuse_overwriting(options.out_path, options.load.layer_path);
   const LayerIndex index = load_index(options.load);
   LayerQuery query(index, options.load.layer_path, index.layer_name());
   Query q;

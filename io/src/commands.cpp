@@ -166,6 +166,7 @@ IndexReport index_layer(const IndexOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   IndexReport r;
   r.path = options.out_path.empty() ? default_sidecar_path(options.layer_path) : options.out_path;
+  refuse_overwriting(r.path, options.layer_path);
   // Fingerprint first: a layer changing while it is read must not look fresh afterwards.
   const Fingerprint source = fingerprint_of(options.layer_path);
   Progress reading;
@@ -218,6 +219,7 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin) {
 }
 
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
+  refuse_overwriting(options.out_path, options.load.layer_path);
   QueryReport report;
   const LayerIndex index = load_index(options.load, &report.index_origin);
   LayerQuery lq(index, options.load.layer_path, index.layer_name());

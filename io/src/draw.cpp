@@ -123,6 +123,7 @@ std::size_t draw_index(const DrawOptions& options) {
   }
   load.layer_name = options.layer_name;
   load.progress = options.progress;
+  refuse_overwriting(options.out_path, options.path);
   const bool cells = options.cell_levels >= 0;
   if (cells) load.per = Per::segment;
   const LayerIndex index = load_index(load);

@@ -87,6 +87,8 @@ std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
 std::size_t write_intersections(const IntersectionsOptions& o, std::FILE* fallback) {
   if (o.format == Format::ids)
     throw InvalidArgument("loci intersections writes csv or geojson, not ids");
+  refuse_overwriting(o.out_path, o.layer_path);
+  refuse_overwriting(o.out_path, o.other_path);
   const std::vector<IntersectionRow> rows = find_intersections(o);
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();

@@ -243,6 +243,8 @@ LayerItems read_items(const std::string& path, const std::string& layer, Per per
     const std::int64_t fid = feature->GetFID();
     if (is_polygonal(g)) out.has_polygons = true;
     if (per == Per::feature) {
+      // The envelope skips NaN coordinates; the feature must be refused, not half indexed.
+      detail::flatten(g, where(path, fid));
       OGREnvelope e;
       g->getEnvelope(&e);
       const Box2 box{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}};

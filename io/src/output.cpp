@@ -1,7 +1,6 @@
 // Result writers and all-or-nothing output files: see output.hpp.
 #include "loci/io/output.hpp"
 
-#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -15,32 +14,6 @@
 
 namespace loci::io {
 namespace {
-
-std::string directory_of(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
-}
-
-std::string base_of(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
-Error cannot_write(const std::string& path, int err) {
-  return Error("cannot write " + path + " (" + std::strerror(err) + ")");
-}
-
-void remove_tree(const std::string& dir) {
-  if (DIR* d = ::opendir(dir.c_str())) {
-    while (const dirent* e = ::readdir(d)) {
-      const std::string name = e->d_name;
-      if (name != "." && name != "..") ::unlink((dir + "/" + name).c_str());
-    }
-    ::closedir(d);
-  }
-  ::rmdir(dir.c_str());
-}
 
 std::string csv_quoted(const std::string& s) {
   if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
@@ -153,81 +126,17 @@ Format parse_format(const std::string& name) {
   throw InvalidArgument("unknown format '" + name + "' (choose ids, csv or geojson)");
 }
 
-OutputFile::OutputFile(const std::string& path, std::FILE* fallback) : path_(path) {
-  if (path.empty()) {
-    stream_ = fallback;
-    return;
-  }
-  tmp_ = directory_of(path) + "/." + base_of(path) + ".tmpXXXXXX";
-  const int fd = ::mkstemp(tmp_.data());
-  if (fd < 0) throw cannot_write(path, errno);
-  ::fchmod(fd, 0644);
-  stream_ = ::fdopen(fd, "w");
-  if (!stream_) {
-    const int e = errno;
-    ::close(fd);
-    ::unlink(tmp_.c_str());
-    throw cannot_write(path, e);
-  }
-}
-
-OutputFile::~OutputFile() {
-  if (path_.empty() || committed_) return;
-  std::fclose(stream_);
-  ::unlink(tmp_.c_str());
+OutputFile::OutputFile(const std::string& path, std::FILE* fallback) : fallback_(fallback) {
+  if (!path.empty()) file_.emplace(path);
 }
 
 void OutputFile::commit() {
-  if (path_.empty()) {
-    if (std::fflush(stream_) != 0)
-      throw Error(std::string("cannot write output (") + std::strerror(errno) + ")");
-    committed_ = true;
+  if (file_) {
+    file_->commit();
     return;
   }
-  committed_ = true;
-  const bool failed = std::ferror(stream_) != 0;
-  if (std::fclose(stream_) != 0 || failed) {
-    const int e = errno;
-    ::unlink(tmp_.c_str());
-    throw cannot_write(path_, e);
-  }
-  if (::rename(tmp_.c_str(), path_.c_str()) != 0) {
-    const int e = errno;
-    ::unlink(tmp_.c_str());
-    throw cannot_write(path_, e);
-  }
-}
-
-OutputDataset::OutputDataset(const std::string& path) : path_(path) {
-  std::string tmpl = directory_of(path) + "/." + base_of(path) + ".tmpXXXXXX";
-  if (!::mkdtemp(tmpl.data())) throw cannot_write(path, errno);
-  dir_ = tmpl;
-  staging_ = dir_ + "/" + base_of(path);
-}
-
-OutputDataset::~OutputDataset() {
-  if (!committed_) remove_tree(dir_);
-}
-
-void OutputDataset::commit() {
-  committed_ = true;
-  const std::string target_dir = directory_of(path_);
-  std::vector<std::string> names;
-  if (DIR* d = ::opendir(dir_.c_str())) {
-    while (const dirent* e = ::readdir(d)) {
-      const std::string name = e->d_name;
-      if (name != "." && name != "..") names.push_back(name);
-    }
-    ::closedir(d);
-  }
-  for (const auto& name : names) {
-    if (::rename((dir_ + "/" + name).c_str(), (target_dir + "/" + name).c_str()) != 0) {
-      const int e = errno;
-      remove_tree(dir_);
-      throw cannot_write(path_, e);
-    }
-  }
-  ::rmdir(dir_.c_str());
+  if (std::fflush(fallback_) != 0 || std::ferror(fallback_))
+    throw Error(std::string("cannot write output (") + std::strerror(errno ? errno : EIO) + ")");
 }
 
 void write_answers(const AnswerSource& source, std::span<const Answer> answers, Format format,
@@ -237,6 +146,7 @@ void write_answers(const AnswerSource& source, std::span<const Answer> answers, 
     if (out_path.empty()) {
       std::fflush(fallback);
       write_geojson(source, answers, numbered, with_distance, "/vsistdout/");
+      OutputFile(std::string(), fallback).commit();  // a full or closed stdout is an error
       return;
     }
     OutputDataset out(out_path);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "loci/geom/error.hpp"
+#include "loci/io/atomic_file.hpp"
 
 namespace loci::io {
 namespace {
@@ -85,7 +86,8 @@ struct Mapping {
 
 // Maps a whole file read-only; the returned pointer unmaps it. Empty files map to nullptr.
 std::shared_ptr<const Mapping> map_file(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: a FIFO must be refused at once, not wait for a writer
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) throw Error(path + ": cannot open (" + std::strerror(errno) + ")");
   struct stat st {};
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
@@ -248,24 +250,10 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   h.payload_checksum = hash_bytes(payload.data(), payload.size());
   h.header_checksum = hash_bytes(&h, offsetof(SidecarHeader, header_checksum));
 
-  std::string tmp = path + ".tmpXXXXXX";
-  const int fd = ::mkstemp(tmp.data());
-  if (fd < 0) throw Error("cannot write " + path + " (" + std::strerror(errno) + ")");
-  try {
-    write_all(fd, &h, sizeof h, path);
-    write_all(fd, payload.data(), payload.size(), path);
-    if (::fchmod(fd, 0644) != 0 || ::close(fd) != 0)
-      throw Error("cannot write " + path + " (" + std::strerror(errno) + ")");
-  } catch (...) {
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    throw;
-  }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int e = errno;
-    ::unlink(tmp.c_str());
-    throw Error("cannot write " + path + " (" + std::strerror(e) + ")");
-  }
+  AtomicFile out(path);
+  write_all(out.fd(), &h, sizeof h, path);
+  write_all(out.fd(), payload.data(), payload.size(), path);
+  out.commit();
 }
 
 Sidecar Sidecar::open(const std::string& path) {

@@ -1,11 +1,8 @@
 // Writing results: files that appear whole or not at all, and the three answer formats of
 // `loci query` (DESIGN.md section 6).
 //
-// OutputFile and OutputDataset write under a temporary name in the target's directory and
-// rename into place on commit(); destroyed without commit() they remove what they wrote, so
-// a failure never leaves a partial file. OutputDataset holds a temporary directory because
-// some GDAL formats are several files (a shapefile's .shp, .shx, .dbf, .prj) that must all
-// move together.
+// Files are written through atomic_file.hpp: whole or not at all, never replacing a device,
+// the old file intact on failure.
 //
 // Formats: `ids` prints one FID per line (`QUERY FID` for numbered batches); `csv` prints a
 // header `fid,` then the layer's attributes (`query,` first for batches, `distance` after fid
@@ -15,9 +12,11 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
+#include "loci/io/atomic_file.hpp"
 #include "loci/io/layer_query.hpp"
 
 namespace loci::io {
@@ -27,41 +26,21 @@ enum class Format { ids, csv, geojson };
 // Accepts "ids", "csv", "geojson"; throws InvalidArgument otherwise.
 Format parse_format(const std::string& name);
 
+// An answer stream: the file `path` written atomically (AtomicFile), or `fallback` (stdout)
+// when the path is empty. commit() reports a failed write (a full disk, a closed pipe) as an
+// Error instead of exiting 0 with a truncated answer.
 class OutputFile {
  public:
-  // An empty path means `fallback` (stdout), written directly. Throws Error when the target
-  // directory cannot hold the file.
   OutputFile(const std::string& path, std::FILE* fallback);
-  ~OutputFile();
-  OutputFile(const OutputFile&) = delete;
-  OutputFile& operator=(const OutputFile&) = delete;
-  std::FILE* stream() const { return stream_; }
+  std::FILE* stream() { return file_ ? file_->stream() : fallback_; }
   void commit();
 
  private:
-  std::string path_;
-  std::string tmp_;
-  std::FILE* stream_ = nullptr;
-  bool committed_ = false;
+  std::optional<AtomicFile> file_;
+  std::FILE* fallback_;
 };
 
-class OutputDataset {
- public:
-  explicit OutputDataset(const std::string& path);
-  ~OutputDataset();
-  OutputDataset(const OutputDataset&) = delete;
-  OutputDataset& operator=(const OutputDataset&) = delete;
-  // Where GDAL should create the dataset.
-  const std::string& staging_path() const { return staging_; }
-  // Moves every file GDAL wrote into the target directory. Call after closing the dataset.
-  void commit();
-
- private:
-  std::string path_;
-  std::string dir_;
-  std::string staging_;
-  bool committed_ = false;
-};
+using OutputDataset = AtomicDataset;
 
 struct AnswerSource {
   std::string layer_path;

@@ -26,8 +26,9 @@
 // of its .shp and .shx, which hold every geometry and the record offsets). Any difference
 // makes the sidecar stale; a touched but unchanged layer is reported stale too, as make would.
 //
-// Writing goes to a temporary file in the same directory, flushed, then renamed over the
-// target, so readers see either the old file or the whole new one.
+// Writing goes through AtomicFile (atomic_file.hpp): a hidden temporary file in the same
+// directory, synced, then renamed over the target, so readers see either the old file or the
+// whole new one, and a failed or interrupted `loci index` leaves the old sidecar valid.
 #pragma once
 
 #include <cstdint>

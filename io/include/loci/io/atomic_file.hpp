@@ -1,0 +1,83 @@
+// Files that appear whole or not at all: every file loci writes (sidecars, query answers,
+// clipped layers, drawings) goes through AtomicFile or AtomicDataset.
+//
+// A target that is a regular file, or does not exist yet, is written under a temporary name in
+// its own directory and renamed over it by commit(), so a reader sees the old file or the whole
+// new one, and a failure (a full disk, an error, a signal) leaves the old file intact:
+// - the temporary name is hidden and says whose it is: `.NAME.PID.tmpXXXXXX`, with NAME
+//   shortened so that the name never exceeds what the final name's directory allows;
+// - its mode is the existing target's, or 0666 less the umask for a new file;
+// - SIGINT, SIGTERM and SIGHUP remove the temporaries of the process before it dies; a leftover
+//   of a process killed harder (SIGKILL) is removed by the next write to the same target once
+//   its PID is gone.
+// A symbolic link is followed: the file it points to is replaced and the link stays. A
+// character device, FIFO or socket (/dev/null, /dev/stdout, a pipe) is written in place and
+// never replaced. A directory is refused.
+//
+// AtomicDataset does the same for GDAL outputs that are several files (a shapefile's .shp,
+// .shx, .dbf, .prj): GDAL writes them into a hidden staging directory, and commit() first
+// removes the target's old shapefile companions (.prj, .qix, ...) that the new dataset does not
+// have, then moves every new file into place. GDAL never sees a device or FIFO target (its
+// drivers may delete an existing file before creating one): a one-file dataset is staged, then
+// copied into it.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+namespace loci::io {
+
+class AtomicFile {
+ public:
+  // Throws loci::Error naming the target when it cannot be written.
+  explicit AtomicFile(const std::string& path);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  int fd() const { return fd_; }
+  // A stdio stream over fd(), made on first use; commit() flushes and closes it.
+  std::FILE* stream();
+  // Flushes, checks every write, syncs and renames into place. Throws loci::Error naming the
+  // target (the old file stays) when anything failed.
+  void commit();
+
+ private:
+  std::string path_;  // the file finally written (a symbolic link resolved)
+  std::string tmp_;   // empty when writing in place
+  int fd_ = -1;
+  std::FILE* stream_ = nullptr;
+  int register_slot_ = -1;  // in the table of temporaries removed on a signal
+  bool committed_ = false;
+};
+
+class AtomicDataset {
+ public:
+  // Throws loci::Error naming the target when its directory cannot hold the dataset.
+  explicit AtomicDataset(const std::string& path);
+  ~AtomicDataset();
+  AtomicDataset(const AtomicDataset&) = delete;
+  AtomicDataset& operator=(const AtomicDataset&) = delete;
+
+  // Where GDAL should create the dataset.
+  const std::string& staging_path() const { return staging_; }
+  // Moves every file GDAL wrote into place. Call after closing the dataset.
+  void commit();
+
+ private:
+  void commit_in_place();
+
+  std::string path_;
+  std::string dir_;  // the staging directory
+  std::string staging_;
+  int register_slot_ = -1;
+  bool in_place_ = false;  // a device or FIFO: the one file written is copied into it
+  bool committed_ = false;
+};
+
+// Throws loci::Error when writing `out` would overwrite the layer `input` or one of its
+// companion files (a shapefile's .shp, .shx, .dbf, ...): the same file, or the same stem in
+// the same directory for a shapefile.
+void refuse_overwriting(const std::string& out, const std::string& input);
+
+}  // namespace loci::io

@@ -1,0 +1,368 @@
+// All-or-nothing output files: see atomic_file.hpp.
+#include "loci/io/atomic_file.hpp"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <climits>
+#include <cstring>
+#include <filesystem>
+#include <system_error>
+#include <vector>
+
+#include "loci/geom/error.hpp"
+
+namespace fs = std::filesystem;
+
+namespace loci::io {
+namespace {
+
+Error cannot_write(const std::string& path, int err) {
+  return Error("cannot write " + path + " (" + std::strerror(err) + ")");
+}
+
+// ---- Temporaries removed on SIGINT, SIGTERM and SIGHUP ----------------------------------
+// A fixed table, so that the handler touches no allocator: a slot holds a path and whether
+// it is a directory (whose files are removed first).
+struct TempSlot {
+  std::atomic<bool> used{false};
+  bool directory = false;
+  char path[PATH_MAX];
+};
+std::array<TempSlot, 16> g_temps;
+std::atomic<bool> g_handlers{false};
+
+void remove_dir_files(const char* dir) {
+  // Only async-signal-safe calls would be ideal; the process is about to die and the
+  // directory holds a handful of files, so the small risk of readdir is accepted.
+  if (DIR* d = ::opendir(dir)) {
+    char buf[PATH_MAX];
+    while (const dirent* e = ::readdir(d)) {
+      if (!std::strcmp(e->d_name, ".") || !std::strcmp(e->d_name, "..")) continue;
+      if (std::strlen(dir) + std::strlen(e->d_name) + 2 > sizeof buf) continue;
+      std::strcpy(buf, dir);
+      std::strcat(buf, "/");
+      std::strcat(buf, e->d_name);
+      ::unlink(buf);
+    }
+    ::closedir(d);
+  }
+  ::rmdir(dir);
+}
+
+extern "C" void remove_temps_and_die(int sig) {
+  for (auto& slot : g_temps) {
+    if (!slot.used.load()) continue;
+    if (slot.directory)
+      remove_dir_files(slot.path);
+    else
+      ::unlink(slot.path);
+  }
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+void install_handlers() {
+  if (g_handlers.exchange(true)) return;
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    ::sigaction(sig, nullptr, &old);
+    if (old.sa_handler == SIG_IGN) continue;  // e.g. nohup: keep ignoring
+    struct sigaction sa {};
+    sa.sa_handler = remove_temps_and_die;
+    sigemptyset(&sa.sa_mask);
+    ::sigaction(sig, &sa, nullptr);
+  }
+}
+
+int register_temp(const std::string& path, bool directory) {
+  install_handlers();
+  if (path.size() >= PATH_MAX) return -1;
+  for (std::size_t i = 0; i < g_temps.size(); ++i) {
+    TempSlot& slot = g_temps[i];
+    bool expected = false;
+    if (slot.used.load()) continue;
+    std::memcpy(slot.path, path.c_str(), path.size() + 1);
+    slot.directory = directory;
+    if (slot.used.compare_exchange_strong(expected, true)) return int(i);
+  }
+  return -1;  // more than 16 at once: still removed on every normal path
+}
+
+void unregister_temp(int slot) {
+  if (slot >= 0) g_temps[std::size_t(slot)].used.store(false);
+}
+
+// ---- Temporary names ----------------------------------------------------------------------
+
+// The hidden prefix of every temporary for `name` in `dir`: ".NAME." with NAME cut so that the
+// whole temporary name fits the directory's limit.
+std::string temp_prefix(const std::string& dir, const std::string& name) {
+  long limit = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  if (limit <= 0) limit = 255;
+  // "." + name + "." + pid (up to 10) + ".tmp" + 6 random characters
+  const std::size_t room = std::size_t(limit) - 1 - 1 - 10 - 4 - 6;
+  return "." + name.substr(0, std::min(name.size(), room)) + ".";
+}
+
+// Removes temporaries for the same target left by a process that no longer exists.
+void remove_stale(const std::string& dir, const std::string& prefix) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string n = e.path().filename().string();
+    if (n.size() <= prefix.size() + 10 || n.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::size_t dot = n.find(".tmp", prefix.size());
+    if (dot == std::string::npos || dot + 10 != n.size()) continue;
+    const std::string pid_text = n.substr(prefix.size(), dot - prefix.size());
+    if (pid_text.empty() || !std::all_of(pid_text.begin(), pid_text.end(), ::isdigit)) continue;
+    const long pid = std::strtol(pid_text.c_str(), nullptr, 10);
+    if (pid <= 0 || (::kill(pid_t(pid), 0) == -1 && errno == ESRCH)) fs::remove_all(e.path(), ec);
+  }
+}
+
+std::string temp_template(const std::string& dir, const std::string& name) {
+  const std::string prefix = temp_prefix(dir, name);
+  remove_stale(dir, prefix);
+  return dir + "/" + prefix + std::to_string(::getpid()) + ".tmpXXXXXX";
+}
+
+std::string directory_of(const fs::path& p) {
+  const fs::path parent = p.parent_path();
+  return parent.empty() ? "." : parent.string();
+}
+
+mode_t new_file_mode() {
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  return 0666 & ~mask;
+}
+
+bool is_special_path(const std::string& path) {
+  return path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(const std::string& path) : path_(path) {
+  std::error_code ec;
+  fs::path target = path;
+  if (fs::is_symlink(fs::symlink_status(target, ec)) && !is_special_path(path)) {
+    target = fs::weakly_canonical(target, ec);
+    if (ec) throw cannot_write(path, ec.value());
+    path_ = target.string();
+  }
+  const fs::file_status st = fs::status(target, ec);
+  if (fs::is_directory(st)) throw Error("cannot write " + path + " (it is a directory)");
+  if (fs::is_block_file(st)) throw Error("cannot write " + path + " (it is a block device)");
+  const bool in_place = fs::is_character_file(st) || fs::is_fifo(st) || fs::is_socket(st) ||
+                        (is_special_path(path) && fs::exists(st));
+  if (in_place) {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+    if (fd_ < 0) throw cannot_write(path, errno);
+    return;
+  }
+  mode_t mode = new_file_mode();
+  struct stat old {};
+  if (::stat(path_.c_str(), &old) == 0) mode = old.st_mode & 07777;
+  tmp_ = temp_template(directory_of(target), target.filename().string());
+  fd_ = ::mkostemp(tmp_.data(), O_CLOEXEC);
+  if (fd_ < 0) throw cannot_write(path, errno);
+  register_slot_ = register_temp(tmp_, false);
+  if (::fchmod(fd_, mode) != 0) {
+    const int e = errno;
+    ::close(fd_);
+    ::unlink(tmp_.c_str());
+    unregister_temp(register_slot_);
+    throw cannot_write(path, e);
+  }
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  if (stream_)
+    std::fclose(stream_);
+  else if (fd_ >= 0)
+    ::close(fd_);
+  if (!tmp_.empty()) {
+    ::unlink(tmp_.c_str());
+    unregister_temp(register_slot_);
+  }
+}
+
+std::FILE* AtomicFile::stream() {
+  if (!stream_) {
+    stream_ = ::fdopen(fd_, "w");
+    if (!stream_) throw cannot_write(path_, errno);
+  }
+  return stream_;
+}
+
+void AtomicFile::commit() {
+  committed_ = true;
+  int err = 0;
+  if (stream_) {
+    if (std::fflush(stream_) != 0 || std::ferror(stream_)) err = errno ? errno : EIO;
+    if (!tmp_.empty() && !err && ::fsync(fd_) != 0 && errno != EINVAL) err = errno;
+    if (std::fclose(stream_) != 0 && !err) err = errno;
+  } else {
+    if (!tmp_.empty() && ::fsync(fd_) != 0 && errno != EINVAL) err = errno;
+    if (::close(fd_) != 0 && !err) err = errno;
+  }
+  stream_ = nullptr;
+  fd_ = -1;
+  if (tmp_.empty()) {
+    if (err) throw cannot_write(path_, err);
+    return;
+  }
+  if (!err && ::rename(tmp_.c_str(), path_.c_str()) != 0) err = errno;
+  if (err) ::unlink(tmp_.c_str());
+  unregister_temp(register_slot_);
+  if (err) throw cannot_write(path_, err);
+}
+
+AtomicDataset::AtomicDataset(const std::string& path) : path_(path) {
+  std::error_code ec;
+  fs::path target = path;
+  if (fs::is_symlink(fs::symlink_status(target, ec))) {
+    target = fs::weakly_canonical(target, ec);
+    path_ = target.string();
+  }
+  const fs::file_status st = fs::status(target, ec);
+  if (fs::is_directory(st)) throw Error("cannot write " + path + " (it is a directory)");
+  if (fs::is_block_file(st)) throw Error("cannot write " + path + " (it is a block device)");
+  in_place_ = fs::is_character_file(st) || fs::is_fifo(st) || fs::is_socket(st) ||
+              (is_special_path(path) && fs::exists(st));
+  if (in_place_) {
+    path_ = path;
+    target = fs::temp_directory_path() / target.filename();
+  }
+  std::string tmpl = temp_template(directory_of(target), target.filename().string());
+  if (!::mkdtemp(tmpl.data())) throw cannot_write(path, errno);
+  dir_ = tmpl;
+  register_slot_ = register_temp(dir_, true);
+  staging_ = dir_ + "/" + target.filename().string();
+}
+
+AtomicDataset::~AtomicDataset() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove_all(dir_, ec);
+  unregister_temp(register_slot_);
+}
+
+namespace {
+
+// Files a shapefile keeps beside its .shp; a new dataset written over an old one must not
+// leave the old ones (a stale .prj, a spatial index hiding features) behind.
+bool shapefile_companion(const std::string& ext) {
+  static const char* kinds[] = {".shp", ".shx", ".dbf", ".prj", ".cpg",    ".qix",
+                                ".sbn", ".sbx", ".qpj", ".fbn", ".fbx",    ".ain",
+                                ".aih", ".atx", ".ixs", ".mxs", ".shp.xml"};
+  std::string e = ext;
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return std::find(std::begin(kinds), std::end(kinds), e) != std::end(kinds);
+}
+
+// ".shp" of "roads.shp", ".shp.xml" of "roads.shp.xml", relative to the stem "roads".
+std::string extension_after(const std::string& name, const std::string& stem) {
+  return name.size() > stem.size() && name.compare(0, stem.size(), stem) == 0 &&
+                 name[stem.size()] == '.'
+             ? name.substr(stem.size())
+             : std::string();
+}
+
+}  // namespace
+
+void AtomicDataset::commit() {
+  committed_ = true;
+  if (in_place_) {
+    commit_in_place();
+    return;
+  }
+  const fs::path target = path_;
+  const fs::path dir = directory_of(target);
+  std::error_code ec;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir_, ec))
+    names.push_back(e.path().filename().string());
+  const std::string ext = target.extension().string();
+  if (shapefile_companion(ext)) {
+    const std::string stem = target.stem().string();
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+      const std::string n = e.path().filename().string();
+      const std::string x = extension_after(n, stem);
+      if (!x.empty() && shapefile_companion(x) &&
+          std::find(names.begin(), names.end(), n) == names.end())
+        fs::remove(e.path(), ec);
+    }
+  }
+  for (const auto& name : names) {
+    if (::rename((dir_ + "/" + name).c_str(), (dir / name).c_str()) != 0) {
+      const int e = errno;
+      fs::remove_all(dir_, ec);
+      unregister_temp(register_slot_);
+      throw cannot_write(path_, e);
+    }
+  }
+  ::rmdir(dir_.c_str());
+  unregister_temp(register_slot_);
+}
+
+void AtomicDataset::commit_in_place() {
+  std::error_code ec;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir_, ec))
+    files.push_back(e.path());
+  int err = 0;
+  if (files.size() != 1) {
+    fs::remove_all(dir_, ec);
+    unregister_temp(register_slot_);
+    throw Error("cannot write " + path_ + ": the format writes " + std::to_string(files.size()) +
+                " files, a device or pipe takes one");
+  }
+  const int in = ::open(files[0].c_str(), O_RDONLY | O_CLOEXEC);
+  const int out = in < 0 ? -1 : ::open(path_.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  if (in < 0 || out < 0) err = errno;
+  char buf[1 << 16];
+  while (!err) {
+    const ssize_t n = ::read(in, buf, sizeof buf);
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno != EINTR) err = errno;
+      continue;
+    }
+    for (ssize_t done = 0; done < n && !err;) {
+      const ssize_t w = ::write(out, buf + done, std::size_t(n - done));
+      if (w < 0 && errno != EINTR) err = errno;
+      if (w > 0) done += w;
+    }
+  }
+  if (in >= 0) ::close(in);
+  if (out >= 0 && ::close(out) != 0 && !err) err = errno;
+  fs::remove_all(dir_, ec);
+  unregister_temp(register_slot_);
+  if (err) throw cannot_write(path_, err);
+}
+
+void refuse_overwriting(const std::string& out, const std::string& input) {
+  if (out.empty() || input.empty()) return;
+  std::error_code ec;
+  const fs::path o = fs::weakly_canonical(out, ec), i = fs::weakly_canonical(input, ec);
+  bool same = fs::exists(o, ec) && fs::exists(i, ec) && fs::equivalent(o, i, ec);
+  if (!same && o.parent_path() == i.parent_path()) {
+    const std::string stem = i.stem().string();
+    const std::string x = extension_after(o.filename().string(), stem);
+    same = shapefile_companion(i.extension().string()) && !x.empty() && shapefile_companion(x);
+  }
+  if (same) throw Error("refusing to write " + out + ": it is the input layer " + input);
+}
+
+}  // namespace loci::io
