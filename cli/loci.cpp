@@ -6,6 +6,7 @@
 // cannot drift from what is accepted. Failures print one line `loci: error: ...` and exit 1.
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -415,7 +416,12 @@ int main(int argc, char** argv) {
         return 0;
       }
     try {
-      return c.run(parse(c, argc, argv));
+      const int status = c.run(parse(c, argc, argv));
+      // Output that did not reach its destination (a full disk, a closed pipe) is a failure.
+      if (std::fflush(stdout) != 0 || std::ferror(stdout))
+        throw loci::Error(std::string("cannot write output (") +
+                          std::strerror(errno ? errno : EIO) + ")");
+      return status;
     } catch (const std::exception& e) {
       std::fflush(stdout);
       std::fprintf(stderr, "loci: error: %s\n", e.what());

@@ -72,6 +72,9 @@ extern "C" void remove_temps_and_die(int sig) {
 
 void install_handlers() {
   if (g_handlers.exchange(true)) return;
+  // Past a file size limit a write fails with EFBIG, which the error path cleans up after,
+  // instead of the process dying with the temporary left behind.
+  ::signal(SIGXFSZ, SIG_IGN);
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction old {};
     ::sigaction(sig, nullptr, &old);

@@ -3,6 +3,7 @@
 #include "loci/io/layer_reader.hpp"
 
 #include <cpl_conv.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <map>
@@ -18,6 +19,11 @@ OpenLayer open_layer(const std::string& path, const std::string& name) {
   GDALAllRegister();
   if (!CPLGetConfigOption("OGR_GEOJSON_MAX_OBJ_SIZE", nullptr))
     CPLSetConfigOption("OGR_GEOJSON_MAX_OBJ_SIZE", "0");
+  // A FIFO or device would block GDAL or feed it endless bytes: only files and directories (a
+  // directory of shapefiles) are layers on disk; other names (/vsi..., PG:...) go to GDAL.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+    throw Error(path + ": not a regular file");
   CPLPushErrorHandler(CPLQuietErrorHandler);
   OpenLayer ol;
   ol.dataset.reset(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));

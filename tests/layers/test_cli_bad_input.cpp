@@ -1,0 +1,243 @@
+// The command line on input and output that would crash it, lose data or answer silently
+// wrongly: each case gives a clear one-line error and exit code 1 (or a correct answer where the
+// input is merely unusual), and leaves nothing half-written. Regression tests of the
+// reliability rows: empty layers, NaN coordinates, a full disk or stdout, devices, FIFOs and
+// symbolic links as outputs, the input layer as output, temporaries and modes.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "layers/cli_support.hpp"
+
+namespace fs = std::filesystem;
+using namespace loci::test;
+
+namespace {
+
+class BadInput : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("loci-bad-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  std::string lines_layer() const {
+    return write("lines.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"n":1},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}},
+{"type":"Feature","properties":{"n":2},"geometry":{"type":"LineString","coordinates":[[2,0],[3,1]]}}]})");
+  }
+  // Files in the directory whose name says they are temporaries.
+  std::vector<std::string> temporaries() const {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir_))
+      if (e.path().filename().string().find(".tmp") != std::string::npos)
+        out.push_back(e.path().filename().string());
+    return out;
+  }
+
+  fs::path dir_;
+};
+
+void expect_one_line_error(const CliRun& r) {
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("loci: error: ", 0), 0u) << r.err;
+}
+
+TEST_F(BadInput, EmptyLayerGivesAnEmptyIndexAndEmptyAnswers) {
+  for (const char* text : {R"({"type":"FeatureCollection","features":[]})",
+                           R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":null}]})"}) {
+    const std::string l = write("empty.geojson", text);
+    fs::remove(l + ".loci");
+    for (const char* per : {"feature", "segment"}) {
+      const CliRun ix = run_loci("index " + shell_quote(l) + " --per " + per + " -q");
+      ASSERT_EQ(ix.status, 0) << ix.err;
+      const CliRun info = run_loci("info " + shell_quote(l));
+      EXPECT_EQ(info.status, 0) << info.err;
+      EXPECT_NE(info.out.find("0 entries"), std::string::npos) << info.out;
+      for (const char* q : {"--bbox 0,0,1,1", "--nearest 0,0 -k 3", "--point 0,0", "--within 0,0,5",
+                            "--segment 0,0,1,1"}) {
+        const CliRun r = run_loci("query " + shell_quote(l) + " " + q);
+        EXPECT_EQ(r.status, 0) << q << ": " << r.err;
+        EXPECT_EQ(r.out, "") << q;
+      }
+      const CliRun d = run_loci("draw " + shell_quote(l) + " -o " + shell_quote(path("e.svg")));
+      EXPECT_LE(d.status, 1);  // no crash: an empty drawing or a clear refusal
+      if (d.status == 1) expect_one_line_error(d);
+    }
+  }
+}
+
+TEST_F(BadInput, NaNCoordinatesAreRefusedNamingTheFeature) {
+  const std::string l = write("nan.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[NaN,1],[2,2]]}}]})");
+  for (const char* per : {"feature", "segment"}) {
+    const CliRun r = run_loci("index " + shell_quote(l) + " --per " + per);
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("feature 1"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(l + ".loci"));
+  }
+  const CliRun clip =
+      run_loci("clip " + shell_quote(l) + " --bbox -1,-1,3,3 -o " + shell_quote(path("c.geojson")));
+  expect_one_line_error(clip);
+  EXPECT_FALSE(fs::exists(path("c.geojson")));
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(BadInput, DevicesFifosAndLinksAreWrittenThroughNeverReplaced) {
+  const std::string l = lines_layer();
+  const std::string dev = path("null");
+  ASSERT_EQ(::mknod(dev.c_str(), S_IFCHR | 0666, makedev(1, 3)), 0) << "needs root";
+  for (const char* f : {"ids", "csv", "geojson"}) {
+    const CliRun r =
+        run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -f " + f + " -o " + shell_quote(dev));
+    EXPECT_EQ(r.status, 0) << r.err;
+    struct stat st {};
+    ASSERT_EQ(::stat(dev.c_str(), &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode)) << "the device was replaced (" << f << ")";
+  }
+  // a symbolic link: the file it points to gets the answer, the link stays
+  write("target.txt", "old\n");
+  fs::create_symlink("target.txt", path("link.txt"));
+  const CliRun r =
+      run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o " + shell_quote(path("link.txt")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(path("link.txt")));
+  EXPECT_EQ(read_text(path("target.txt")), "0\n1\n");
+  // a FIFO as sidecar or layer is refused at once, not waited on
+  const std::string fifo = path("fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  expect_one_line_error(
+      run_loci("query " + shell_quote(l) + " --index " + shell_quote(fifo) + " --bbox 0,0,1,1"));
+  expect_one_line_error(run_loci("info " + shell_quote(fifo)));
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(20));
+  // a directory as output
+  expect_one_line_error(
+      run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o " + shell_quote(dir_.string())));
+}
+
+TEST_F(BadInput, TheInputLayerIsNeverOverwritten) {
+  const std::string l = lines_layer();
+  const std::string before = read_text(l);
+  expect_one_line_error(run_loci("index " + shell_quote(l) + " -o " + shell_quote(l)));
+  expect_one_line_error(
+      run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o " + shell_quote(l)));
+  expect_one_line_error(
+      run_loci("clip " + shell_quote(l) + " --bbox 0,0,9,9 -o " + shell_quote(l)));
+  expect_one_line_error(run_loci("intersections " + shell_quote(l) + " -o " + shell_quote(l)));
+  EXPECT_EQ(read_text(l), before);
+  // a shapefile's companion files count as the layer
+  const CliRun shp =
+      run_loci("clip " + shell_quote(l) + " --bbox -1,-1,9,9 -o " + shell_quote(path("roads.shp")));
+  ASSERT_EQ(shp.status, 0) << shp.err;
+  const std::string dbf = read_text(path("roads.dbf"));
+  expect_one_line_error(run_loci("query " + shell_quote(path("roads.shp")) + " --bbox 0,0,9,9 -o " +
+                                 shell_quote(path("roads.dbf"))));
+  EXPECT_EQ(read_text(path("roads.dbf")), dbf);
+}
+
+TEST_F(BadInput, FullDiskAndFullStdoutFailAndKeepTheOldFile) {
+  const std::string l = lines_layer();
+  for (const char* f : {"ids", "csv", "geojson"}) {
+    const CliRun r = run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -f " + std::string(f) +
+                              " > /dev/full");
+    expect_one_line_error(r);
+  }
+  expect_one_line_error(run_loci("info " + shell_quote(l) + " > /dev/full"));
+  // a file size limit stands in for a full disk: the old output must stay whole
+  write("old.csv", "the old answer\n");
+  const std::string cmd = "ulimit -f 0; " + std::string(LOCI_EXE) + " query " + shell_quote(l) +
+                          " --bbox 0,0,9,9 -f csv -o " + shell_quote(path("old.csv")) +
+                          " 2>/dev/null";
+  const int st = std::system(("bash -c " + shell_quote(cmd)).c_str());
+  EXPECT_NE(st, 0);
+  EXPECT_EQ(read_text(path("old.csv")), "the old answer\n");
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(BadInput, TemporariesAreHiddenModesKeptAndLeftoversRemoved) {
+  const std::string l = lines_layer();
+  // a leftover of a process killed with SIGKILL (its PID no longer exists) goes away
+  const std::string stale = path(".lines.geojson.loci.2147483646.tmpAbCdEf");
+  write(".lines.geojson.loci.2147483646.tmpAbCdEf", "half a sidecar");
+  ::umask(077);
+  const CliRun ix = run_loci("index " + shell_quote(l) + " -q");
+  ::umask(022);
+  ASSERT_EQ(ix.status, 0) << ix.err;
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_EQ(fs::status(l + ".loci").permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write);
+  // an existing output keeps its mode
+  write("out.txt", "x");
+  fs::permissions(path("out.txt"),
+                  fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  ASSERT_EQ(
+      run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o " + shell_quote(path("out.txt")))
+          .status,
+      0);
+  EXPECT_EQ(fs::status(path("out.txt")).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  // a long layer name: the temporary's name must still fit
+  const std::string long_name(237, 'x');
+  fs::copy_file(l, path(long_name));
+  const CliRun lng = run_loci("index " + shell_quote(path(long_name)) + " -q");
+  EXPECT_EQ(lng.status, 0) << lng.err;
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(BadInput, SigtermRemovesTheTemporaries) {
+  // clip into a FIFO nobody reads: loci stages the dataset and then blocks writing it out
+  const std::string l = lines_layer();
+  const std::string fifo = path("out.geojson");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 2);
+    ::execl(LOCI_EXE, LOCI_EXE, "clip", l.c_str(), "--bbox", "-1,-1,9,9", "-o", fifo.c_str(),
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const std::string prefix = ".out.geojson." + std::to_string(pid) + ".tmp";
+  auto staged = [&] {
+    for (const auto& e : fs::directory_iterator(fs::temp_directory_path()))
+      if (e.path().filename().string().rfind(prefix, 0) == 0) return true;
+    return false;
+  };
+  bool seen = false;
+  for (int i = 0; i < 200 && !seen; ++i) {
+    seen = staged();
+    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  EXPECT_TRUE(seen) << "the staging directory never appeared";
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM);
+  EXPECT_FALSE(staged()) << "the staging directory survived SIGTERM";
+}
+
+}  // namespace
