@@ -303,7 +303,8 @@ void report(const std::vector<Result>& rs, std::size_t n, const char* workload) 
                 b2->median_ms / tree->median_ms);
 }
 
-void bench(std::size_t n, double speed, const char* workload, int ticks, int peer_ticks) {
+void bench(std::size_t n, double speed, const char* workload, int ticks, int peer_ticks,
+           bool peers) {
   const int slow = n >= 50000 ? std::min(ticks, peer_ticks) : ticks;
   std::vector<Result> rs;
   {
@@ -327,17 +328,17 @@ void bench(std::size_t n, double speed, const char* workload, int ticks, int pee
     rs.push_back(run(c, n, speed, ticks));
   }
 #if LOCI_HAVE_BULLET
-  {
+  if (peers) {
     BulletDbvt b;
     rs.push_back(run(b, n, speed, slow));
   }
-  {
+  if (peers) {
     BulletSap b(std::sqrt(double(n) * 100));
     rs.push_back(run(b, n, speed, slow));
   }
 #endif
 #if LOCI_HAVE_BOX2D
-  {
+  if (peers) {
     auto b = std::make_unique<Box2dTree>();
     rs.push_back(run(*b, n, speed, slow));
   }
@@ -351,6 +352,7 @@ int main(int argc, char** argv) {
   std::vector<std::size_t> ns{10000, 100000};
   int ticks = 100, peer_ticks = 10;
   std::string workload = "all";
+  bool peers = true;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
     if (flag == "--n") {
@@ -364,6 +366,8 @@ int main(int argc, char** argv) {
       ticks = std::stoi(value);
     } else if (flag == "--peer-ticks") {
       peer_ticks = std::stoi(value);
+    } else if (flag == "--peers") {
+      peers = value != "no";
     } else if (flag == "--workload") {
       workload = value;
     } else {
@@ -376,9 +380,9 @@ int main(int argc, char** argv) {
   std::printf("bench_broadphase: median time per tick (moves + all pairs), fixed seed 42\n");
   for (const std::size_t n : ns) {
     if (workload == "all" || workload == "fast")
-      bench(n, 1.4, "fast (speed <= 1.4)", ticks, peer_ticks);
+      bench(n, 1.4, "fast (speed <= 1.4)", ticks, peer_ticks, peers);
     if (workload == "all" || workload == "coherent")
-      bench(n, 0.05, "coherent (speed <= 0.05)", ticks, peer_ticks);
+      bench(n, 0.05, "coherent (speed <= 0.05)", ticks, peer_ticks, peers);
   }
   return 0;
 }

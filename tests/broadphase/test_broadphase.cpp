@@ -23,6 +23,10 @@ struct FineGrid : UniformGrid<D> {
   FineGrid() : UniformGrid<D>(0.05) {}
 };
 template <int D>
+struct StripedSweep : SweepPrune<D> {
+  StripedSweep() : SweepPrune<D>(16) {}
+};
+template <int D>
 struct TightTree : DynamicAabbTree<D> {
   TightTree() : DynamicAabbTree<D>(AabbTreeOptions{0, 0, 0}) {}
 };
@@ -221,10 +225,10 @@ void run(Scene scene, std::uint64_t seed, int n = 200, int ticks = 40) {
 template <class BP>
 class BroadPhaseTest : public ::testing::Test {};
 
-using Structures =
-    ::testing::Types<SweepPrune<2>, SweepPrune<3>, IncrementalSweepPrune<2>,
-                     IncrementalSweepPrune<3>, UniformGrid<2>, UniformGrid<3>, FineGrid<2>,
-                     DynamicAabbTree<2>, DynamicAabbTree<3>, TightTree<2>>;
+using Structures = ::testing::Types<SweepPrune<2>, SweepPrune<3>, StripedSweep<2>, StripedSweep<3>,
+                                    IncrementalSweepPrune<2>, IncrementalSweepPrune<3>,
+                                    UniformGrid<2>, UniformGrid<3>, FineGrid<2>, DynamicAabbTree<2>,
+                                    DynamicAabbTree<3>, TightTree<2>>;
 TYPED_TEST_SUITE(BroadPhaseTest, Structures);
 
 TYPED_TEST(BroadPhaseTest, RandomMotion) {

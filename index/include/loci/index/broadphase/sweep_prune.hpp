@@ -6,19 +6,31 @@
 // Each pair is found once, from the proxy that comes first (Baraff's sweep and prune, 1992;
 // Terdiman, "Box pruning revisited", 2017, for the single-axis, sort-every-frame form).
 //
-// Axis. The axis is the one along which the box centres vary most: the fewer boxes share a
-// stretch of that axis, the shorter the runs. SweepPrune picks it afresh each tick.
+// Axis. The sweep axis is the one along which the box centres vary most: the fewer boxes
+// share a stretch of that axis, the shorter the runs.
 //
-// Sorting. SweepPrune sorts from scratch each tick with an LSD radix sort on the min
-// coordinate mapped to a 64-bit key whose unsigned order is the order of the doubles
-// (detail::ordered_key). IncrementalSweepPrune keeps the order from the last tick and
-// repairs it with insertion sort, which costs O(n + swaps) when boxes move little between
-// ticks (coherence); past a budget of swaps it gives up and radix sorts, so a scene that
-// jumps costs no more than SweepPrune. It changes axis only when another axis's centre
-// variance is well above the current one's (hysteresis: a change costs a full sort).
+// Stripes (SweepPrune, from 4096 proxies on). A single sweep over a square world of n boxes
+// makes runs of length ~sqrt(n): every box in the whole height of the world whose min falls
+// in a box's extent. So SweepPrune also cuts the second axis (the one of next largest centre
+// variance) into stripes about four mean box extents high, enters each box in every stripe it
+// touches, and sweeps the stripes one after the other (the bucketed variant of Terdiman's
+// "multi box pruning"). A pair sharing several stripes is reported only from the stripe that
+// holds the larger of the two boxes' mins on the stripe axis: the one where either box starts.
 //
-// Sweep. The sorted boxes are gathered into structure-of-arrays with a +inf sentinel after the
-// last, so the run of proxy i ends on a comparison instead of a bounds check; the test on the
+// Sorting. SweepPrune radix sorts (detail::radix_sort, LSD) 64-bit keys each tick: the stripe
+// above, below it the box's min on the sweep axis rounded down to a float and mapped to an
+// unsigned integer with the same order; four passes for up to 4096 stripes. The rounded key
+// only orders the runs (it is <= the true min, so a run never stops early); the tests that
+// report a pair are exact, on the doubles. IncrementalSweepPrune keeps one plain sweep's order
+// (exact 64-bit keys of the doubles, detail::ordered_key) from the last tick and repairs it
+// with insertion sort, which costs O(n + swaps) when boxes move little between ticks
+// (coherence); past a budget of swaps it gives up and radix sorts, so a scene that jumps
+// costs no more than a fresh sort. It changes axis only when another axis's centre variance
+// is well above the current one's (hysteresis: a change costs a full sort). It keeps no
+// stripes, so its runs grow as sqrt(n) in a square world.
+//
+// Sweep. The sorted boxes are gathered into structure-of-arrays, each stripe followed by a
+// +inf sentinel, so a run ends on a comparison instead of a bounds check; the test on the
 // other axes is branch-free and writes each candidate into a buffer whose cursor advances by
 // the test's result (left-packed output), so the only unpredictable branch is the end of the
 // run.
@@ -26,15 +38,16 @@
 // Queries: query(box) scans the proxies (O(n)); a structure answering windows in O(log n)
 // is DynamicAabbTree.
 //
-// Complexity per tick: O(n) for the sort (six radix passes; O(n + swaps) when incremental),
-// O(n + runs + k) for the sweep where runs is the number of pairs overlapping on the sweep
-// axis. Memory: O(n).
+// Complexity per tick: O(n) for the sort (four radix passes; O(n + swaps) when incremental),
+// O(n + runs + k) for the sweep where runs is the number of pairs of a stripe overlapping on
+// the sweep axis. Memory: O(n) (plus one entry per extra stripe a box touches).
 //
 // Thread-safety as broad_phase.hpp says.
 #pragma once
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -91,6 +104,9 @@ class BasicSweepPrune {
  public:
   static constexpr int dimension = D;
 
+  // SweepPrune cuts space into stripes once it holds `striped_from` proxies (see above).
+  explicit BasicSweepPrune(std::size_t striped_from = kStripedFrom) : striped_from_(striped_from) {}
+
   void add(Id id, const Box<D>& b) {
     const std::uint32_t s = proxies_.add(id, b, kName);
     if constexpr (Incremental) {
@@ -130,7 +146,15 @@ class BasicSweepPrune {
 
   template <PairVisitor F>
   QueryStats pairs(F&& visit) {
-    sort();
+    if constexpr (Incremental) {
+      sort_incremental();
+      begin_gather(order_.size());
+      for (const std::uint32_t s : order_)
+        gather(s, proxies_.box(s).min[axis_], true);
+      gather_sentinel();
+    } else {
+      sort_striped();
+    }
     return sweep(visit);
   }
   std::vector<IdPair> pairs() {
@@ -169,33 +193,28 @@ class BasicSweepPrune {
 
  private:
   static constexpr const char* kName = Incremental ? "IncrementalSweepPrune" : "SweepPrune";
+  // Below this many proxies one stripe is best; above, at most this many stripes.
+  static constexpr std::size_t kStripedFrom = 4096;
+  static constexpr double kMaxStripes = 4096;
 
-  // Leaves order_ holding the live slots by increasing min on axis_.
-  void sort() {
-    if constexpr (Incremental) {
-      double var[D];
-      const int best = detail::widest_axis(proxies_, var);
-      const bool switch_axis = best != axis_ && var[best] > 2.0 * var[axis_];
-      if (holes_) {
-        std::erase(order_, kNone);
-        holes_ = 0;
-      }
-      if (switch_axis || !sorted_once_) {
-        axis_ = best;
-        radix_order();
-      } else if (!insertion_order()) {
-        radix_order();
-      }
-      sorted_once_ = true;
-      for (std::uint32_t p = 0; p < order_.size(); ++p)
-        pos_[order_[p]] = p;
-    } else {
-      axis_ = detail::widest_axis(proxies_);
-      order_.clear();
-      for (std::uint32_t s = 0; s < proxies_.slots(); ++s)
-        if (proxies_.alive(s)) order_.push_back(s);
+  // Leaves order_ holding the live slots by increasing min on axis_ (incremental).
+  void sort_incremental() {
+    double var[D];
+    const int best = detail::widest_axis(proxies_, var);
+    const bool switch_axis = best != axis_ && var[best] > 2.0 * var[axis_];
+    if (holes_) {
+      std::erase(order_, kNone);
+      holes_ = 0;
+    }
+    if (switch_axis || !sorted_once_) {
+      axis_ = best;
+      radix_order();
+    } else if (!insertion_order()) {
       radix_order();
     }
+    sorted_once_ = true;
+    for (std::uint32_t p = 0; p < order_.size(); ++p)
+      pos_[order_[p]] = p;
   }
 
   // Radix sorts order_ by the min coordinate on axis_.
@@ -235,49 +254,144 @@ class BasicSweepPrune {
     return true;
   }
 
+  // The stripes of the bucketed sweep: stripe_of(y) for y on stripe_axis_.
+  std::uint32_t stripe_of(double y) const {
+    const double k = std::floor((y - stripe_origin_) * stripe_inv_);
+    return std::uint32_t(std::clamp(k, 0.0, double(stripes_ - 1)));
+  }
+
+  // Chooses the sweep axis and the stripes: about four mean box extents high, so that a box
+  // is in one or two stripes and a run only meets the boxes of its own stripe.
+  void choose_stripes() {
+    double var[D];
+    axis_ = detail::widest_axis(proxies_, var);
+    stripe_axis_ = axis_ == 0 ? 1 : 0;
+    for (int a = 0; a < D; ++a)
+      if (a != axis_ && var[a] > var[stripe_axis_]) stripe_axis_ = a;
+    stripes_ = 1;
+    stripe_origin_ = 0;
+    stripe_inv_ = 0;
+    if (proxies_.size() < striped_from_) return;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo, extent = 0;
+    for (std::uint32_t s = 0; s < proxies_.slots(); ++s) {
+      if (!proxies_.alive(s)) continue;
+      const Box<D>& b = proxies_.box(s);
+      lo = std::min(lo, b.min[stripe_axis_]);
+      hi = std::max(hi, b.min[stripe_axis_]);
+      extent += b.extent(stripe_axis_);
+    }
+    const double span = hi - lo;
+    const double height = std::max(4 * extent / double(proxies_.size()), span / kMaxStripes);
+    if (!(height > 0) || !std::isfinite(span / height)) return;
+    stripes_ = std::uint32_t(std::clamp(std::ceil(span / height), 1.0, double(kMaxStripes)));
+    stripe_origin_ = lo;
+    stripe_inv_ = 1.0 / height;
+  }
+
+  // Key of x rounded down to a float, in the float order (32 bits): a conservative start
+  // for the run, refined by the exact test.
+  static std::uint32_t float_key(double x) {
+    float f = static_cast<float>(x);
+    if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    const auto bits = std::bit_cast<std::uint32_t>(f);
+    return (bits >> 31) ? ~bits : bits | 0x80000000u;
+  }
+  static double from_float_key(std::uint32_t k) {
+    const std::uint32_t bits = (k >> 31) ? k & 0x7fffffffu : ~k;
+    return double(std::bit_cast<float>(bits));
+  }
+
+  // Sorts the (stripe, slot) entries by stripe, then by the min on axis_ (one radix sort on
+  // 64-bit keys: stripe above, the float key below) and gathers them.
+  void sort_striped() {
+    choose_stripes();
+    keyed_.clear();
+    for (std::uint32_t s = 0; s < proxies_.slots(); ++s) {
+      if (!proxies_.alive(s)) continue;
+      const Box<D>& b = proxies_.box(s);
+      const std::uint64_t k = float_key(b.min[axis_]);
+      const std::uint32_t last = stripe_of(b.max[stripe_axis_]);
+      for (std::uint32_t t = stripe_of(b.min[stripe_axis_]); t <= last; ++t)
+        keyed_.push_back({std::uint64_t(t) << 32 | k, s});
+    }
+    detail::radix_sort(keyed_, 0, 32 + std::bit_width(stripes_ - 1),
+                       [](const detail::KeyedIndex& e) { return e.key; });
+    begin_gather(keyed_.size() + stripes_);
+    std::uint32_t stripe = 0;
+    for (const detail::KeyedIndex& e : keyed_) {
+      const std::uint32_t t = std::uint32_t(e.key >> 32);
+      if (t != stripe) {
+        gather_sentinel();
+        stripe = t;
+      }
+      const Box<D>& b = proxies_.box(e.index);
+      gather(e.index, from_float_key(std::uint32_t(e.key)), stripe_of(b.min[stripe_axis_]) == t);
+    }
+    gather_sentinel();
+  }
+
+  void begin_gather(std::size_t capacity) {
+    count_ = 0;
+    start_.resize(capacity + 1);
+    lo_.resize(capacity + 1);
+    hi_.resize(capacity + 1);
+    for (int k = 0; k < D - 1; ++k) {
+      olo_[k].resize(capacity + 1);
+      ohi_[k].resize(capacity + 1);
+    }
+    home_.resize(capacity + 1);
+    ids_.resize(capacity + 1);
+    hits_.resize(capacity + 1);
+  }
+  // Appends slot s; `start` <= its min on axis_ orders the run, `home` marks the stripe
+  // holding the box's min on the stripe axis.
+  void gather(std::uint32_t s, double start, bool home) {
+    const Box<D>& b = proxies_.box(s);
+    start_[count_] = start;
+    lo_[count_] = b.min[axis_];
+    hi_[count_] = b.max[axis_];
+    for (int k = 0, a = 0; a < D; ++a) {
+      if (a == axis_) continue;
+      olo_[k][count_] = b.min[a];
+      ohi_[k][count_] = b.max[a];
+      ++k;
+    }
+    home_[count_] = home;
+    ids_[count_] = proxies_.id(s);
+    ++count_;
+  }
+  // Ends a stripe: a start of +inf stops every run before it.
+  void gather_sentinel() {
+    start_[count_] = std::numeric_limits<double>::infinity();
+    hi_[count_] = -std::numeric_limits<double>::infinity();
+    ++count_;
+  }
+
+  // The runs over the gathered entries. A pair met in several stripes is reported from the
+  // stripe holding the larger of the two mins on the stripe axis, the one where either box is
+  // at home.
   template <class F>
   QueryStats sweep(F& visit) {
-    const std::size_t n = order_.size();
     constexpr int kOther = D - 1;
-    lo_.resize(n + 1);
-    hi_.resize(n + 1);
-    for (int k = 0; k < kOther; ++k) {
-      olo_[k].resize(n + 1);
-      ohi_[k].resize(n + 1);
-    }
-    ids_.resize(n + 1);
-    hits_.resize(n + 1);
-    for (std::size_t p = 0; p < n; ++p) {
-      const Box<D>& b = proxies_.box(order_[p]);
-      lo_[p] = b.min[axis_];
-      hi_[p] = b.max[axis_];
-      for (int k = 0, a = 0; a < D; ++a) {
-        if (a == axis_) continue;
-        olo_[k][p] = b.min[a];
-        ohi_[k][p] = b.max[a];
-        ++k;
-      }
-      ids_[p] = proxies_.id(order_[p]);
-    }
-    lo_[n] = std::numeric_limits<double>::infinity();  // ends every run
-
     QueryStats st;
-    st.nodes_visited = n;
-    const double* lo = lo_.data();
+    const double* start = start_.data();
     std::uint32_t* hits = hits_.data();
-    for (std::size_t i = 0; i < n; ++i) {
-      const double end = hi_[i];
-      double ilo[kOther > 0 ? kOther : 1], ihi[kOther > 0 ? kOther : 1];
-      const double* jlo[kOther > 0 ? kOther : 1];
-      const double* jhi[kOther > 0 ? kOther : 1];
+    for (std::size_t i = 0; i < count_; ++i) {
+      if (start[i] == std::numeric_limits<double>::infinity()) continue;  // a sentinel
+      ++st.nodes_visited;
+      const double end = hi_[i], begin = lo_[i];
+      const std::uint32_t home = home_[i];
+      double ilo[kOther], ihi[kOther];
+      const double* jlo[kOther];
+      const double* jhi[kOther];
       for (int k = 0; k < kOther; ++k) {
         ilo[k] = olo_[k][i], ihi[k] = ohi_[k][i];
         jlo[k] = olo_[k].data(), jhi[k] = ohi_[k].data();
       }
       std::size_t found = 0;
       std::size_t j = i + 1;
-      for (; lo[j] <= end; ++j) {
-        bool meet = true;
+      for (; start[j] <= end; ++j) {
+        bool meet = (lo_[j] <= end) & (begin <= hi_[j]) & ((home | home_[j]) != 0);
         for (int k = 0; k < kOther; ++k)
           meet &= (jlo[k][j] <= ihi[k]) & (ilo[k] <= jhi[k][j]);
         hits[found] = std::uint32_t(j);
@@ -294,18 +408,26 @@ class BasicSweepPrune {
     return st;
   }
 
+  std::size_t striped_from_;
   detail::ProxyTable<D> proxies_;
   detail::PairTracker tracker_;
-  int axis_ = 0;                      // sweep axis of the last tick
-  bool sorted_once_ = false;          // incremental: order_ has been sorted at least once
-  std::vector<std::uint32_t> order_;  // slots by increasing min on axis_ (kNone: a hole)
-  std::vector<std::uint32_t> pos_;    // incremental: position of each slot in order_
-  std::size_t holes_ = 0;             // incremental: kNone entries in order_
-  std::vector<detail::KeyedIndex> keyed_;
-  std::vector<double> key_;
-  // The sweep's structure-of-arrays, in sorted order, one slot longer for the sentinel.
-  std::vector<double> lo_, hi_;
-  std::vector<double> olo_[D > 1 ? D - 1 : 1], ohi_[D > 1 ? D - 1 : 1];
+  int axis_ = 0;                           // sweep axis of the last tick
+  bool sorted_once_ = false;               // incremental: order_ has been sorted at least once
+  std::vector<std::uint32_t> order_;       // slots by increasing min on axis_ (kNone: a hole)
+  std::vector<std::uint32_t> pos_;         // incremental: position of each slot in order_
+  std::size_t holes_ = 0;                  // incremental: kNone entries in order_
+  std::vector<detail::KeyedIndex> keyed_;  // sort records (key, slot)
+  std::vector<double> key_;                // incremental: min on axis_ in order_
+  int stripe_axis_ = 1;                    // the axis cut into stripes
+  std::uint32_t stripes_ = 1;              // stripe count (1: a plain sweep)
+  double stripe_origin_ = 0, stripe_inv_ = 0;
+  // The sweep's structure-of-arrays in sorted order, stripe after stripe, each stripe
+  // followed by a sentinel.
+  std::size_t count_ = 0;        // entries and sentinels gathered
+  std::vector<double> start_;    // run order key: <= min on axis_, +inf at a sentinel
+  std::vector<double> lo_, hi_;  // box on axis_
+  std::vector<double> olo_[D - 1], ohi_[D - 1];  // box on the other axes
+  std::vector<std::uint32_t> home_;              // 1 in the stripe of the box's min on stripe_axis_
   std::vector<Id> ids_;
   std::vector<std::uint32_t> hits_;  // left-packed candidates of one run
 };
