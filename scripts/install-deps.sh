@@ -11,6 +11,7 @@ packages=(
   libsqlite3-dev sqlite3
   libgtest-dev googletest
   libspatialindex-dev libgeos-dev libnanoflann-dev
+  libbullet-dev libbox2d-dev
   nodejs npm clang-format clang libclang-rt-14-dev
 )
 

@@ -1,0 +1,447 @@
+// SweepPrune<D> and IncrementalSweepPrune<D>: sort-and-sweep on one axis ("box pruning").
+//
+// Every tick the proxies are ordered by the min coordinate of their boxes on one axis, the
+// sweep axis. Walking that order, proxy i can only meet the proxies j after it whose min is
+// at most i's max on the axis; those are compared on the other axes and the hits reported.
+// Each pair is found once, from the proxy that comes first (Baraff's sweep and prune, 1992;
+// Terdiman, "Box pruning revisited", 2017, for the single-axis, sort-every-frame form).
+//
+// Axis. The sweep axis is the one along which the box centres vary most: the fewer boxes
+// share a stretch of that axis, the shorter the runs.
+//
+// Stripes (SweepPrune, from 4096 proxies on). A single sweep over a square world of n boxes
+// makes runs of length ~sqrt(n): every box in the whole height of the world whose min falls
+// in a box's extent. So SweepPrune also cuts the second axis (the one of next largest centre
+// variance) into stripes about four mean box extents high, enters each box in every stripe it
+// touches, and sweeps the stripes one after the other (the bucketed variant of Terdiman's
+// "multi box pruning"). A pair sharing several stripes is reported only from the stripe that
+// holds the larger of the two boxes' mins on the stripe axis: the one where either box starts.
+//
+// Sorting. SweepPrune radix sorts (detail::radix_sort, LSD) 64-bit keys each tick: the stripe
+// above, below it the box's min on the sweep axis rounded down to a float and mapped to an
+// unsigned integer with the same order; four passes for up to 4096 stripes. The rounded key
+// only orders the runs (it is <= the true min, so a run never stops early); the tests that
+// report a pair are exact, on the doubles. IncrementalSweepPrune keeps one plain sweep's order
+// (exact 64-bit keys of the doubles, detail::ordered_key) from the last tick and repairs it
+// with insertion sort, which costs O(n + swaps) when boxes move little between ticks
+// (coherence); past a budget of swaps it gives up and radix sorts, so a scene that jumps
+// costs no more than a fresh sort. It changes axis only when another axis's centre variance
+// is well above the current one's (hysteresis: a change costs a full sort). It keeps no
+// stripes, so its runs grow as sqrt(n) in a square world.
+//
+// Sweep. The sorted boxes are gathered into structure-of-arrays, each stripe followed by a
+// +inf sentinel, so a run ends on a comparison instead of a bounds check; the test on the
+// other axes is branch-free and writes each candidate into a buffer whose cursor advances by
+// the test's result (left-packed output), so the only unpredictable branch is the end of the
+// run.
+//
+// Queries: query(box) scans the proxies (O(n)); a structure answering windows in O(log n)
+// is DynamicAabbTree.
+//
+// Complexity per tick: O(n) for the sort (four radix passes; O(n + swaps) when incremental),
+// O(n + runs + k) for the sweep where runs is the number of pairs of a stripe overlapping on
+// the sweep axis. Memory: O(n) (plus one entry per extra stripe a box touches).
+//
+// Thread-safety as broad_phase.hpp says.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "loci/geom/box.hpp"
+#include "loci/index/broadphase/broad_phase.hpp"
+#include "loci/index/broadphase/detail/pair_tracker.hpp"
+#include "loci/index/broadphase/detail/proxy_table.hpp"
+#include "loci/index/detail/radix_sort.hpp"
+
+namespace loci {
+
+namespace detail {
+
+// Unsigned key with the order of the double x (negative numbers flipped whole, positive ones
+// with the sign bit set): -0.0 sorts just before +0.0, which is harmless as they are equal.
+inline std::uint64_t ordered_key(double x) {
+  const auto bits = std::bit_cast<std::uint64_t>(x);
+  return (bits >> 63) ? ~bits : bits | (std::uint64_t(1) << 63);
+}
+
+// Index of the axis along which the centres of the live boxes vary most.
+template <int D>
+int widest_axis(const ProxyTable<D>& proxies, double* variance = nullptr) {
+  double sum[D] = {}, sq[D] = {};
+  std::size_t n = 0;
+  for (std::uint32_t s = 0; s < proxies.slots(); ++s) {
+    if (!proxies.alive(s)) continue;
+    const Box<D>& b = proxies.box(s);
+    for (int a = 0; a < D; ++a) {
+      const double c = 0.5 * (b.min[a] + b.max[a]);
+      sum[a] += c;
+      sq[a] += c * c;
+    }
+    ++n;
+  }
+  int best = 0;
+  double best_var = -1;
+  for (int a = 0; a < D; ++a) {
+    const double mean = n ? sum[a] / double(n) : 0.0;
+    const double var = n ? sq[a] / double(n) - mean * mean : 0.0;
+    if (variance) variance[a] = var;
+    if (var > best_var) best_var = var, best = a;
+  }
+  return best;
+}
+
+}  // namespace detail
+
+template <int D, bool Incremental>
+class BasicSweepPrune {
+  static_assert(D == 2 || D == 3, "sweep and prune is written for 2 and 3 dimensions");
+
+ public:
+  static constexpr int dimension = D;
+
+  // SweepPrune cuts space into stripes once it holds `striped_from` proxies (see above).
+  explicit BasicSweepPrune(std::size_t striped_from = kStripedFrom) : striped_from_(striped_from) {}
+
+  void add(Id id, const Box<D>& b) {
+    const std::uint32_t s = proxies_.add(id, b, kName);
+    if constexpr (Incremental) {
+      if (pos_.size() < proxies_.slots()) pos_.resize(proxies_.slots(), kNone);
+      pos_[s] = std::uint32_t(order_.size());
+      order_.push_back(s);
+    }
+  }
+  void move(Id id, const Box<D>& b) {
+    check_box(b, "proxy box");
+    proxies_.set_box(proxies_.slot_of(id, kName), b);
+  }
+  bool remove(Id id) {
+    const std::uint32_t s = proxies_.find(id);
+    if (s == kNone) return false;
+    if constexpr (Incremental) {
+      order_[pos_[s]] = kNone;
+      pos_[s] = kNone;
+      ++holes_;
+    }
+    proxies_.remove(s);
+    return true;
+  }
+  void clear() {
+    proxies_.clear();
+    order_.clear();
+    pos_.clear();
+    holes_ = 0;
+    tracker_.reset();
+  }
+
+  bool contains(Id id) const { return proxies_.find(id) != kNone; }
+  std::size_t size() const { return proxies_.size(); }
+  bool empty() const { return size() == 0; }
+  // The axis of the last sweep.
+  int axis() const { return axis_; }
+
+  template <PairVisitor F>
+  QueryStats pairs(F&& visit) {
+    if constexpr (Incremental) {
+      sort_incremental();
+      begin_gather(order_.size());
+      for (const std::uint32_t s : order_)
+        gather(s, proxies_.box(s).min[axis_], true);
+      gather_sentinel();
+    } else {
+      sort_striped();
+    }
+    return sweep(visit);
+  }
+  std::vector<IdPair> pairs() {
+    return collect_pairs([&](auto&& v) { return pairs(v); });
+  }
+
+  template <PairVisitor Begin, PairVisitor End>
+  QueryStats update(Begin&& begin, End&& end) {
+    return tracker_.update([&](auto&& v) { return pairs(v); }, begin, end);
+  }
+
+  template <WindowVisitor<D> F>
+  QueryStats query(const Box<D>& w, F&& visit) const {
+    return proxies_.scan(w, visit);
+  }
+  std::vector<Id> query(const Box<D>& w) const {
+    return collect_ids([&](auto&& v) { return query(w, v); });
+  }
+
+  // Throws Error on the first broken invariant: the proxy table, and for the incremental
+  // variant that the kept order holds every live slot once.
+  void validate() const {
+    proxies_.validate(kName);
+    if constexpr (Incremental) {
+      std::size_t live = 0;
+      for (std::size_t p = 0; p < order_.size(); ++p) {
+        const std::uint32_t s = order_[p];
+        if (s == kNone) continue;
+        ++live;
+        if (s >= proxies_.slots() || !proxies_.alive(s) || pos_[s] != p)
+          throw Error(std::string(kName) + ": sort order and positions disagree");
+      }
+      if (live != proxies_.size()) throw Error(std::string(kName) + ": sort order misses proxies");
+    }
+  }
+
+ private:
+  static constexpr const char* kName = Incremental ? "IncrementalSweepPrune" : "SweepPrune";
+  // Below this many proxies one stripe is best; above, at most this many stripes.
+  static constexpr std::size_t kStripedFrom = 4096;
+  static constexpr double kMaxStripes = 4096;
+
+  // Leaves order_ holding the live slots by increasing min on axis_ (incremental).
+  void sort_incremental() {
+    double var[D];
+    const int best = detail::widest_axis(proxies_, var);
+    const bool switch_axis = best != axis_ && var[best] > 2.0 * var[axis_];
+    if (holes_) {
+      std::erase(order_, kNone);
+      holes_ = 0;
+    }
+    if (switch_axis || !sorted_once_) {
+      axis_ = best;
+      radix_order();
+    } else if (!insertion_order()) {
+      radix_order();
+    }
+    sorted_once_ = true;
+    for (std::uint32_t p = 0; p < order_.size(); ++p)
+      pos_[order_[p]] = p;
+  }
+
+  // Radix sorts order_ by the min coordinate on axis_.
+  void radix_order() {
+    keyed_.resize(order_.size());
+    for (std::size_t p = 0; p < order_.size(); ++p)
+      keyed_[p] = {detail::ordered_key(proxies_.box(order_[p]).min[axis_]), order_[p]};
+    detail::radix_sort(keyed_, 64);
+    for (std::size_t p = 0; p < order_.size(); ++p)
+      order_[p] = keyed_[p].index;
+  }
+
+  // Insertion sort of order_ by the current min on axis_; false (order_ still a permutation,
+  // partly sorted) when it gives up after a budget of element moves.
+  bool insertion_order() {
+    const std::size_t n = order_.size();
+    key_.resize(n);
+    for (std::size_t p = 0; p < n; ++p)
+      key_[p] = proxies_.box(order_[p]).min[axis_];
+    std::size_t budget = 8 * n + 64;
+    for (std::size_t i = 1; i < n; ++i) {
+      const double k = key_[i];
+      if (!(k < key_[i - 1])) continue;
+      const std::uint32_t s = order_[i];
+      std::size_t j = i;
+      while (j > 0 && k < key_[j - 1]) {
+        key_[j] = key_[j - 1];
+        order_[j] = order_[j - 1];
+        --j;
+      }
+      key_[j] = k;
+      order_[j] = s;
+      const std::size_t moved = i - j;
+      if (moved > budget) return false;
+      budget -= moved;
+    }
+    return true;
+  }
+
+  // The stripes of the bucketed sweep: stripe_of(y) for y on stripe_axis_.
+  std::uint32_t stripe_of(double y) const {
+    const double k = std::floor((y - stripe_origin_) * stripe_inv_);
+    return std::uint32_t(std::clamp(k, 0.0, double(stripes_ - 1)));
+  }
+
+  // Chooses the sweep axis and the stripes: about four mean box extents high, so that a box
+  // is in one or two stripes and a run only meets the boxes of its own stripe.
+  void choose_stripes() {
+    double var[D];
+    axis_ = detail::widest_axis(proxies_, var);
+    stripe_axis_ = axis_ == 0 ? 1 : 0;
+    for (int a = 0; a < D; ++a)
+      if (a != axis_ && var[a] > var[stripe_axis_]) stripe_axis_ = a;
+    stripes_ = 1;
+    stripe_origin_ = 0;
+    stripe_inv_ = 0;
+    if (proxies_.size() < striped_from_) return;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo, extent = 0;
+    for (std::uint32_t s = 0; s < proxies_.slots(); ++s) {
+      if (!proxies_.alive(s)) continue;
+      const Box<D>& b = proxies_.box(s);
+      lo = std::min(lo, b.min[stripe_axis_]);
+      hi = std::max(hi, b.min[stripe_axis_]);
+      extent += b.extent(stripe_axis_);
+    }
+    const double span = hi - lo;
+    const double height = std::max(4 * extent / double(proxies_.size()), span / kMaxStripes);
+    if (!(height > 0) || !std::isfinite(span / height)) return;
+    stripes_ = std::uint32_t(std::clamp(std::ceil(span / height), 1.0, double(kMaxStripes)));
+    stripe_origin_ = lo;
+    stripe_inv_ = 1.0 / height;
+  }
+
+  // Key of x rounded down to a float, in the float order (32 bits): a conservative start
+  // for the run, refined by the exact test.
+  static std::uint32_t float_key(double x) {
+    float f = static_cast<float>(x);
+    if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    const auto bits = std::bit_cast<std::uint32_t>(f);
+    return (bits >> 31) ? ~bits : bits | 0x80000000u;
+  }
+  static double from_float_key(std::uint32_t k) {
+    const std::uint32_t bits = (k >> 31) ? k & 0x7fffffffu : ~k;
+    return double(std::bit_cast<float>(bits));
+  }
+
+  // Sorts the (stripe, slot) entries by stripe, then by the min on axis_ (one radix sort on
+  // 64-bit keys: stripe above, the float key below) and gathers them.
+  void sort_striped() {
+    choose_stripes();
+    keyed_.clear();
+    for (std::uint32_t s = 0; s < proxies_.slots(); ++s) {
+      if (!proxies_.alive(s)) continue;
+      const Box<D>& b = proxies_.box(s);
+      const std::uint64_t k = float_key(b.min[axis_]);
+      const std::uint32_t last = stripe_of(b.max[stripe_axis_]);
+      for (std::uint32_t t = stripe_of(b.min[stripe_axis_]); t <= last; ++t)
+        keyed_.push_back({std::uint64_t(t) << 32 | k, s});
+    }
+    detail::radix_sort(keyed_, 0, 32 + std::bit_width(stripes_ - 1),
+                       [](const detail::KeyedIndex& e) { return e.key; });
+    begin_gather(keyed_.size() + stripes_);
+    std::uint32_t stripe = 0;
+    for (const detail::KeyedIndex& e : keyed_) {
+      const std::uint32_t t = std::uint32_t(e.key >> 32);
+      if (t != stripe) {
+        gather_sentinel();
+        stripe = t;
+      }
+      const Box<D>& b = proxies_.box(e.index);
+      gather(e.index, from_float_key(std::uint32_t(e.key)), stripe_of(b.min[stripe_axis_]) == t);
+    }
+    gather_sentinel();
+  }
+
+  void begin_gather(std::size_t capacity) {
+    count_ = 0;
+    start_.resize(capacity + 1);
+    lo_.resize(capacity + 1);
+    hi_.resize(capacity + 1);
+    for (int k = 0; k < D - 1; ++k) {
+      olo_[k].resize(capacity + 1);
+      ohi_[k].resize(capacity + 1);
+    }
+    home_.resize(capacity + 1);
+    ids_.resize(capacity + 1);
+    hits_.resize(capacity + 1);
+  }
+  // Appends slot s; `start` <= its min on axis_ orders the run, `home` marks the stripe
+  // holding the box's min on the stripe axis.
+  void gather(std::uint32_t s, double start, bool home) {
+    const Box<D>& b = proxies_.box(s);
+    start_[count_] = start;
+    lo_[count_] = b.min[axis_];
+    hi_[count_] = b.max[axis_];
+    for (int k = 0, a = 0; a < D; ++a) {
+      if (a == axis_) continue;
+      olo_[k][count_] = b.min[a];
+      ohi_[k][count_] = b.max[a];
+      ++k;
+    }
+    home_[count_] = home;
+    ids_[count_] = proxies_.id(s);
+    ++count_;
+  }
+  // Ends a stripe: a start of +inf stops every run before it.
+  void gather_sentinel() {
+    start_[count_] = std::numeric_limits<double>::infinity();
+    hi_[count_] = -std::numeric_limits<double>::infinity();
+    ++count_;
+  }
+
+  // The runs over the gathered entries. A pair met in several stripes is reported from the
+  // stripe holding the larger of the two mins on the stripe axis, the one where either box is
+  // at home.
+  template <class F>
+  QueryStats sweep(F& visit) {
+    constexpr int kOther = D - 1;
+    QueryStats st;
+    const double* start = start_.data();
+    std::uint32_t* hits = hits_.data();
+    for (std::size_t i = 0; i < count_; ++i) {
+      if (start[i] == std::numeric_limits<double>::infinity()) continue;  // a sentinel
+      ++st.nodes_visited;
+      const double end = hi_[i], begin = lo_[i];
+      const std::uint32_t home = home_[i];
+      double ilo[kOther], ihi[kOther];
+      const double* jlo[kOther];
+      const double* jhi[kOther];
+      for (int k = 0; k < kOther; ++k) {
+        ilo[k] = olo_[k][i], ihi[k] = ohi_[k][i];
+        jlo[k] = olo_[k].data(), jhi[k] = ohi_[k].data();
+      }
+      std::size_t found = 0;
+      std::size_t j = i + 1;
+      for (; start[j] <= end; ++j) {
+        bool meet = (lo_[j] <= end) & (begin <= hi_[j]) & ((home | home_[j]) != 0);
+        for (int k = 0; k < kOther; ++k)
+          meet &= (jlo[k][j] <= ihi[k]) & (ilo[k] <= jhi[k][j]);
+        hits[found] = std::uint32_t(j);
+        found += meet;
+      }
+      st.entries_tested += j - i - 1;
+      const Id a = ids_[i];
+      for (std::size_t h = 0; h < found; ++h) {
+        const Id b = ids_[hits[h]];
+        ++st.results;
+        if (!(a < b ? visit(a, b) : visit(b, a))) return st;
+      }
+    }
+    return st;
+  }
+
+  std::size_t striped_from_;
+  detail::ProxyTable<D> proxies_;
+  detail::PairTracker tracker_;
+  int axis_ = 0;                           // sweep axis of the last tick
+  bool sorted_once_ = false;               // incremental: order_ has been sorted at least once
+  std::vector<std::uint32_t> order_;       // slots by increasing min on axis_ (kNone: a hole)
+  std::vector<std::uint32_t> pos_;         // incremental: position of each slot in order_
+  std::size_t holes_ = 0;                  // incremental: kNone entries in order_
+  std::vector<detail::KeyedIndex> keyed_;  // sort records (key, slot)
+  std::vector<double> key_;                // incremental: min on axis_ in order_
+  int stripe_axis_ = 1;                    // the axis cut into stripes
+  std::uint32_t stripes_ = 1;              // stripe count (1: a plain sweep)
+  double stripe_origin_ = 0, stripe_inv_ = 0;
+  // The sweep's structure-of-arrays in sorted order, stripe after stripe, each stripe
+  // followed by a sentinel.
+  std::size_t count_ = 0;        // entries and sentinels gathered
+  std::vector<double> start_;    // run order key: <= min on axis_, +inf at a sentinel
+  std::vector<double> lo_, hi_;  // box on axis_
+  std::vector<double> olo_[D - 1], ohi_[D - 1];  // box on the other axes
+  std::vector<std::uint32_t> home_;              // 1 in the stripe of the box's min on stripe_axis_
+  std::vector<Id> ids_;
+  std::vector<std::uint32_t> hits_;  // left-packed candidates of one run
+};
+
+// Sorts from scratch every tick (radix sort): the choice when boxes move far between ticks.
+template <int D>
+using SweepPrune = BasicSweepPrune<D, false>;
+// Keeps the order between ticks (insertion sort): the choice when boxes move little.
+template <int D>
+using IncrementalSweepPrune = BasicSweepPrune<D, true>;
+
+static_assert(BroadPhase<SweepPrune<2>>);
+static_assert(BroadPhase<SweepPrune<3>>);
+static_assert(BroadPhase<IncrementalSweepPrune<2>>);
+static_assert(BroadPhase<IncrementalSweepPrune<3>>);
+
+}  // namespace loci

@@ -1,0 +1,335 @@
+// Every broad phase against brute force, tick by tick, over random motion with fixed seeds:
+// all pairs, begin/end pairs against the difference of consecutive brute-force answers,
+// window queries, and validate() after every tick.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "loci/index/broadphase/dynamic_aabb_tree.hpp"
+#include "loci/index/broadphase/sweep_prune.hpp"
+#include "loci/index/broadphase/uniform_grid.hpp"
+
+namespace loci {
+namespace {
+
+// Variants with non-default settings, so that the grid's large-box path and a tree without
+// margins get the same workout.
+template <int D>
+struct FineGrid : UniformGrid<D> {
+  FineGrid() : UniformGrid<D>(0.05) {}
+};
+template <int D>
+struct StripedSweep : SweepPrune<D> {
+  StripedSweep() : SweepPrune<D>(16) {}
+};
+template <int D>
+struct TightTree : DynamicAabbTree<D> {
+  TightTree() : DynamicAabbTree<D>(AabbTreeOptions{0, 0, 0}) {}
+};
+
+enum class Scene { mixed, identical, sizes, line, points, sparse_ids };
+
+std::string name(Scene s) {
+  switch (s) {
+    case Scene::mixed:
+      return "mixed";
+    case Scene::identical:
+      return "identical";
+    case Scene::sizes:
+      return "sizes";
+    case Scene::line:
+      return "line";
+    case Scene::points:
+      return "points";
+    default:
+      return "sparse_ids";
+  }
+}
+
+// Objects moving at constant velocity through a world of side 60 they are free to leave,
+// some teleporting, some added and removed every tick.
+template <int D>
+class World {
+ public:
+  World(Scene scene, std::uint64_t seed) : scene_(scene), rng_(seed) {}
+
+  struct Obj {
+    Id id;
+    Box<D> box;
+    Point<D> v;
+  };
+
+  Obj make() {
+    Obj o;
+    o.id = scene_ == Scene::sparse_ids ? Id(rng_()) : next_id_++;
+    Point<D> c, h;
+    for (int a = 0; a < D; ++a) {
+      c[a] = uniform(0, 60);
+      o.v[a] = uniform(-1.5, 1.5);
+      h[a] = uniform(0.2, 2.5);
+    }
+    switch (scene_) {
+      case Scene::identical:
+        for (int a = 0; a < D; ++a)
+          c[a] = 10 + 5 * double(rng_() % 3), h[a] = 1, o.v[a] = 0.3;
+        break;
+      case Scene::sizes:
+        for (int a = 0; a < D; ++a)
+          h[a] = rng_() % 20 == 0 ? uniform(10, 40) : uniform(0.001, 0.3);
+        break;
+      case Scene::line:
+        for (int a = 1; a < D; ++a)
+          c[a] = 0, h[a] = 0, o.v[a] = 0;
+        break;
+      case Scene::points:
+        for (int a = 0; a < D; ++a)
+          h[a] = 0, c[a] = std::round(c[a] / 12) * 12, o.v[a] = std::round(o.v[a]);
+        break;
+      default:
+        break;
+    }
+    for (int a = 0; a < D; ++a) {
+      o.box.min[a] = c[a] - h[a];
+      o.box.max[a] = c[a] + h[a];
+    }
+    return o;
+  }
+
+  // One tick of motion on every object, teleports included.
+  void step() {
+    for (Obj& o : objs) {
+      Point<D> d = o.v;
+      if (rng_() % 100 == 0)
+        for (int a = 0; a < D; ++a)
+          d[a] = uniform(-50, 50);
+      if (scene_ == Scene::line)
+        for (int a = 1; a < D; ++a)
+          d[a] = 0;
+      for (int a = 0; a < D; ++a) {
+        o.box.min[a] += d[a];
+        o.box.max[a] += d[a];
+      }
+    }
+  }
+
+  std::vector<IdPair> brute_pairs() const {
+    std::vector<IdPair> out;
+    for (std::size_t i = 0; i < objs.size(); ++i)
+      for (std::size_t j = i + 1; j < objs.size(); ++j)
+        if (intersects(objs[i].box, objs[j].box))
+          out.push_back({std::min(objs[i].id, objs[j].id), std::max(objs[i].id, objs[j].id)});
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  std::vector<Id> brute_query(const Box<D>& w) const {
+    std::vector<Id> out;
+    for (const Obj& o : objs)
+      if (intersects(o.box, w)) out.push_back(o.id);
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  double uniform(double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng_);
+  }
+  std::uint64_t next() { return rng_(); }
+
+  std::vector<Obj> objs;
+
+ private:
+  Scene scene_;
+  std::mt19937_64 rng_;
+  Id next_id_ = 0;
+};
+
+std::vector<IdPair> sorted(std::vector<IdPair> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+// The pairs of `now` not in `before` (both sorted).
+std::vector<IdPair> minus(const std::vector<IdPair>& now, const std::vector<IdPair>& before) {
+  std::vector<IdPair> out;
+  std::set_difference(now.begin(), now.end(), before.begin(), before.end(),
+                      std::back_inserter(out));
+  return out;
+}
+
+template <class BP>
+void run(Scene scene, std::uint64_t seed, int n = 200, int ticks = 40) {
+  constexpr int D = BP::dimension;
+  SCOPED_TRACE(name(scene) + " seed " + std::to_string(seed));
+  World<D> world(scene, seed);
+  BP bp;
+  auto add_one = [&] {
+    auto o = world.make();
+    for (const auto& p : world.objs)
+      if (p.id == o.id) return;
+    bp.add(o.id, o.box);
+    world.objs.push_back(o);
+  };
+  for (int i = 0; i < n; ++i)
+    add_one();
+  std::vector<IdPair> before;
+  std::size_t total = 0;
+  for (int tick = 0; tick < ticks; ++tick) {
+    SCOPED_TRACE("tick " + std::to_string(tick));
+    world.step();
+    for (const auto& o : world.objs)
+      bp.move(o.id, o.box);
+    // Removals and additions mid-run, some reusing the slots just freed.
+    for (int k = 0; k < 4 && !world.objs.empty(); ++k) {
+      const std::size_t i = world.next() % world.objs.size();
+      ASSERT_TRUE(bp.remove(world.objs[i].id));
+      world.objs.erase(world.objs.begin() + std::ptrdiff_t(i));
+    }
+    for (int k = 0; k < 4; ++k)
+      add_one();
+    ASSERT_EQ(bp.size(), world.objs.size());
+
+    const auto expect = world.brute_pairs();
+    ASSERT_EQ(sorted(bp.pairs()), expect);
+    ASSERT_NO_THROW(bp.validate());
+
+    std::vector<IdPair> began, ended;
+    bp.update(
+        [&](Id a, Id b) {
+          return began.push_back({a, b}), true;
+        },
+        [&](Id a, Id b) {
+          return ended.push_back({a, b}), true;
+        });
+    ASSERT_EQ(sorted(began), minus(expect, before));
+    ASSERT_EQ(sorted(ended), minus(before, expect));
+    before = expect;
+    total += expect.size();
+
+    Box<D> w;
+    for (int a = 0; a < D; ++a) {
+      const double c = world.uniform(-10, 70), h = world.uniform(0, 15);
+      w.min[a] = c - h, w.max[a] = c + h;
+    }
+    auto got = bp.query(w);
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, world.brute_query(w));
+    ASSERT_NO_THROW(bp.validate());
+  }
+  EXPECT_GT(total, std::size_t(ticks)) << "the scene should keep objects in contact";
+}
+
+template <class BP>
+class BroadPhaseTest : public ::testing::Test {};
+
+using Structures = ::testing::Types<SweepPrune<2>, SweepPrune<3>, StripedSweep<2>, StripedSweep<3>,
+                                    IncrementalSweepPrune<2>, IncrementalSweepPrune<3>,
+                                    UniformGrid<2>, UniformGrid<3>, FineGrid<2>, DynamicAabbTree<2>,
+                                    DynamicAabbTree<3>, TightTree<2>>;
+TYPED_TEST_SUITE(BroadPhaseTest, Structures);
+
+TYPED_TEST(BroadPhaseTest, RandomMotion) {
+  for (std::uint64_t seed : {1, 2, 3})
+    run<TypeParam>(Scene::mixed, seed);
+}
+
+TYPED_TEST(BroadPhaseTest, IdenticalBoxes) {
+  run<TypeParam>(Scene::identical, 4, 60, 20);
+}
+
+TYPED_TEST(BroadPhaseTest, VeryDifferentSizes) {
+  run<TypeParam>(Scene::sizes, 5);
+}
+
+TYPED_TEST(BroadPhaseTest, AllOnOneLine) {
+  run<TypeParam>(Scene::line, 6);
+}
+
+TYPED_TEST(BroadPhaseTest, PointBoxes) {
+  run<TypeParam>(Scene::points, 7);
+}
+
+TYPED_TEST(BroadPhaseTest, SparseIds) {
+  run<TypeParam>(Scene::sparse_ids, 8);
+}
+
+TYPED_TEST(BroadPhaseTest, EmptyAndSingle) {
+  TypeParam bp;
+  EXPECT_TRUE(bp.empty());
+  EXPECT_TRUE(bp.pairs().empty());
+  bp.validate();
+  Box<TypeParam::dimension> b;
+  for (int a = 0; a < TypeParam::dimension; ++a)
+    b.min[a] = 0, b.max[a] = 1;
+  bp.add(7, b);
+  EXPECT_TRUE(bp.pairs().empty());
+  EXPECT_EQ(bp.query(b), std::vector<Id>{7});
+  bp.add(3, b);
+  EXPECT_EQ(bp.pairs(), (std::vector<IdPair>{{3, 7}}));
+  bp.validate();
+  EXPECT_TRUE(bp.remove(7));
+  EXPECT_TRUE(bp.pairs().empty());
+  EXPECT_TRUE(bp.remove(3));
+  EXPECT_TRUE(bp.empty());
+  bp.validate();
+}
+
+TYPED_TEST(BroadPhaseTest, TouchingCounts) {
+  constexpr int D = TypeParam::dimension;
+  TypeParam bp;
+  Box<D> a, b, c;
+  for (int k = 0; k < D; ++k) {
+    a.min[k] = 0, a.max[k] = 1;
+    b.min[k] = 1, b.max[k] = 2;  // touches a at a corner
+    c.min[k] = 1.5, c.max[k] = 2;
+  }
+  c.min[0] = 2.5, c.max[0] = 3;
+  bp.add(0, a);
+  bp.add(1, b);
+  bp.add(2, c);
+  EXPECT_EQ(bp.pairs(), (std::vector<IdPair>{{0, 1}}));
+  c.min[0] = 2;  // now touches b on a face
+  bp.move(2, c);
+  EXPECT_EQ(sorted(bp.pairs()), (std::vector<IdPair>{{0, 1}, {1, 2}}));
+}
+
+TYPED_TEST(BroadPhaseTest, Errors) {
+  constexpr int D = TypeParam::dimension;
+  TypeParam bp;
+  Box<D> b;
+  for (int k = 0; k < D; ++k)
+    b.min[k] = 0, b.max[k] = 1;
+  bp.add(1, b);
+  EXPECT_THROW(bp.add(1, b), InvalidArgument);
+  EXPECT_THROW(bp.move(2, b), InvalidArgument);
+  EXPECT_FALSE(bp.remove(2));
+  Box<D> bad = b;
+  bad.min[0] = 2;
+  EXPECT_THROW(bp.add(3, bad), InvalidGeometry);
+  EXPECT_THROW(bp.move(1, bad), InvalidGeometry);
+  bad.min[0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(bp.add(3, bad), InvalidGeometry);
+  bp.validate();
+}
+
+TYPED_TEST(BroadPhaseTest, EarlyStop) {
+  constexpr int D = TypeParam::dimension;
+  TypeParam bp;
+  Box<D> b;
+  for (int k = 0; k < D; ++k)
+    b.min[k] = 0, b.max[k] = 1;
+  for (Id i = 0; i < 10; ++i)
+    bp.add(i, b);
+  int seen = 0;
+  const QueryStats st = bp.pairs([&](Id, Id) { return ++seen < 5; });
+  EXPECT_EQ(seen, 5);
+  EXPECT_EQ(st.results, 5u);
+  EXPECT_EQ(bp.pairs().size(), 45u);
+  bp.validate();
+}
+
+}  // namespace
+}  // namespace loci

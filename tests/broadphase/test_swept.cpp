@@ -1,0 +1,166 @@
+// Contact intervals of moving boxes and spheres: exact hand cases, and random cases against a
+// fine-step simulation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "loci/geom/swept.hpp"
+
+namespace loci {
+namespace {
+
+Box2 box(double x0, double y0, double x1, double y1) {
+  return {{x0, y0}, {x1, y1}};
+}
+
+TEST(BoxContact, HeadOn) {
+  // a reaches b at t = 2 (a.max = 3) and leaves it at t = 4 (a.min = 4): touching counts.
+  const auto c =
+      box_contact(box(0, 0, 1, 1), Point2{1, 0}, box(3, 0, 4, 1), Point2{0, 0}, 0.0, 10.0);
+  EXPECT_EQ(c, (ContactInterval{2, 4}));
+  // Both moving: relative speed 2.
+  EXPECT_EQ(box_contact(box(0, 0, 1, 1), Point2{1, 0}, box(3, 0, 4, 1), Point2{-1, 0}, 0.0, 10.0),
+            (ContactInterval{1, 2}));
+}
+
+TEST(BoxContact, TouchingOnlyCounts) {
+  // The y extents only touch (a.max y = b.min y) for the whole run.
+  const auto c =
+      box_contact(box(0, 0, 1, 1), Point2{1, 0}, box(2, 1, 3, 2), Point2{0, 0}, 0.0, 10.0);
+  EXPECT_EQ(c, (ContactInterval{1, 3}));
+  // Corner to corner at one instant.
+  const auto d =
+      box_contact(box(0, 0, 1, 1), Point2{1, 1}, box(2, 2, 3, 3), Point2{0, 0}, 0.0, 10.0);
+  EXPECT_EQ(d, (ContactInterval{1, 3}));
+  const auto e =
+      box_contact(box(0, 0, 1, 1), Point2{1, 0}, box(3, 0, 4, 1), Point2{0, 0}, 0.0, 2.0);
+  EXPECT_EQ(e, (ContactInterval{2, 2}));
+}
+
+TEST(BoxContact, ParallelMotion) {
+  // Same velocity: apart forever, or together forever.
+  EXPECT_TRUE(
+      box_contact(box(0, 0, 1, 1), Point2{1, 1}, box(0, 3, 1, 4), Point2{1, 1}, 0.0, 10.0).empty());
+  EXPECT_EQ(
+      box_contact(box(0, 0, 1, 1), Point2{1, 1}, box(0.5, 0.5, 2, 2), Point2{1, 1}, 0.0, 10.0),
+      (ContactInterval{0, 10}));
+  // Moving along x, apart on y: never.
+  EXPECT_TRUE(box_contact(box(0, 0, 1, 1), Point2{1, 0}, box(3, 1.5, 4, 2), Point2{0, 0}, 0.0, 10.0)
+                  .empty());
+}
+
+TEST(BoxContact, AlreadyOverlappingAndWindow) {
+  EXPECT_EQ(box_contact(box(0, 0, 2, 2), Point2{1, 0}, box(1, 0, 3, 2), Point2{0, 0}, 0.0, 10.0),
+            (ContactInterval{0, 3}));
+  // Contact [2, 4] clipped to [3, 10], and missed by [5, 10] and [0, 1].
+  const Box2 a = box(0, 0, 1, 1), b = box(3, 0, 4, 1);
+  EXPECT_EQ(box_contact(a, Point2{1, 0}, b, Point2{0, 0}, 3.0, 10.0), (ContactInterval{3, 4}));
+  EXPECT_TRUE(box_contact(a, Point2{1, 0}, b, Point2{0, 0}, 5.0, 10.0).empty());
+  EXPECT_TRUE(box_contact(a, Point2{1, 0}, b, Point2{0, 0}, 0.0, 1.0).empty());
+}
+
+TEST(SphereContact, HandCases) {
+  // |(-5 + t, 0)| <= 2 for t in [3, 7].
+  const auto c =
+      sphere_contact(Point2{0, 0}, 1.0, Point2{1, 0}, Point2{5, 0}, 1.0, Point2{0, 0}, 0.0, 10.0);
+  EXPECT_DOUBLE_EQ(c.enter, 3);
+  EXPECT_DOUBLE_EQ(c.exit, 7);
+  // Grazing: the distance is 2 at t = 5 only.
+  const auto g =
+      sphere_contact(Point2{0, 0}, 1.0, Point2{1, 0}, Point2{5, 2}, 1.0, Point2{0, 0}, 0.0, 10.0);
+  ASSERT_FALSE(g.empty());
+  EXPECT_DOUBLE_EQ(g.enter, 5);
+  EXPECT_DOUBLE_EQ(g.exit, 5);
+  // Misses by a little; parallel; already overlapping; 3D.
+  EXPECT_TRUE(
+      sphere_contact(Point2{0, 0}, 1.0, Point2{1, 0}, Point2{5, 2.01}, 1.0, Point2{0, 0}, 0.0, 10.0)
+          .empty());
+  EXPECT_TRUE(
+      sphere_contact(Point2{0, 0}, 1.0, Point2{1, 0}, Point2{0, 3}, 1.0, Point2{1, 0}, 0.0, 10.0)
+          .empty());
+  EXPECT_EQ(
+      sphere_contact(Point2{0, 0}, 1.0, Point2{1, 0}, Point2{0, 1}, 1.0, Point2{1, 0}, 0.0, 10.0),
+      (ContactInterval{0, 10}));
+  const auto o =
+      sphere_contact(Point2{0, 0}, 1.0, Point2{1, 0}, Point2{1, 0}, 1.0, Point2{0, 0}, 0.0, 10.0);
+  EXPECT_EQ(o.enter, 0);
+  EXPECT_DOUBLE_EQ(o.exit, 3);
+  const auto s = sphere_contact(Point3{0, 0, 0}, 0.5, Point3{0, 0, 2}, Point3{0, 0, 10}, 0.5,
+                                Point3{0, 0, 0}, 0.0, 10.0);
+  EXPECT_DOUBLE_EQ(s.enter, 4.5);
+  EXPECT_DOUBLE_EQ(s.exit, 5.5);
+  // Fast and thin: a tick-by-tick overlap test at t = 0, 1, 2 would miss this (tunnelling).
+  const auto t =
+      sphere_contact(Point2{0, 0}, 0.1, Point2{10, 0}, Point2{5, 0}, 0.1, Point2{0, 0}, 0.0, 2.0);
+  EXPECT_NEAR(t.enter, 0.48, 1e-12);
+  EXPECT_NEAR(t.exit, 0.52, 1e-12);
+}
+
+TEST(SweptBox, ContainsTheMotion) {
+  const Box2 b = box(0, 0, 1, 2);
+  const Point2 v{2, -1};
+  const Box2 s = swept_box(b, v, 1.0, 3.0);
+  EXPECT_EQ(s, box(2, -3, 7, 1));
+  for (double t = 1; t <= 3; t += 0.125)
+    EXPECT_TRUE(contains(s, moved_box(b, v, t)));
+}
+
+// Against a fine-step simulation: every sampled time in contact lies in the interval, every
+// sampled time well inside the interval is in contact.
+TEST(Contact, FineStepSimulation) {
+  std::mt19937_64 rng(99);
+  auto u = [&](double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng);
+  };
+  const double t0 = 0, t1 = 10, dt = 1e-3, eps = 1e-9;
+  int boxes_hit = 0, spheres_hit = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    Box2 a, b;
+    Point2 va, vb, ca, cb;
+    for (int k = 0; k < 2; ++k) {
+      const double c1 = u(-10, 10), c2 = u(-10, 10), h1 = u(0.1, 2), h2 = u(0.1, 2);
+      a.min[k] = c1 - h1, a.max[k] = c1 + h1;
+      b.min[k] = c2 - h2, b.max[k] = c2 + h2;
+      va[k] = u(-2, 2), vb[k] = u(-2, 2);
+      ca[k] = c1, cb[k] = c2;
+    }
+    const double ra = u(0.1, 2), rb = u(0.1, 2);
+    const auto bc = box_contact(a, va, b, vb, t0, t1);
+    const auto sc = sphere_contact(ca, ra, va, cb, rb, vb, t0, t1);
+    double first_box = -1, first_sphere = -1;
+    for (double t = t0; t <= t1; t += dt) {
+      const bool box_meet = intersects(moved_box(a, va, t), moved_box(b, vb, t));
+      if (box_meet && first_box < 0) first_box = t;
+      if (box_meet)
+        EXPECT_TRUE(!bc.empty() && bc.enter - eps <= t && t <= bc.exit + eps)
+            << trial << " t " << t;
+      if (!bc.empty() && bc.enter + eps < t && t < bc.exit - eps) EXPECT_TRUE(box_meet) << trial;
+      double d2 = 0;
+      for (int k = 0; k < 2; ++k) {
+        const double d = (ca[k] + va[k] * t) - (cb[k] + vb[k] * t);
+        d2 += d * d;
+      }
+      const bool sphere_meet = std::sqrt(d2) <= ra + rb;
+      if (sphere_meet && first_sphere < 0) first_sphere = t;
+      if (sphere_meet)
+        EXPECT_TRUE(!sc.empty() && sc.enter - eps <= t && t <= sc.exit + eps) << trial;
+      if (!sc.empty() && sc.enter + 1e-7 < t && t < sc.exit - 1e-7)
+        EXPECT_TRUE(sphere_meet) << trial;
+    }
+    if (first_box >= 0) {
+      ++boxes_hit;
+      EXPECT_NEAR(bc.enter, first_box, dt) << trial;
+    }
+    if (first_sphere >= 0) {
+      ++spheres_hit;
+      EXPECT_NEAR(sc.enter, first_sphere, dt) << trial;
+    }
+  }
+  // The random cases do exercise contact.
+  EXPECT_GT(boxes_hit, 20);
+  EXPECT_GT(spheres_hit, 20);
+}
+
+}  // namespace
+}  // namespace loci
