@@ -62,13 +62,6 @@ namespace loci {
 
 namespace detail {
 
-// Unsigned key with the order of the double x (negative numbers flipped whole, positive ones
-// with the sign bit set): -0.0 sorts just before +0.0, which is harmless as they are equal.
-inline std::uint64_t ordered_key(double x) {
-  const auto bits = std::bit_cast<std::uint64_t>(x);
-  return (bits >> 63) ? ~bits : bits | (std::uint64_t(1) << 63);
-}
-
 // Index of the axis along which the centres of the live boxes vary most.
 template <int D>
 int widest_axis(const ProxyTable<D>& proxies, double* variance = nullptr) {
