@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -16,8 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "bench.hpp"
 #include "loci/geom/error.hpp"
-#include "loci/io/bench.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/intersections.hpp"
 #include "loci/io/layer_cells.hpp"
@@ -55,6 +56,11 @@ struct Command {
 
 const std::vector<Command>& commands();
 
+constexpr std::size_t kMaxK = 1000000;
+// A drawing of 2^L x 2^L cells: past 12 levels (16 million cells) the SVG stops being something
+// a viewer opens.
+constexpr std::size_t kMaxCellLevels = 12;
+
 class UsageError : public loci::Error {
  public:
   using Error::Error;
@@ -79,14 +85,30 @@ const std::string& layer_arg(const Args& a, const char* command) {
   return a.positional[0];
 }
 
-std::size_t parse_k(const std::string& text) {
-  char* end = nullptr;
-  errno = 0;
-  const long long k = std::strtoll(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || errno != 0)
-    throw UsageError("bad -k '" + text + "': expected a whole number");
-  if (k <= 0) throw UsageError("-k must be >= 1 (got " + text + ")");
-  return std::size_t(k);
+// A whole number in [lo, hi] given to `flag`; the error names the flag and the range.
+std::size_t parse_count(const char* flag, const std::string& text, std::size_t lo, std::size_t hi) {
+  long long v = 0;  // signed, so that "-3" is out of range rather than not a number
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+  const std::string shown = "'" + text.substr(0, 40) + "'";
+  if (text.empty() || r.ptr != text.data() + text.size() ||
+      (r.ec != std::errc() && r.ec != std::errc::result_out_of_range))
+    throw UsageError(std::string("bad ") + flag + " " + shown + ": expected a whole number from " +
+                     std::to_string(lo) + " to " + std::to_string(hi));
+  if (r.ec != std::errc() || v < 0 || std::size_t(v) < lo || std::size_t(v) > hi)
+    throw UsageError(std::string(flag) + " must be >= " + std::to_string(lo) +
+                     " and <= " + std::to_string(hi) + " (got " + shown + ")");
+  return v;
+}
+
+// A flag's value run through the io parser that owns its vocabulary, the message prefixed
+// with the flag's name.
+template <class Parse>
+auto parse_flag(const char* flag, const std::string& text, Parse parse) {
+  try {
+    return parse(text);
+  } catch (const loci::Error& e) {
+    throw UsageError(std::string(flag) + ": " + e.what());
+  }
 }
 
 LoadOptions load_options(const Args& a, const std::string& layer) {
@@ -94,13 +116,9 @@ LoadOptions load_options(const Args& a, const std::string& layer) {
   o.layer_path = layer;
   o.layer_name = a.get("--layer");
   o.index_path = a.get("--index");
-  if (a.has("--structure")) o.structure = parse_structure(a.get("--structure"));
-  if (a.has("--per")) {
-    const std::string per = a.get("--per");
-    if (per != "feature" && per != "segment")
-      throw UsageError("bad --per '" + per + "' (choose feature or segment)");
-    o.per = per == "segment" ? Per::segment : Per::feature;
-  }
+  if (a.has("--structure"))
+    o.structure = parse_flag("--structure", a.get("--structure"), parse_structure);
+  if (a.has("--per")) o.per = parse_flag("--per", a.get("--per"), parse_per);
   o.progress = progress_bar(a, "indexing");
   return o;
 }
@@ -116,7 +134,8 @@ int run_index(const Args& a) {
   o.layer_path = layer_arg(a, "index");
   o.layer_name = a.get("--layer");
   o.out_path = a.get("--output");
-  if (a.has("--structure")) o.structure = parse_structure(a.get("--structure"));
+  if (a.has("--structure"))
+    o.structure = parse_flag("--structure", a.get("--structure"), parse_structure);
   const LoadOptions lo = load_options(a, o.layer_path);
   o.per = lo.per.value_or(Per::feature);
   o.progress = progress_bar(a, "indexing");
@@ -141,7 +160,7 @@ int run_query(const Args& a) {
     throw UsageError(
         "loci query needs exactly one of --bbox, --bbox-file, --nearest, "
         "--nearest-file, --within, --segment, --point");
-  const std::size_t k = a.has("-k") ? parse_k(a.get("-k")) : 1;
+  const std::size_t k = a.has("-k") ? parse_count("-k", a.get("-k"), 1, kMaxK) : 1;
   Query q;
   q.k = k;
   if (a.has("--bbox")) {
@@ -169,7 +188,7 @@ int run_query(const Args& a) {
     o.queries.emplace_back(1, q);
   }
   o.candidates = a.has("--candidates");
-  o.format = parse_format(a.get("--format", "ids"));
+  o.format = parse_flag("--format", a.get("--format", "ids"), parse_format);
   o.out_path = a.get("--output");
   o.progress = progress_bar(a, "querying");
   query_layer(o, stdout);
@@ -199,7 +218,7 @@ int run_intersections(const Args& a) {
   o.layer_name = a.get("--layer");
   if (a.positional.size() == 2) o.other_path = a.positional[1];
   o.other_name = a.get("--layer2");
-  o.format = parse_format(a.get("--format", "csv"));
+  o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
   o.pairs_only = a.has("--pairs-only");
   o.out_path = a.get("--output");
   const std::size_t n = write_intersections(o, stdout);
@@ -214,17 +233,12 @@ int run_draw(const Args& a) {
   o.layer_name = a.get("--layer");
   if (!a.has("--output")) throw UsageError("loci draw needs -o OUT.svg");
   o.out_path = a.get("--output");
-  if (a.has("--levels")) o.max_levels = int(parse_k(a.get("--levels")));
-  if (a.has("--width")) o.width = int(parse_k(a.get("--width")));
-  if (a.has("--cells")) {
-    const std::string v = a.get("--cells");
-    char* end = nullptr;
-    const long levels = std::strtol(v.c_str(), &end, 10);
-    if (v.empty() || *end || levels < 0 || levels > RegionQuadtree::kMaxLevels)
-      throw UsageError("--cells takes a number of levels from 0 to " +
-                       std::to_string(RegionQuadtree::kMaxLevels) + ", got '" + v + "'");
-    o.cell_levels = int(levels);
-  }
+  if (a.has("--levels")) o.max_levels = int(parse_count("--levels", a.get("--levels"), 1, 64));
+  if (a.has("--width")) o.width = int(parse_count("--width", a.get("--width"), 16, 100000));
+  if (a.has("--cells"))
+    o.cell_levels = int(parse_flag("--cells", a.get("--cells"), [](const std::string& t) {
+      return parse_count("level count", t, 0, kMaxCellLevels);
+    }));
   o.progress = progress_bar(a, o.cell_levels >= 0 ? "cells" : "indexing");
   const std::size_t n = draw_index(o);
   if (!a.has("--quiet"))
@@ -239,8 +253,8 @@ int run_bench(const Args& a) {
   o.layer_name = a.get("--layer");
   const LoadOptions lo = load_options(a, o.layer_path);
   o.per = lo.per.value_or(Per::segment);
-  if (a.has("--queries")) o.queries = parse_k(a.get("--queries"));
-  if (a.has("-k")) o.k = parse_k(a.get("-k"));
+  if (a.has("--queries")) o.queries = parse_count("--queries", a.get("--queries"), 1, 100000000);
+  if (a.has("-k")) o.k = parse_count("-k", a.get("-k"), 1, kMaxK);
   o.progress = progress_bar(a, "reading");
   std::fputs(bench_layer(o).c_str(), stdout);
   return 0;
@@ -329,11 +343,12 @@ const std::vector<Command>& commands() {
        "SVG of the layer's linework and the packed index's nodes, one colour per level, or "
        "its region quadtree cells",
        {{"--output", "-o", "OUT.svg", "the drawing"},
-        {"--levels", nullptr, "N", "how many levels to draw, from the root down (default 3)"},
+        {"--levels", nullptr, "N",
+         "how many levels to draw, from the root down (1 to 64, default 3)"},
         {"--cells", nullptr, "L",
-         "draw the layer's region quadtree cut L times instead: polygon interiors, the cells "
-         "the linework runs through (MX cells), empty blocks"},
-        {"--width", nullptr, "PX", "width in pixels (default 1200)"},
+         "draw the layer's region quadtree cut L times (0 to 12) instead: polygon interiors, "
+         "the cells the linework runs through (MX cells), empty blocks"},
+        {"--width", nullptr, "PX", "width in pixels (16 to 100000, default 1200)"},
         kPer,
         kLayer,
         kQuiet},

@@ -3,9 +3,11 @@
 
 #include <sys/stat.h>
 
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -15,23 +17,38 @@
 namespace loci::io {
 namespace {
 
+// The text as a message may quote it: at most 60 characters, control characters (a NUL, an
+// escape sequence meant for the terminal) shown as '?'.
+std::string quoted(const std::string& text) {
+  std::string out;
+  for (unsigned char c : text.substr(0, 60))
+    out += c < 0x20 || c == 0x7f ? '?' : char(c);
+  return "'" + out + (text.size() > 60 ? "...'" : "'");
+}
+
+// "A,B,..." as n finite numbers; spaces around each are allowed. std::from_chars reads the
+// C locale's format whatever the process locale (a user's decimal comma does not change it).
 std::vector<double> parse_numbers(const std::string& text, std::size_t n, const char* what,
                                   const char* form) {
+  auto bad = [&] {
+    return InvalidArgument(std::string("bad ") + what + " " + quoted(text) + ": expected " + form);
+  };
   std::vector<double> v;
   std::size_t at = 0;
   while (at <= text.size()) {
     const std::size_t comma = std::min(text.find(',', at), text.size());
-    const std::string part = text.substr(at, comma - at);
-    char* end = nullptr;
-    const double d = std::strtod(part.c_str(), &end);
-    const bool blank_tail = end && std::string(end).find_first_not_of(" \t\r") == std::string::npos;
-    if (part.find_first_not_of(" \t") == std::string::npos || !blank_tail || !std::isfinite(d))
-      throw InvalidArgument(std::string("bad ") + what + " '" + text + "': expected " + form);
+    std::size_t first = text.find_first_not_of(" \t", at), last = comma;
+    while (last > at && (text[last - 1] == ' ' || text[last - 1] == '\t' || text[last - 1] == '\r'))
+      --last;
+    if (first == std::string::npos || first >= last) throw bad();
+    if (text[first] == '+') ++first;  // from_chars takes no leading plus
+    double d = 0;
+    const auto r = std::from_chars(text.data() + first, text.data() + last, d);
+    if (r.ec != std::errc() || r.ptr != text.data() + last || !std::isfinite(d)) throw bad();
     v.push_back(d);
     at = comma + 1;
   }
-  if (v.size() != n)
-    throw InvalidArgument(std::string("bad ") + what + " '" + text + "': expected " + form);
+  if (v.size() != n) throw bad();
   return v;
 }
 
@@ -63,7 +80,7 @@ Box2 parse_bbox(const std::string& text) {
   const auto v = parse_numbers(text, 4, "bbox", "XMIN,YMIN,XMAX,YMAX");
   const Box2 b{{v[0], v[1]}, {v[2], v[3]}};
   if (v[0] > v[2] || v[1] > v[3])
-    throw InvalidArgument("bad bbox '" + text + "': XMIN > XMAX or YMIN > YMAX");
+    throw InvalidArgument("bad bbox " + quoted(text) + ": XMIN > XMAX or YMIN > YMAX");
   return b;
 }
 
@@ -79,7 +96,7 @@ Segment2 parse_segment(const std::string& text) {
 
 Query parse_within(const std::string& text) {
   const auto v = parse_numbers(text, 3, "--within", "X,Y,D");
-  if (v[2] < 0) throw InvalidArgument("bad --within '" + text + "': D must be >= 0");
+  if (v[2] < 0) throw InvalidArgument("bad --within " + quoted(text) + ": D must be >= 0");
   Query q;
   q.kind = Query::Kind::within;
   q.point = {v[0], v[1]};
@@ -89,6 +106,9 @@ Query parse_within(const std::string& text) {
 
 std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& path,
                                                            Query::Kind kind, std::size_t k) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw Error(path + ": is a directory, not a query file");
   std::ifstream in(path);
   if (!in) throw Error(path + ": cannot read the query file");
   std::vector<std::pair<std::size_t, Query>> out;

@@ -1,6 +1,6 @@
-// What the io/ sources share about GDAL: opening a layer with a useful error, walking the
-// linework of an OGR geometry, flattening it for the exact tests, and writing files through a
-// temporary name. Private to io/: no public header includes GDAL.
+// What the io/ sources share about GDAL (implemented in gdal_layer.cpp): opening a layer with
+// a useful error, walking the linework of an OGR geometry, flattening it for the exact tests,
+// and choosing an output driver. Private to io/: no public header includes GDAL.
 #pragma once
 
 #include <gdal_priv.h>

@@ -37,6 +37,12 @@ const char* to_string(Structure s) {
   }
 }
 
+Per parse_per(const std::string& name) {
+  if (name == "feature") return Per::feature;
+  if (name == "segment") return Per::segment;
+  throw InvalidArgument("unknown granularity '" + name + "' (choose feature or segment)");
+}
+
 const char* to_string(Per p) {
   return p == Per::segment ? "segment" : "feature";
 }

@@ -48,6 +48,8 @@ enum class Structure : std::uint8_t { packed_hilbert, packed_str, rstar, rtree }
 // Throws InvalidArgument listing the choices.
 Structure parse_structure(const std::string& name);
 const char* to_string(Structure s);
+// Accepts "feature" and "segment"; throws InvalidArgument listing the choices.
+Per parse_per(const std::string& name);
 const char* to_string(Per p);
 
 class LayerIndex {

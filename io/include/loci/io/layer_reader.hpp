@@ -18,6 +18,7 @@
 #include "loci/geom/box.hpp"
 #include "loci/geom/segment.hpp"
 #include "loci/io/progress.hpp"
+#include "loci/io/sidecar.hpp"
 
 namespace loci::io {
 
@@ -36,27 +37,6 @@ struct FeatureRecord {
 // geometry column, or a coordinate is NaN or infinite (naming the feature).
 std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer = {});
 std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::string& layer = {});
-
-// What one index entry stands for. 16 bytes, trivially copyable: stored as is in sidecars.
-struct ItemRecord {
-  std::int64_t fid;     // the feature id GDAL reports
-  std::int32_t part;    // per segment: the line or ring within the feature; per feature: 0
-  std::uint32_t flags;  // ItemFlags
-};
-static_assert(sizeof(ItemRecord) == 16);
-
-enum ItemFlags : std::uint32_t {
-  item_ring = 1u,          // the segment lies on a polygon ring
-  item_antidiagonal = 2u,  // the segment runs from (min x, max y) to (max x, min y) of its box
-};
-
-// The segment an entry of a per-segment index stands for, recovered from its box and flags.
-inline Segment2 segment_of(const Box2& box, std::uint32_t flags) {
-  if (flags & item_antidiagonal) return {{box.min[0], box.max[1]}, {box.max[0], box.min[1]}};
-  return {box.min, box.max};
-}
-
-enum class Per : std::uint8_t { feature = 0, segment = 1 };
 
 struct LayerItems {
   Per per = Per::feature;

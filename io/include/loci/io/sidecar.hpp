@@ -36,10 +36,33 @@
 #include <span>
 #include <string>
 
+#include "loci/geom/segment.hpp"
 #include "loci/index/packed_rtree.hpp"
-#include "loci/io/layer_reader.hpp"
 
 namespace loci::io {
+
+// The records section: what one index entry stands for. 16 bytes, trivially copyable: stored as is
+// in sidecars.
+struct ItemRecord {
+  std::int64_t fid;     // the feature id GDAL reports
+  std::int32_t part;    // per segment: the line or ring within the feature; per feature: 0
+  std::uint32_t flags;  // ItemFlags
+};
+static_assert(sizeof(ItemRecord) == 16);
+
+enum ItemFlags : std::uint32_t {
+  item_ring = 1u,          // the segment lies on a polygon ring
+  item_antidiagonal = 2u,  // the segment runs from (min x, max y) to (max x, min y) of its box
+};
+
+// The segment an entry of a per-segment index stands for, recovered from its box and flags.
+inline Segment2 segment_of(const Box2& box, std::uint32_t flags) {
+  if (flags & item_antidiagonal) return {{box.min[0], box.max[1]}, {box.max[0], box.min[1]}};
+  return {box.min, box.max};
+}
+
+// Granularity of an index: one entry per feature, or one per segment of the linework.
+enum class Per : std::uint8_t { feature = 0, segment = 1 };
 
 struct Fingerprint {
   std::uint64_t size = 0;     // bytes

@@ -1,5 +1,5 @@
 // `loci bench`: see bench.hpp.
-#include "loci/io/bench.hpp"
+#include "bench.hpp"
 
 #include <boost/geometry.hpp>
 #include <boost/geometry/index/rtree.hpp>

@@ -1,4 +1,5 @@
 // `loci bench`: a user's own layer on loci and on Boost.Geometry's rtree, side by side.
+// (Part of the loci executable only: the installed library carries no peer.)
 //
 // The layer's boxes (per feature or per segment) go into loci's packed R-tree (Hilbert) and
 // into boost::geometry::index::rtree with its bulk-loading constructor and the R* parameters

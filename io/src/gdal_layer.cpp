@@ -1,0 +1,157 @@
+// The GDAL plumbing io/ shares (gdal_layer.hpp): opening a layer, walking and flattening
+// geometries, choosing an output driver.
+#include "gdal_layer.hpp"
+
+#include <cpl_conv.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <map>
+#include <memory>
+
+#include "loci/geom/error.hpp"
+
+namespace loci::io {
+namespace detail {
+
+OpenLayer open_layer(const std::string& path, const std::string& name) {
+  GDALAllRegister();
+  if (!CPLGetConfigOption("OGR_GEOJSON_MAX_OBJ_SIZE", nullptr))
+    CPLSetConfigOption("OGR_GEOJSON_MAX_OBJ_SIZE", "0");
+  // A FIFO or device would block GDAL or feed it endless bytes: only files and directories (a
+  // directory of shapefiles) are layers on disk; other names (/vsi..., PG:...) go to GDAL.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+    throw Error(path + ": not a regular file");
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  OpenLayer ol;
+  ol.dataset.reset(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+  const std::string gdal_message = CPLGetLastErrorMsg();
+  CPLPopErrorHandler();
+  if (!ol.dataset) {
+    VSIStatBufL st;
+    if (VSIStatL(path.c_str(), &st) != 0) throw Error(path + ": no such file");
+    throw Error(path + ": cannot open as a vector layer" +
+                (gdal_message.empty() ? std::string() : " (" + gdal_message + ")"));
+  }
+  if (ol.dataset->GetLayerCount() == 0) throw Error(path + ": contains no layer");
+  ol.layer = name.empty() ? ol.dataset->GetLayer(0) : ol.dataset->GetLayerByName(name.c_str());
+  if (!ol.layer) throw Error(path + ": no layer named '" + name + "'");
+  if (ol.layer->GetLayerDefn()->GetGeomFieldCount() == 0)
+    throw Error(path + ": layer '" + ol.layer->GetName() + "' has no geometry");
+  ol.layer->ResetReading();
+  return ol;
+}
+
+std::string where(const std::string& path, std::int64_t fid) {
+  return path + ": feature " + std::to_string(fid);
+}
+
+namespace {
+
+void walk(const OGRGeometry* g, std::uint32_t& polygons,
+          const std::function<void(const OGRSimpleCurve&, bool, std::uint32_t)>& f) {
+  if (!g) return;
+  switch (wkbFlatten(g->getGeometryType())) {
+    case wkbLineString:
+    case wkbLinearRing:
+      f(*g->toSimpleCurve(), false, 0);
+      break;
+    case wkbPolygon: {
+      const std::uint32_t id = polygons++;
+      for (const auto* ring : *g->toPolygon())
+        f(*ring, true, id);
+      break;
+    }
+    case wkbMultiLineString:
+    case wkbMultiPolygon:
+    case wkbGeometryCollection:
+      for (const auto* part : *g->toGeometryCollection())
+        walk(part, polygons, f);
+      break;
+    default:
+      break;
+  }
+}
+
+// Curved geometries (arcs) are approximated by GDAL's default linearisation.
+std::unique_ptr<OGRGeometry> linear_copy(const OGRGeometry* g) {
+  if (!g || !g->hasCurveGeometry()) return nullptr;
+  return std::unique_ptr<OGRGeometry>(g->getLinearGeometry());
+}
+
+void add_points(const OGRGeometry* g, FlatGeometry& out, const std::string& what) {
+  if (!g) return;
+  const auto type = wkbFlatten(g->getGeometryType());
+  if (type == wkbPoint) {
+    const OGRPoint* p = g->toPoint();
+    if (p->IsEmpty()) return;
+    const Point2 q{p->getX(), p->getY()};
+    if (!is_finite(q)) throw InvalidGeometry(what + " has a NaN or infinite coordinate");
+    const auto at = std::uint32_t(out.points.size());
+    out.points.push_back(q);
+    out.parts.push_back({at, at + 1, PartKind::point, 0});
+  } else if (type == wkbMultiPoint || type == wkbGeometryCollection) {
+    for (const auto* part : *g->toGeometryCollection())
+      add_points(part, out, what);
+  }
+}
+
+}  // namespace
+
+void for_each_curve(const OGRGeometry* g,
+                    const std::function<void(const OGRSimpleCurve&, bool, std::uint32_t)>& f) {
+  const auto linear = linear_copy(g);
+  std::uint32_t polygons = 0;
+  walk(linear ? linear.get() : g, polygons, f);
+}
+
+FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
+  FlatGeometry out;
+  if (!g || g->IsEmpty()) return out;
+  const auto linear = linear_copy(g);
+  if (linear) g = linear.get();
+  add_points(g, out, what);
+  std::uint32_t polygons = 0;
+  walk(g, polygons, [&](const OGRSimpleCurve& c, bool ring, std::uint32_t polygon) {
+    const int n = c.getNumPoints();
+    if (n == 0) return;
+    const auto at = std::uint32_t(out.points.size());
+    for (int i = 0; i < n; ++i) {
+      const Point2 q{c.getX(i), c.getY(i)};
+      if (!is_finite(q)) throw InvalidGeometry(what + " has a NaN or infinite coordinate");
+      out.points.push_back(q);
+    }
+    out.parts.push_back(
+        {at, std::uint32_t(out.points.size()), ring ? PartKind::ring : PartKind::line, polygon});
+  });
+  out.polygons = polygons;
+  return out;
+}
+
+GDALDriver* driver_for(const std::string& path) {
+  GDALAllRegister();
+  std::string ext = CPLGetExtension(path.c_str());
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  const char* name = "GeoJSON";
+  if (ext == "shp")
+    name = "ESRI Shapefile";
+  else if (ext == "gpkg")
+    name = "GPKG";
+  else if (ext == "fgb")
+    name = "FlatGeobuf";
+  else if (ext == "csv")
+    name = "CSV";
+  else if (ext == "kml")
+    name = "KML";
+  else if (ext == "gml")
+    name = "GML";
+  GDALDriver* d = GetGDALDriverManager()->GetDriverByName(name);
+  if (!d) throw Error(std::string("GDAL has no ") + name + " driver");
+  return d;
+}
+
+}  // namespace detail
+
+}  // namespace loci::io
