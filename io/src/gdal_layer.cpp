@@ -8,10 +8,29 @@
 #include <algorithm>
 #include <map>
 #include <memory>
+#include <utility>
 
 #include "loci/geom/error.hpp"
+#include "loci/io/commands.hpp"
 
 namespace loci::io {
+
+namespace detail {
+
+ReadCheck::ReadCheck(std::string path) : path_(std::move(path)) {
+  CPLErrorReset();
+}
+
+void ReadCheck::finish() const {
+  if (CPLGetLastErrorType() == CE_Failure || CPLGetLastErrorType() == CE_Fatal)
+    throw Error(path_ + ": cannot read the layer whole (" + CPLGetLastErrorMsg() + ")");
+}
+
+}  // namespace detail
+
+void silence_gdal_messages() {
+  CPLSetErrorHandler(CPLQuietErrorHandler);
+}
 namespace detail {
 
 OpenLayer open_layer(const std::string& path, const std::string& name) {

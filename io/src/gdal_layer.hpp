@@ -32,6 +32,19 @@ void for_each_curve(const OGRGeometry* g,
 // Throws InvalidGeometry (naming `what`) on a NaN or infinite coordinate.
 FlatGeometry flatten(const OGRGeometry* g, const std::string& what);
 
+// GDAL reports a file it can read only in part (a truncated or garbled shapefile) through its
+// error state, feature after feature, and still hands out what it could read. A ReadCheck made
+// before reading resets that state; finish() after reading throws loci::Error naming the file
+// and carrying GDAL's message if anything failed, so a layer is read whole or refused.
+class ReadCheck {
+ public:
+  explicit ReadCheck(std::string path);
+  void finish() const;
+
+ private:
+  std::string path_;
+};
+
 // A GDAL vector driver chosen from the output file name's extension (GeoJSON by default).
 GDALDriver* driver_for(const std::string& path);
 

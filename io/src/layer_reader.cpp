@@ -16,6 +16,7 @@ using detail::where;
 std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer) {
   auto ol = open_layer(path, layer);
   std::vector<SegmentRecord> out;
+  const detail::ReadCheck read_check(path);
   for (auto& feature : *ol.layer) {
     const std::int64_t fid = feature->GetFID();
     std::int32_t part = 0;
@@ -31,12 +32,14 @@ std::vector<SegmentRecord> read_segments(const std::string& path, const std::str
           ++part;
         });
   }
+  read_check.finish();
   return out;
 }
 
 std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::string& layer) {
   auto ol = open_layer(path, layer);
   std::vector<FeatureRecord> out;
+  const detail::ReadCheck read_check(path);
   for (auto& feature : *ol.layer) {
     const OGRGeometry* g = feature->GetGeometryRef();
     if (!g || g->IsEmpty()) continue;
@@ -46,6 +49,7 @@ std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::st
     check_box(box, where(path, feature->GetFID()).c_str());
     out.push_back({box, feature->GetFID()});
   }
+  read_check.finish();
   return out;
 }
 
@@ -97,6 +101,7 @@ LayerItems read_items(const std::string& path, const std::string& layer, Per per
   out.layer_name = ol.layer->GetName();
   ProgressTicker ticker(progress, double(ol.layer->GetFeatureCount(FALSE)));
   std::size_t seen = 0;
+  const detail::ReadCheck read_check(path);
   for (auto& feature : *ol.layer) {
     ticker.tick(double(++seen));
     const OGRGeometry* g = feature->GetGeometryRef();
@@ -116,6 +121,7 @@ LayerItems read_items(const std::string& path, const std::string& layer, Per per
       add_segments(g, fid, path, out);
     }
   }
+  read_check.finish();
   return out;
 }
 
@@ -142,6 +148,7 @@ LayerSummary summarize_layer(const std::string& path, const std::string& layer,
   }
   std::map<std::string, std::int64_t> types;
   ProgressTicker ticker(progress, double(ol.layer->GetFeatureCount(FALSE)));
+  const detail::ReadCheck read_check(path);
   for (auto& feature : *ol.layer) {
     ++s.feature_count;
     ticker.tick(double(s.feature_count));
@@ -155,6 +162,7 @@ LayerSummary summarize_layer(const std::string& path, const std::string& layer,
     g->getEnvelope(&e);
     s.extent.expand(Box2{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}});
   }
+  read_check.finish();
   s.geometry_types.assign(types.begin(), types.end());
   return s;
 }

@@ -206,6 +206,28 @@ TEST_F(BadInput, TemporariesAreHiddenModesKeptAndLeftoversRemoved) {
   EXPECT_TRUE(temporaries().empty());
 }
 
+TEST_F(BadInput, TruncatedAndForeignFilesAreRefusedInOneLine) {
+  const std::string l = lines_layer();
+  ASSERT_EQ(
+      run_loci("clip " + shell_quote(l) + " --bbox -1,-1,9,9 -o " + shell_quote(path("roads.shp")))
+          .status,
+      0);
+  const std::string shp = path("roads.shp");
+  const std::string whole = read_text(shp);
+  std::ofstream(shp, std::ios::binary) << whole.substr(0, whole.size() - 20);
+  for (const char* cmd : {"index ", "info ", "query --bbox 0,0,9,9 "}) {
+    std::string c = cmd;
+    const std::size_t sp = c.find(' ');
+    const CliRun r = run_loci(c.substr(0, sp) + " " + shell_quote(shp) + c.substr(sp));
+    expect_one_line_error(r);  // GDAL's own ERROR lines must not leak either
+  }
+  EXPECT_FALSE(fs::exists(shp + ".loci"));
+  write("random.shp", std::string("\x89garbage\x00bytes", 16));
+  expect_one_line_error(run_loci("index " + shell_quote(path("random.shp"))));
+  write("empty.geojson", "");
+  expect_one_line_error(run_loci("index " + shell_quote(path("empty.geojson"))));
+}
+
 TEST_F(BadInput, SigtermRemovesTheTemporaries) {
   // clip into a FIFO nobody reads: loci stages the dataset and then blocks writing it out
   const std::string l = lines_layer();

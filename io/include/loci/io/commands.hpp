@@ -23,6 +23,11 @@
 
 namespace loci::io {
 
+// GDAL prints its own "ERROR n: ..." lines on stderr unless told otherwise; a command-line
+// program calls this once so that the only message a user sees is loci's one line (every
+// failure GDAL reports is turned into a loci::Error carrying GDAL's message).
+void silence_gdal_messages();
+
 // Parse "A,B,C,D" style arguments; throw InvalidArgument quoting the text and the form wanted.
 Box2 parse_bbox(const std::string& text);
 Point2 parse_point(const std::string& text);
