@@ -10,6 +10,7 @@
 #include "loci/index/interval_tree.hpp"
 #include "loci/index/segment_tree.hpp"
 #include "support/brute_force.hpp"
+#include "support/churn.hpp"
 #include "support/interval_data.hpp"
 
 using namespace loci;
@@ -184,6 +185,28 @@ TEST(IntervalTree, RejectsBadInput) {
   const auto st = SegmentTree::build(std::vector<Interval>{{0, 1}});
   EXPECT_THROW(st.stab(inf), InvalidGeometry);
   EXPECT_TRUE(SegmentTree().stab(1).empty());
+}
+
+// The shared churn harness (tests/support/churn.hpp) on intervals.
+struct IntervalChurn {
+  IntervalTree tree;
+  Interval make_item(std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(0, 1000), len(0, 30);
+    const double lo = u(rng);
+    return {lo, rng() % 5 == 0 ? lo : lo + len(rng)};
+  }
+  Interval make_window(std::mt19937_64& rng) { return make_item(rng); }
+  bool meets(const Interval& iv, const Interval& w) { return iv.overlaps(w); }
+  void insert(const Interval& iv, Id id) { tree.insert(iv, id); }
+  bool erase(const Interval& iv, Id id) { return tree.erase(iv, id); }
+  std::vector<Id> query(const Interval& w) { return tree.overlap(w); }
+  void validate() { tree.validate(); }
+  std::size_t size() { return tree.size(); }
+};
+
+TEST(IntervalTreeDynamic, SharedChurnHarness) {
+  IntervalChurn ops;
+  churn_against_brute_force(ops, 83, 4000);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "loci/index/kd_tree.hpp"
 #include "support/brute_force.hpp"
+#include "support/churn.hpp"
 #include "support/point_data.hpp"
 
 using namespace loci;
@@ -202,6 +203,26 @@ TEST(KdTree, CustomIds) {
   const auto tree = KdTree2::build(pts, ids);
   EXPECT_EQ(tree.nearest({6, 6}, 1).front().id, 50u);
   EXPECT_EQ(sorted(tree.query(Box2{{0, 0}, {5, 5}})), (std::vector<Id>{50, 70}));
+}
+
+// The shared churn harness (tests/support/churn.hpp) on points: insertions, duplicates,
+// erasures (also of absent entries), updates and window queries against brute force.
+template <class Tree>
+struct PointChurn {
+  Tree tree;
+  Point<2> make_item(std::mt19937_64& rng) { return random_point<2>(rng); }
+  Box<2> make_window(std::mt19937_64& rng) { return random_window<2>(rng); }
+  bool meets(const Point<2>& p, const Box<2>& w) { return intersects(w, p); }
+  void insert(const Point<2>& p, Id id) { tree.insert(p, id); }
+  bool erase(const Point<2>& p, Id id) { return tree.erase(p, id); }
+  std::vector<Id> query(const Box<2>& w) { return tree.query(w); }
+  void validate() { tree.validate(); }
+  std::size_t size() { return tree.size(); }
+};
+
+TEST(KdDynamic, SharedChurnHarness) {
+  PointChurn<KdTree2> ops{KdTree2()};
+  churn_against_brute_force(ops, 73, 4000);
 }
 
 }  // namespace

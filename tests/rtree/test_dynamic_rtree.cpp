@@ -9,6 +9,7 @@
 #include "loci/index/rstar_tree.hpp"
 #include "loci/index/rtree.hpp"
 #include "support/brute_force.hpp"
+#include "support/churn.hpp"
 #include "support/random_data.hpp"
 
 using namespace loci;
@@ -66,6 +67,37 @@ void check_queries(const Tree& tree, const Model<D>& model, std::mt19937_64& rng
       ASSERT_TRUE(model.live.count(got[i].id));
       EXPECT_DOUBLE_EQ(got[i].distance, std::sqrt(squared_distance(p, model.live.at(got[i].id))));
     }
+  }
+}
+
+// The shared churn harness: insertions, duplicates, erasures (also of absent entries),
+// updates and window queries against brute force, for every dynamic R-tree.
+template <class Tree>
+struct BoxChurn {
+  static constexpr int D = Tree::dimension;
+  Tree tree;
+  double side;
+  Box<D> make_item(std::mt19937_64& rng) {
+    const Point<D> p = loci::test::random_point<D>(rng);
+    std::uniform_real_distribution<double> s(0.0, side);
+    Box<D> b{p, p};
+    for (int a = 0; a < D; ++a)
+      b.max[a] += s(rng);
+    return b;
+  }
+  Box<D> make_window(std::mt19937_64& rng) { return loci::test::random_window<D>(rng); }
+  bool meets(const Box<D>& b, const Box<D>& w) { return intersects(b, w); }
+  void insert(const Box<D>& b, Id id) { tree.insert(b, id); }
+  bool erase(const Box<D>& b, Id id) { return tree.erase(b, id); }
+  std::vector<Id> query(const Box<D>& w) { return tree.query(w); }
+  void validate() { tree.validate(); }
+  std::size_t size() { return tree.size(); }
+};
+
+TYPED_TEST(DynamicRTreeTest, SharedChurnHarness) {
+  for (double side : {0.0, 12.0}) {
+    BoxChurn<TypeParam> ops{TypeParam(), side};
+    loci::test::churn_against_brute_force(ops, 71, 3000);
   }
 }
 
