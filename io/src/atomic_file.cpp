@@ -1,7 +1,6 @@
 // All-or-nothing output files: see atomic_file.hpp.
 #include "loci/io/atomic_file.hpp"
 
-#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -15,8 +14,12 @@
 #include <climits>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <system_error>
 #include <vector>
+
+#include <cpl_string.h>
+#include <cpl_vsi.h>
 
 #include "loci/geom/error.hpp"
 
@@ -30,41 +33,18 @@ Error cannot_write(const std::string& path, int err) {
 }
 
 // ---- Temporaries removed on SIGINT, SIGTERM and SIGHUP ----------------------------------
-// A fixed table, so that the handler touches no allocator: a slot holds a path and whether
-// it is a directory (whose files are removed first).
+// A fixed table, so that the handler touches no allocator: a slot holds a path.
 struct TempSlot {
   std::atomic<bool> used{false};
-  bool directory = false;
   char path[PATH_MAX];
 };
 std::array<TempSlot, 16> g_temps;
 std::atomic<bool> g_handlers{false};
 
-void remove_dir_files(const char* dir) {
-  // Only async-signal-safe calls would be ideal; the process is about to die and the
-  // directory holds a handful of files, so the small risk of readdir is accepted.
-  if (DIR* d = ::opendir(dir)) {
-    char buf[PATH_MAX];
-    while (const dirent* e = ::readdir(d)) {
-      if (!std::strcmp(e->d_name, ".") || !std::strcmp(e->d_name, "..")) continue;
-      if (std::strlen(dir) + std::strlen(e->d_name) + 2 > sizeof buf) continue;
-      std::strcpy(buf, dir);
-      std::strcat(buf, "/");
-      std::strcat(buf, e->d_name);
-      ::unlink(buf);
-    }
-    ::closedir(d);
-  }
-  ::rmdir(dir);
-}
-
 extern "C" void remove_temps_and_die(int sig) {
   for (auto& slot : g_temps) {
     if (!slot.used.load()) continue;
-    if (slot.directory)
-      remove_dir_files(slot.path);
-    else
-      ::unlink(slot.path);
+    ::unlink(slot.path);
   }
   ::signal(sig, SIG_DFL);
   ::raise(sig);
@@ -86,7 +66,7 @@ void install_handlers() {
   }
 }
 
-int register_temp(const std::string& path, bool directory) {
+int register_temp(const std::string& path) {
   install_handlers();
   if (path.size() >= PATH_MAX) return -1;
   for (std::size_t i = 0; i < g_temps.size(); ++i) {
@@ -94,7 +74,6 @@ int register_temp(const std::string& path, bool directory) {
     bool expected = false;
     if (slot.used.load()) continue;
     std::memcpy(slot.path, path.c_str(), path.size() + 1);
-    slot.directory = directory;
     if (slot.used.compare_exchange_strong(expected, true)) return int(i);
   }
   return -1;  // more than 16 at once: still removed on every normal path
@@ -178,7 +157,7 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   tmp_ = temp_template(directory_of(target), target.filename().string());
   fd_ = ::mkostemp(tmp_.data(), O_CLOEXEC);
   if (fd_ < 0) throw cannot_write(path, errno);
-  register_slot_ = register_temp(tmp_, false);
+  register_slot_ = register_temp(tmp_);
   if (::fchmod(fd_, mode) != 0) {
     const int e = errno;
     ::close(fd_);
@@ -232,33 +211,19 @@ void AtomicFile::commit() {
 }
 
 AtomicDataset::AtomicDataset(const std::string& path) : path_(path) {
+  static std::atomic<unsigned> counter{0};
   std::error_code ec;
-  fs::path target = path;
-  if (fs::is_symlink(fs::symlink_status(target, ec))) {
-    target = fs::weakly_canonical(target, ec);
-    path_ = target.string();
-  }
-  const fs::file_status st = fs::status(target, ec);
-  if (fs::is_directory(st)) throw Error("cannot write " + path + " (it is a directory)");
-  if (fs::is_block_file(st)) throw Error("cannot write " + path + " (it is a block device)");
-  in_place_ = fs::is_character_file(st) || fs::is_fifo(st) || fs::is_socket(st) ||
-              (is_special_path(path) && fs::exists(st));
-  if (in_place_) {
-    path_ = path;
-    target = fs::temp_directory_path() / target.filename();
-  }
-  std::string tmpl = temp_template(directory_of(target), target.filename().string());
-  if (!::mkdtemp(tmpl.data())) throw cannot_write(path, errno);
-  dir_ = tmpl;
-  register_slot_ = register_temp(dir_, true);
-  staging_ = dir_ + "/" + target.filename().string();
+  if (fs::is_directory(fs::status(path, ec)))
+    throw Error("cannot write " + path + " (it is a directory)");
+  // GDAL writes into memory: its drivers do not report every failed write to disk, so the files
+  // go to disk afterwards through AtomicFile, every write checked.
+  dir_ = "/vsimem/loci-dataset-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  VSIMkdir(dir_.c_str(), 0755);
+  staging_ = dir_ + "/" + fs::path(path).filename().string();
 }
 
 AtomicDataset::~AtomicDataset() {
-  if (committed_) return;
-  std::error_code ec;
-  fs::remove_all(dir_, ec);
-  unregister_temp(register_slot_);
+  VSIRmdirRecursive(dir_.c_str());
 }
 
 namespace {
@@ -285,21 +250,40 @@ std::string extension_after(const std::string& name, const std::string& stem) {
 }  // namespace
 
 void AtomicDataset::commit() {
-  committed_ = true;
-  if (in_place_) {
-    commit_in_place();
-    return;
-  }
-  const fs::path target = path_;
-  const fs::path dir = directory_of(target);
-  std::error_code ec;
   std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir_, ec))
-    names.push_back(e.path().filename().string());
-  const std::string ext = target.extension().string();
-  if (shapefile_companion(ext)) {
+  if (char** list = VSIReadDir(dir_.c_str())) {
+    for (char** n = list; *n; ++n)
+      if (std::strcmp(*n, ".") != 0 && std::strcmp(*n, "..") != 0) names.emplace_back(*n);
+    CSLDestroy(list);
+  }
+  std::sort(names.begin(), names.end());
+  const fs::path target = path_;
+  const std::string main_name = target.filename().string();
+  if (std::find(names.begin(), names.end(), main_name) == names.end())
+    throw Error("cannot write " + path_ + " (the driver wrote no file of that name)");
+  std::error_code ec;
+  const fs::file_status st = fs::status(target, ec);
+  const bool device = fs::is_character_file(st) || fs::is_fifo(st) || fs::is_socket(st);
+  if (device && names.size() > 1)
+    throw Error("cannot write " + path_ + " (the format writes " + std::to_string(names.size()) +
+                " files, a device or pipe takes one)");
+  // Every file whole under its temporary name first, then all renamed.
+  std::vector<std::unique_ptr<AtomicFile>> files;
+  for (const auto& name : names) {
+    files.push_back(std::make_unique<AtomicFile>(
+        name == main_name ? path_ : (target.parent_path() / name).string()));
+    vsi_l_offset size = 0;
+    const GByte* data = VSIGetMemFileBuffer((dir_ + "/" + name).c_str(), &size, FALSE);
+    std::FILE* f = files.back()->stream();
+    if (size && std::fwrite(data, 1, std::size_t(size), f) != std::size_t(size))
+      throw Error("cannot write " + path_ + " (" + std::strerror(errno ? errno : EIO) + ")");
+  }
+  for (auto& f : files)
+    f->commit();
+  if (!device && shapefile_companion(target.extension().string())) {
     const std::string stem = target.stem().string();
-    for (const auto& e : fs::directory_iterator(dir, ec)) {
+    for (const auto& e :
+         fs::directory_iterator(target.parent_path().empty() ? "." : target.parent_path(), ec)) {
       const std::string n = e.path().filename().string();
       const std::string x = extension_after(n, stem);
       if (!x.empty() && shapefile_companion(x) &&
@@ -307,52 +291,6 @@ void AtomicDataset::commit() {
         fs::remove(e.path(), ec);
     }
   }
-  for (const auto& name : names) {
-    if (::rename((dir_ + "/" + name).c_str(), (dir / name).c_str()) != 0) {
-      const int e = errno;
-      fs::remove_all(dir_, ec);
-      unregister_temp(register_slot_);
-      throw cannot_write(path_, e);
-    }
-  }
-  ::rmdir(dir_.c_str());
-  unregister_temp(register_slot_);
-}
-
-void AtomicDataset::commit_in_place() {
-  std::error_code ec;
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir_, ec))
-    files.push_back(e.path());
-  int err = 0;
-  if (files.size() != 1) {
-    fs::remove_all(dir_, ec);
-    unregister_temp(register_slot_);
-    throw Error("cannot write " + path_ + ": the format writes " + std::to_string(files.size()) +
-                " files, a device or pipe takes one");
-  }
-  const int in = ::open(files[0].c_str(), O_RDONLY | O_CLOEXEC);
-  const int out = in < 0 ? -1 : ::open(path_.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
-  if (in < 0 || out < 0) err = errno;
-  char buf[1 << 16];
-  while (!err) {
-    const ssize_t n = ::read(in, buf, sizeof buf);
-    if (n == 0) break;
-    if (n < 0) {
-      if (errno != EINTR) err = errno;
-      continue;
-    }
-    for (ssize_t done = 0; done < n && !err;) {
-      const ssize_t w = ::write(out, buf + done, std::size_t(n - done));
-      if (w < 0 && errno != EINTR) err = errno;
-      if (w > 0) done += w;
-    }
-  }
-  if (in >= 0) ::close(in);
-  if (out >= 0 && ::close(out) != 0 && !err) err = errno;
-  fs::remove_all(dir_, ec);
-  unregister_temp(register_slot_);
-  if (err) throw cannot_write(path_, err);
 }
 
 void refuse_overwriting(const std::string& out, const std::string& input) {

@@ -15,11 +15,11 @@
 // never replaced. A directory is refused.
 //
 // AtomicDataset does the same for GDAL outputs that are several files (a shapefile's .shp,
-// .shx, .dbf, .prj): GDAL writes them into a hidden staging directory, and commit() first
-// removes the target's old shapefile companions (.prj, .qix, ...) that the new dataset does not
-// have, then moves every new file into place. GDAL never sees a device or FIFO target (its
-// drivers may delete an existing file before creating one): a one-file dataset is staged, then
-// copied into it.
+// .shx, .dbf, .prj): GDAL writes them in memory (/vsimem/, since its drivers do not report every
+// failed write to disk), and commit() writes each through an AtomicFile, every write checked,
+// renames them all into place, then removes the target's old shapefile companions (.prj, .qix,
+// ...) that the new dataset does not have. GDAL never sees the real target: a device or FIFO
+// receives the one file of a one-file format.
 #pragma once
 
 #include <cstdio>
@@ -65,14 +65,9 @@ class AtomicDataset {
   void commit();
 
  private:
-  void commit_in_place();
-
   std::string path_;
-  std::string dir_;  // the staging directory
+  std::string dir_;  // the staging directory, in GDAL's /vsimem/
   std::string staging_;
-  int register_slot_ = -1;
-  bool in_place_ = false;  // a device or FIFO: the one file written is copied into it
-  bool committed_ = false;
 };
 
 // Throws loci::Error when writing `out` would overwrite the layer `input` or one of its
