@@ -205,20 +205,7 @@ TEST(KdTree, CustomIds) {
   EXPECT_EQ(sorted(tree.query(Box2{{0, 0}, {5, 5}})), (std::vector<Id>{50, 70}));
 }
 
-// The shared churn harness (tests/support/churn.hpp) on points: insertions, duplicates,
-// erasures (also of absent entries), updates and window queries against brute force.
-template <class Tree>
-struct PointChurn {
-  Tree tree;
-  Point<2> make_item(std::mt19937_64& rng) { return random_point<2>(rng); }
-  Box<2> make_window(std::mt19937_64& rng) { return random_window<2>(rng); }
-  bool meets(const Point<2>& p, const Box<2>& w) { return intersects(w, p); }
-  void insert(const Point<2>& p, Id id) { tree.insert(p, id); }
-  bool erase(const Point<2>& p, Id id) { return tree.erase(p, id); }
-  std::vector<Id> query(const Box<2>& w) { return tree.query(w); }
-  void validate() { tree.validate(); }
-  std::size_t size() { return tree.size(); }
-};
+// The shared churn harness (tests/support/churn.hpp) on points.
 
 TEST(KdDynamic, SharedChurnHarness) {
   PointChurn<KdTree2> ops{KdTree2()};

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "loci/index/query.hpp"
+#include "support/random_data.hpp"
 
 namespace loci::test {
 
@@ -72,5 +73,19 @@ void churn_against_brute_force(Ops& ops, std::uint64_t seed, std::size_t steps) 
   }
   check(steps + 1);
 }
+
+// The adapter of a dynamic point index (KdTree, PrQuadtree): random points and windows.
+template <class Tree>
+struct PointChurn {
+  Tree tree;
+  Point<2> make_item(std::mt19937_64& rng) { return random_point<2>(rng); }
+  Box<2> make_window(std::mt19937_64& rng) { return random_window<2>(rng); }
+  bool meets(const Point<2>& p, const Box<2>& w) { return intersects(w, p); }
+  void insert(const Point<2>& p, Id id) { tree.insert(p, id); }
+  bool erase(const Point<2>& p, Id id) { return tree.erase(p, id); }
+  std::vector<Id> query(const Box<2>& w) { return tree.query(w); }
+  void validate() { tree.validate(); }
+  std::size_t size() { return tree.size(); }
+};
 
 }  // namespace loci::test
