@@ -231,7 +231,10 @@ TEST_F(BadInput, TruncatedAndForeignFilesAreRefusedInOneLine) {
     expect_one_line_error(r);  // GDAL's own ERROR lines must not leak either
   }
   EXPECT_FALSE(fs::exists(shp + ".loci"));
-  static constexpr char kForeign[] = "\x89" "garbage\0" "bytes and more";
+  static constexpr char kForeign[] =
+      "\x89"
+      "garbage\0"
+      "bytes and more";
   write("random.shp", std::string(kForeign, sizeof kForeign - 1));
   expect_one_line_error(run_loci("index " + shell_quote(path("random.shp"))));
   write("empty.geojson", "");
