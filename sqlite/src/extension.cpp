@@ -1,0 +1,64 @@
+// The extension's entry point and its scalar functions.
+//
+// Loaded by name: `.load PATH/loci` in the sqlite3 shell, sqlite3_load_extension(db,
+// "PATH/loci", 0, &err) from C, SELECT load_extension('PATH/loci') from SQL. SQLite derives the
+// entry point sqlite3_loci_init from the file name. Programs that link SQLite in call the same
+// function from the static library loci_sqlite_static (sqlite3_auto_extension, see
+// include/loci/sqlite/loci_sqlite.h).
+#include <memory>
+
+#include "rtree_table.hpp"
+
+SQLITE_EXTENSION_INIT1
+
+namespace loci::sqlite {
+
+namespace {
+
+void free_registry(void* p) {
+  delete static_cast<std::shared_ptr<Registry>*>(p);
+}
+
+// loci_check('t'): 'ok' or what is wrong with t's index.
+void check_function(sqlite3_context* ctx, int, sqlite3_value** argv) {
+  try {
+    auto& registry = **static_cast<std::shared_ptr<Registry>*>(sqlite3_user_data(ctx));
+    const char* name = reinterpret_cast<const char*>(sqlite3_value_text(argv[0]));
+    RTreeTable& t = table_named(sqlite3_context_db_handle(ctx), registry, name, "loci_check");
+    const std::string verdict = t.check();
+    sqlite3_result_text(ctx, verdict.c_str(), int(verdict.size()), SQLITE_TRANSIENT);
+  } catch (const SqlError& e) {
+    sqlite3_result_error(ctx, e.message.c_str(), int(e.message.size()));
+    sqlite3_result_error_code(ctx, e.code);
+  } catch (const std::bad_alloc&) {
+    sqlite3_result_error_nomem(ctx);
+  } catch (const std::exception& e) {
+    sqlite3_result_error(ctx, e.what(), -1);
+  }
+}
+
+int register_all(sqlite3* db, char** err) {
+  try {
+    auto registry = std::make_shared<Registry>();
+    int rc = register_rtree(db, registry);
+    if (rc == SQLITE_OK) rc = register_nearest(db, registry);
+    if (rc == SQLITE_OK)
+      rc = sqlite3_create_function_v2(db, "loci_check", 1, SQLITE_UTF8 | SQLITE_DIRECTONLY,
+                                      new std::shared_ptr<Registry>(registry), check_function,
+                                      nullptr, nullptr, free_registry);
+    if (rc != SQLITE_OK && err) *err = sqlite3_mprintf("loci: %s", sqlite3_errmsg(db));
+    return rc;
+  } catch (...) {
+    return SQLITE_NOMEM;
+  }
+}
+
+}  // namespace
+
+}  // namespace loci::sqlite
+
+extern "C" __attribute__((visibility("default"))) int sqlite3_loci_init(
+    sqlite3* db, char** err, const sqlite3_api_routines* api) {
+  SQLITE_EXTENSION_INIT2(api);
+  return loci::sqlite::register_all(db, err);
+}

@@ -1,0 +1,818 @@
+// The loci_rtree module: CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy
+// [, +aux ...]), SQLite rtree's argument shape with exact double coordinates.
+#include "rtree_table.hpp"
+
+#include <strings.h>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace loci::sqlite {
+
+namespace {
+
+constexpr std::size_t kChunkBytes = 1 << 20;
+constexpr int kCoordinates = 4;
+const char* const kShadowSuffixes[] = {"node", "delta", "dead", "meta", "aux"};
+
+// ---- Values -------------------------------------------------------------------------------
+
+// A coordinate from SQL: integers and real numbers, and text that reads as one; anything
+// else is an error naming the column.
+double coordinate(sqlite3_value* v, const char* column, const RTreeTable& t) {
+  int type = sqlite3_value_type(v);
+  if (type == SQLITE_TEXT) type = sqlite3_value_numeric_type(v);
+  const auto fail = [&](const char* what) {
+    return SqlError{SQLITE_CONSTRAINT,
+                    format_sql("loci_rtree %s: %s is %s", t.name.c_str(), column, what)};
+  };
+  if (type == SQLITE_NULL) throw fail("NULL");
+  if (type != SQLITE_INTEGER && type != SQLITE_FLOAT) throw fail("not a number");
+  const double x = sqlite3_value_double(v);
+  if (!std::isfinite(x)) throw fail("not finite");
+  return x;
+}
+
+// A row id from SQL: an integer, or a real number or text holding one.
+bool row_id(sqlite3_value* v, RowId& id) {
+  int type = sqlite3_value_type(v);
+  if (type == SQLITE_TEXT) type = sqlite3_value_numeric_type(v);
+  if (type == SQLITE_INTEGER) {
+    id = sqlite3_value_int64(v);
+    return true;
+  }
+  if (type == SQLITE_FLOAT) {
+    const double d = sqlite3_value_double(v);
+    if (d >= -9223372036854775808.0 && d < 9223372036854775808.0 && d == std::floor(d)) {
+      id = RowId(d);
+      return true;
+    }
+  }
+  return false;
+}
+
+// The largest double <= i and the smallest double >= i.
+double double_below(sqlite3_int64 i) {
+  double d = double(i);
+  if (d > -9223372036854775808.0 && d < 9223372036854775808.0 && sqlite3_int64(d) <= i) return d;
+  if (d >= 9223372036854775808.0) return std::nextafter(d, 0.0);
+  return sqlite3_int64(d) > i ? std::nextafter(d, -INFINITY) : d;
+}
+double double_above(sqlite3_int64 i) {
+  double d = double(i);
+  if (d >= 9223372036854775808.0) return d;  // 2^63 > every int64
+  return sqlite3_int64(d) < i ? std::nextafter(d, INFINITY) : d;
+}
+
+// Adds "column op value" to the window with SQL's comparison rules: the columns hold reals, an
+// integer operand compares exactly, NULL matches nothing, text and blobs sort above numbers.
+void add_constraint(Window& w, int column, Op op, sqlite3_value* v) {
+  switch (sqlite3_value_type(v)) {
+    case SQLITE_NULL:
+      w.make_empty();
+      return;
+    case SQLITE_TEXT:
+    case SQLITE_BLOB:
+      if (op == Op::eq || op == Op::gt || op == Op::ge) w.make_empty();
+      return;
+    case SQLITE_INTEGER: {
+      const sqlite3_int64 i = sqlite3_value_int64(v);
+      const double below = double_below(i), above = double_above(i);
+      switch (op) {
+        case Op::eq:
+          if (below != above) w.make_empty();
+          w.add(column, op, below);
+          return;
+        case Op::le:
+        case Op::gt:
+          w.add(column, op, below);
+          return;
+        case Op::lt:
+        case Op::ge:
+          w.add(column, op, above);
+          return;
+      }
+      return;
+    }
+    default:
+      w.add(column, op, sqlite3_value_double(v));
+  }
+}
+
+// ---- Plans --------------------------------------------------------------------------------
+
+enum Plan : int { plan_scan = 0, plan_rowid = 1, plan_window = 2 };
+
+char op_code(unsigned char op) {
+  switch (op) {
+    case SQLITE_INDEX_CONSTRAINT_EQ:
+      return '=';
+    case SQLITE_INDEX_CONSTRAINT_LT:
+      return '<';
+    case SQLITE_INDEX_CONSTRAINT_LE:
+      return 'l';
+    case SQLITE_INDEX_CONSTRAINT_GT:
+      return '>';
+    case SQLITE_INDEX_CONSTRAINT_GE:
+      return 'g';
+    default:
+      return 0;
+  }
+}
+Op op_of(char c) {
+  switch (c) {
+    case '=':
+      return Op::eq;
+    case '<':
+      return Op::lt;
+    case 'l':
+      return Op::le;
+    case '>':
+      return Op::gt;
+    default:
+      return Op::ge;
+  }
+}
+
+struct Cursor : sqlite3_vtab_cursor {
+  std::vector<Hit> hits;
+  std::size_t at = 0;
+};
+
+RTreeTable& table_of(sqlite3_vtab* v) {
+  return *static_cast<RTreeTable*>(v);
+}
+
+// ---- Creating and connecting --------------------------------------------------------------
+
+int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_vtab** out,
+            char** err, bool create) {
+  auto table = std::make_unique<RTreeTable>();
+  std::memset(static_cast<sqlite3_vtab*>(table.get()), 0, sizeof(sqlite3_vtab));
+  try {
+    const int columns = argc - 3;
+    std::vector<std::string> names, aux_names;
+    for (int i = 3; i < argc; ++i) {
+      std::string a = argv[i];
+      while (!a.empty() && (a.front() == ' ' || a.front() == '\t'))
+        a.erase(0, 1);
+      while (!a.empty() && (a.back() == ' ' || a.back() == '\t'))
+        a.pop_back();
+      if (a.empty()) throw SqlError{SQLITE_ERROR, "loci_rtree: an empty column name"};
+      if (a[0] == '+') {
+        if (names.size() < 1 + kCoordinates)
+          throw SqlError{SQLITE_ERROR,
+                         "loci_rtree: +aux columns come after id, minx, maxx, "
+                         "miny, maxy"};
+        aux_names.push_back(a.substr(1));
+      } else {
+        if (!aux_names.empty()) throw SqlError{SQLITE_ERROR, "loci_rtree: +aux columns come last"};
+        names.push_back(a);
+      }
+    }
+    if (names.size() != 1 + kCoordinates)
+      throw SqlError{SQLITE_ERROR,
+                     format_sql("loci_rtree: expected (id, minx, maxx, miny, maxy [, +aux ...]), "
+                                "got %d column%s before the +aux ones (2-dimensional boxes only)",
+                                int(names.size()), names.size() == 1 ? "" : "s")};
+    (void)columns;
+    table->db = db;
+    table->schema = argv[1];
+    table->name = argv[2];
+    table->aux_count = int(aux_names.size());
+    table->registry = *static_cast<std::shared_ptr<Registry>*>(aux);
+
+    std::string decl = "CREATE TABLE x(";
+    for (std::size_t i = 0; i < names.size(); ++i)
+      decl += (i ? ", " : "") + names[i];
+    for (const auto& a : aux_names)
+      decl += ", " + a;
+    decl += ")";
+    if (sqlite3_declare_vtab(db, decl.c_str()) != SQLITE_OK)
+      throw SqlError{SQLITE_ERROR, std::string("loci_rtree: ") + sqlite3_errmsg(db)};
+    sqlite3_vtab_config(db, SQLITE_VTAB_CONSTRAINT_SUPPORT, 1);
+
+    if (create) {
+      const RTreeTable& t = *table;
+      exec(db, format_sql("CREATE TABLE %s(n INTEGER PRIMARY KEY, data BLOB);"
+                          "CREATE TABLE %s(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, "
+                          "miny REAL, maxy REAL);"
+                          "CREATE TABLE %s(id INTEGER PRIMARY KEY);"
+                          "CREATE TABLE %s(k TEXT PRIMARY KEY, v);"
+                          "INSERT INTO %s VALUES('format', %d), ('generation', 0);",
+                          t.shadow("node").c_str(), t.shadow("delta").c_str(),
+                          t.shadow("dead").c_str(), t.shadow("meta").c_str(),
+                          t.shadow("meta").c_str(), int(RTreeIndex::kFormat)));
+      if (t.aux_count) {
+        std::string sql = "CREATE TABLE " + t.shadow("aux") + "(id INTEGER PRIMARY KEY";
+        for (int i = 0; i < t.aux_count; ++i)
+          sql += format_sql(", a%d", i);
+        exec(db, sql + ")");
+      }
+    }
+    table->prepare_statements();
+    table->registry->tables.push_back(table.get());
+    *out = table.release();
+    return SQLITE_OK;
+  } catch (const SqlError& e) {
+    *err = sqlite3_mprintf("%s", e.message.c_str());
+    return e.code;
+  } catch (const std::bad_alloc&) {
+    return SQLITE_NOMEM;
+  } catch (const std::exception& e) {
+    *err = sqlite3_mprintf("loci_rtree: %s", e.what());
+    return SQLITE_ERROR;
+  }
+}
+
+int x_create(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_vtab** out,
+             char** err) {
+  return connect(db, aux, argc, argv, out, err, true);
+}
+int x_connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_vtab** out,
+              char** err) {
+  return connect(db, aux, argc, argv, out, err, false);
+}
+
+int x_disconnect(sqlite3_vtab* v) {
+  RTreeTable* t = &table_of(v);
+  auto& tables = t->registry->tables;
+  std::erase(tables, t);
+  delete t;
+  return SQLITE_OK;
+}
+
+int x_destroy(sqlite3_vtab* v) {
+  RTreeTable& t = table_of(v);
+  const int rc = guarded(v, [&] {
+    std::string sql;
+    for (const char* s : kShadowSuffixes)
+      sql += "DROP TABLE IF EXISTS " + t.shadow(s) + ";";
+    t.finalize_statements();  // they hold the shadow tables open
+    exec(t.db, sql);
+    return SQLITE_OK;
+  });
+  if (rc != SQLITE_OK) return rc;
+  return x_disconnect(v);
+}
+
+// ---- Planning -----------------------------------------------------------------------------
+
+int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
+  return guarded(v, [&] {
+    // A lookup by id beats any window.
+    for (int i = 0; i < info->nConstraint; ++i) {
+      const auto& c = info->aConstraint[i];
+      if (c.usable && c.op == SQLITE_INDEX_CONSTRAINT_EQ && c.iColumn <= col_id) {
+        info->aConstraintUsage[i].argvIndex = 1;
+        info->aConstraintUsage[i].omit = 0;  // SQLite checks the id's type rules again
+        info->idxNum = plan_rowid;
+        info->estimatedCost = 10.0;
+        info->estimatedRows = 1;
+        info->idxFlags = SQLITE_INDEX_SCAN_UNIQUE;
+        return SQLITE_OK;
+      }
+    }
+    std::string codes;
+    int arg = 0;
+    for (int i = 0; i < info->nConstraint; ++i) {
+      const auto& c = info->aConstraint[i];
+      const char code = op_code(c.op);
+      if (!c.usable || !code || c.iColumn < col_minx || c.iColumn > col_maxy) continue;
+      if (arg == 30) break;
+      codes += code;
+      codes += char('0' + c.iColumn);
+      info->aConstraintUsage[i].argvIndex = ++arg;
+      info->aConstraintUsage[i].omit = 1;
+    }
+    const RTreeTable& t = table_of(v);
+    const double rows = t.index ? double(std::max<std::size_t>(t.index->size(), 1)) : 1e6;
+    if (arg == 0) {
+      info->idxNum = plan_scan;
+      info->estimatedCost = 2.0 * rows + 1e5;
+      info->estimatedRows = sqlite3_int64(rows);
+      return SQLITE_OK;
+    }
+    info->idxNum = plan_window;
+    info->idxStr = sqlite3_mprintf("%s", codes.c_str());
+    if (!info->idxStr) return SQLITE_NOMEM;
+    info->needToFreeIdxStr = 1;
+    // Each constraint on another column narrows the window: the more, the cheaper.
+    info->estimatedCost = 20.0 + rows / double(1 << std::min(2 * arg, 20));
+    info->estimatedRows = sqlite3_int64(std::max(1.0, rows / double(1 << std::min(2 * arg, 20))));
+    return SQLITE_OK;
+  });
+}
+
+// ---- Reading ------------------------------------------------------------------------------
+
+int x_open(sqlite3_vtab*, sqlite3_vtab_cursor** out) {
+  auto* c = new (std::nothrow) Cursor();
+  if (!c) return SQLITE_NOMEM;
+  *out = c;
+  return SQLITE_OK;
+}
+int x_close(sqlite3_vtab_cursor* c) {
+  delete static_cast<Cursor*>(c);
+  return SQLITE_OK;
+}
+
+int x_filter(sqlite3_vtab_cursor* cur, int plan, const char* codes, int argc,
+             sqlite3_value** argv) {
+  Cursor& c = *static_cast<Cursor*>(cur);
+  return guarded(cur->pVtab, [&] {
+    RTreeIndex& index = table_of(cur->pVtab).current();
+    c.hits.clear();
+    c.at = 0;
+    if (plan == plan_rowid) {
+      RowId id;
+      if (argc == 1 && row_id(argv[0], id)) {
+        if (auto b = index.find(id)) c.hits.push_back({id, *b});
+      } else if (argc == 1 && sqlite3_value_type(argv[0]) != SQLITE_NULL) {
+        index.scan(c.hits);  // not an integer: SQLite's own comparison decides
+      }
+    } else if (plan == plan_window) {
+      Window w;
+      for (int i = 0; i < argc && codes && codes[2 * i]; ++i)
+        add_constraint(w, codes[2 * i + 1] - '0', op_of(codes[2 * i]), argv[i]);
+      if (w.unbounded() && !w.empty())
+        index.scan(c.hits);
+      else
+        index.window(w, c.hits);
+    } else {
+      index.scan(c.hits);
+    }
+    return SQLITE_OK;
+  });
+}
+
+int x_next(sqlite3_vtab_cursor* cur) {
+  ++static_cast<Cursor*>(cur)->at;
+  return SQLITE_OK;
+}
+int x_eof(sqlite3_vtab_cursor* cur) {
+  const Cursor& c = *static_cast<Cursor*>(cur);
+  return c.at >= c.hits.size();
+}
+
+int x_column(sqlite3_vtab_cursor* cur, sqlite3_context* ctx, int column) {
+  const Cursor& c = *static_cast<Cursor*>(cur);
+  const Hit& h = c.hits[c.at];
+  if (column == col_id) {
+    sqlite3_result_int64(ctx, h.id);
+    return SQLITE_OK;
+  }
+  if (column <= col_maxy) {
+    sqlite3_result_double(ctx, column_of(h.box, column));
+    return SQLITE_OK;
+  }
+  return guarded(cur->pVtab, [&] {
+    RTreeTable& t = table_of(cur->pVtab);
+    Statement& s = t.get_aux;
+    s.bind(1, sqlite3_int64(h.id));
+    if (s.step()) sqlite3_result_value(ctx, sqlite3_column_value(s.get(), column - col_maxy));
+    s.reset();
+    return SQLITE_OK;
+  });
+}
+
+int x_rowid(sqlite3_vtab_cursor* cur, sqlite_int64* id) {
+  const Cursor& c = *static_cast<Cursor*>(cur);
+  *id = c.hits[c.at].id;
+  return SQLITE_OK;
+}
+
+// ---- Writing ------------------------------------------------------------------------------
+
+int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_rowid) {
+  RTreeTable& t = table_of(v);
+  return guarded(v, [&] {
+    RTreeIndex& index = t.current();
+    RowId old_id = 0;
+    const bool has_old = sqlite3_value_type(argv[0]) != SQLITE_NULL;
+    if (has_old) old_id = sqlite3_value_int64(argv[0]);
+    if (argc == 1) {
+      if (index.erase(old_id) && t.aux_count) {
+        t.drop_aux.bind(1, sqlite3_int64(old_id));
+        t.drop_aux.run();
+      }
+      return SQLITE_OK;
+    }
+    // argv[1] the new rowid, argv[2] the id column, argv[3..6] the box, then the aux values.
+    RowId id = 0;
+    sqlite3_value* given = sqlite3_value_type(argv[2]) != SQLITE_NULL   ? argv[2]
+                           : sqlite3_value_type(argv[1]) != SQLITE_NULL ? argv[1]
+                                                                        : nullptr;
+    if (given) {
+      if (!row_id(given, id))
+        throw SqlError{SQLITE_MISMATCH,
+                       format_sql("loci_rtree %s: the id must be an integer", t.name.c_str())};
+    } else if (has_old) {
+      id = old_id;
+    } else {
+      if (index.max_id() == std::numeric_limits<RowId>::max())
+        throw SqlError{SQLITE_FULL, format_sql("loci_rtree %s: no id left", t.name.c_str())};
+      id = index.any_row() ? index.max_id() + 1 : 1;
+    }
+    Box2 b;
+    b.min[0] = coordinate(argv[3], "minx", t);
+    b.max[0] = coordinate(argv[4], "maxx", t);
+    b.min[1] = coordinate(argv[5], "miny", t);
+    b.max[1] = coordinate(argv[6], "maxy", t);
+    for (int a = 0; a < 2; ++a)
+      if (b.min[a] > b.max[a])
+        throw SqlError{SQLITE_CONSTRAINT,
+                       format_sql("loci_rtree %s: %s > %s for id %lld", t.name.c_str(),
+                                  a ? "miny" : "minx", a ? "maxy" : "maxx", (long long)id)};
+    if ((!has_old || id != old_id) && index.find(id)) {
+      if (sqlite3_vtab_on_conflict(t.db) != SQLITE_REPLACE)
+        throw SqlError{SQLITE_CONSTRAINT, format_sql("UNIQUE constraint failed: %s.id (%lld)",
+                                                     t.name.c_str(), (long long)id)};
+      index.erase(id);
+    }
+    if (has_old && id != old_id) {
+      index.erase(old_id);
+      if (t.aux_count) {
+        t.drop_aux.bind(1, sqlite3_int64(old_id));
+        t.drop_aux.run();
+      }
+    }
+    index.put(id, b);
+    if (t.aux_count) {
+      t.put_aux.bind(1, sqlite3_int64(id));
+      for (int i = 0; i < t.aux_count; ++i)
+        sqlite3_bind_value(t.put_aux.get(), 2 + i, argv[7 + i]);
+      t.put_aux.run();
+    }
+    if (!has_old) *new_rowid = id;
+    return SQLITE_OK;
+  });
+}
+
+// ---- Transactions -------------------------------------------------------------------------
+
+int x_begin(sqlite3_vtab*) {
+  return SQLITE_OK;
+}
+int x_sync(sqlite3_vtab* v) {
+  return guarded(v, [&] { return table_of(v).flush(true), SQLITE_OK; });
+}
+int x_commit(sqlite3_vtab*) {
+  return SQLITE_OK;
+}
+int x_rollback(sqlite3_vtab* v) {
+  table_of(v).forget();
+  return SQLITE_OK;
+}
+int x_savepoint(sqlite3_vtab* v, int) {
+  return guarded(v, [&] { return table_of(v).flush(false), SQLITE_OK; });
+}
+int x_release(sqlite3_vtab*, int) {
+  return SQLITE_OK;
+}
+int x_rollback_to(sqlite3_vtab* v, int) {
+  table_of(v).forget();
+  return SQLITE_OK;
+}
+
+int x_rename(sqlite3_vtab* v, const char* new_name) {
+  RTreeTable& t = table_of(v);
+  return guarded(v, [&] {
+    t.flush(false);
+    std::string sql;
+    for (const char* s : kShadowSuffixes) {
+      if (std::strcmp(s, "aux") == 0 && !t.aux_count) continue;
+      sql += format_sql("ALTER TABLE %s RENAME TO \"%w_%s\";", t.shadow(s).c_str(), new_name, s);
+    }
+    t.finalize_statements();  // statements on the old names go before the tables move
+    exec(t.db, sql);
+    t.name = new_name;
+    t.prepare_statements();
+    return SQLITE_OK;
+  });
+}
+
+int x_shadow_name(const char* suffix) {
+  for (const char* s : kShadowSuffixes)
+    if (sqlite3_stricmp(suffix, s) == 0) return 1;
+  return 0;
+}
+
+sqlite3_module rtree_module() {
+  sqlite3_module m{};
+  m.iVersion = 3;
+  m.xCreate = x_create;
+  m.xConnect = x_connect;
+  m.xBestIndex = x_best_index;
+  m.xDisconnect = x_disconnect;
+  m.xDestroy = x_destroy;
+  m.xOpen = x_open;
+  m.xClose = x_close;
+  m.xFilter = x_filter;
+  m.xNext = x_next;
+  m.xEof = x_eof;
+  m.xColumn = x_column;
+  m.xRowid = x_rowid;
+  m.xUpdate = x_update;
+  m.xBegin = x_begin;
+  m.xSync = x_sync;
+  m.xCommit = x_commit;
+  m.xRollback = x_rollback;
+  m.xRename = x_rename;
+  m.xSavepoint = x_savepoint;
+  m.xRelease = x_release;
+  m.xRollbackTo = x_rollback_to;
+  m.xShadowName = x_shadow_name;
+  return m;
+}
+
+const sqlite3_module kRTreeModule = rtree_module();
+
+void free_registry(void* p) {
+  delete static_cast<std::shared_ptr<Registry>*>(p);
+}
+
+}  // namespace
+
+// ---- RTreeTable ---------------------------------------------------------------------------
+
+std::string RTreeTable::shadow(const char* suffix) const {
+  return format_sql("\"%w\".\"%w_%s\"", schema.c_str(), name.c_str(), suffix);
+}
+
+void RTreeTable::finalize_statements() {
+  for (Statement* s : {&get_generation, &set_generation, &read_node, &write_node, &clear_node,
+                       &read_delta, &put_delta, &drop_delta, &clear_delta, &read_dead, &put_dead,
+                       &clear_dead, &get_aux, &put_aux, &drop_aux})
+    s->finalize();
+}
+
+void RTreeTable::prepare_statements() {
+  const auto sql = [&](const char* fmt, const char* suffix) {
+    return format_sql(fmt, shadow(suffix).c_str());
+  };
+  get_generation.prepare(db, sql("SELECT v FROM %s WHERE k = 'generation'", "meta"));
+  set_generation.prepare(db, sql("UPDATE %s SET v = ?1 WHERE k = 'generation'", "meta"));
+  read_node.prepare(db, sql("SELECT n, data FROM %s ORDER BY n", "node"));
+  write_node.prepare(db, sql("INSERT INTO %s(n, data) VALUES(?1, ?2)", "node"));
+  clear_node.prepare(db, sql("DELETE FROM %s", "node"));
+  read_delta.prepare(db, sql("SELECT id, minx, maxx, miny, maxy FROM %s", "delta"));
+  put_delta.prepare(db, sql("INSERT OR REPLACE INTO %s VALUES(?1, ?2, ?3, ?4, ?5)", "delta"));
+  drop_delta.prepare(db, sql("DELETE FROM %s WHERE id = ?1", "delta"));
+  clear_delta.prepare(db, sql("DELETE FROM %s", "delta"));
+  read_dead.prepare(db, sql("SELECT id FROM %s", "dead"));
+  put_dead.prepare(db, sql("INSERT OR IGNORE INTO %s VALUES(?1)", "dead"));
+  clear_dead.prepare(db, sql("DELETE FROM %s", "dead"));
+  if (aux_count) {
+    get_aux.prepare(db, sql("SELECT * FROM %s WHERE id = ?1", "aux"));
+    std::string values = "?1";
+    for (int i = 0; i < aux_count; ++i)
+      values += format_sql(", ?%d", i + 2);
+    put_aux.prepare(db, format_sql("INSERT OR REPLACE INTO %s VALUES(%s)", shadow("aux").c_str(),
+                                   values.c_str()));
+    drop_aux.prepare(db, sql("DELETE FROM %s WHERE id = ?1", "aux"));
+  }
+}
+
+RTreeIndex RTreeTable::load_stored() {
+  RTreeIndex::Header h{};
+  std::memcpy(h.magic, RTreeIndex::kMagic, sizeof h.magic);
+  h.format = RTreeIndex::kFormat;
+  h.node_size = RTreeIndex::Packed::node_size;
+  h.payload_bytes = 0;
+
+  struct Reader {
+    Statement& s;
+    sqlite3_int64 next = 1;
+    const std::byte* data = nullptr;
+    std::size_t left = 0;
+    bool done = false;
+    bool more() {
+      while (left == 0 && !done) {
+        if (!s.step()) {
+          done = true;
+          break;
+        }
+        if (sqlite3_column_int64(s.get(), 0) != next++)
+          throw Error("the %_node chunks are not numbered 1, 2, 3, ...");
+        data = static_cast<const std::byte*>(sqlite3_column_blob(s.get(), 1));
+        left = std::size_t(sqlite3_column_bytes(s.get(), 1));
+      }
+      return left != 0;
+    }
+  } reader{read_node};
+
+  struct ResetOnExit {
+    Statement& s;
+    ~ResetOnExit() { s.reset(); }
+  } reset_node{read_node};
+  if (read_node.step()) {
+    if (sqlite3_column_int64(read_node.get(), 0) != 0 ||
+        sqlite3_column_bytes(read_node.get(), 1) != int(sizeof h))
+      throw Error("the %_node header is missing or has the wrong size");
+    std::memcpy(&h, sqlite3_column_blob(read_node.get(), 1), sizeof h);
+  } else {
+    reader.done = true;  // never written: empty
+  }
+  const auto read = [&](std::span<std::byte> dst) {
+    while (!dst.empty()) {
+      if (!reader.more()) return false;
+      const std::size_t n = std::min(dst.size(), reader.left);
+      std::memcpy(dst.data(), reader.data, n);
+      reader.data += n;
+      reader.left -= n;
+      dst = dst.subspan(n);
+    }
+    return true;
+  };
+
+  std::vector<Hit> delta;
+  {
+    struct R {
+      Statement& s;
+      ~R() { s.reset(); }
+    } r{read_delta};
+    while (read_delta.step()) {
+      sqlite3_stmt* s = read_delta.get();
+      for (int i = 1; i <= 4; ++i)
+        if (sqlite3_column_type(s, i) != SQLITE_FLOAT &&
+            sqlite3_column_type(s, i) != SQLITE_INTEGER)
+          throw Error("%_delta holds a coordinate that is not a number");
+      delta.push_back({sqlite3_column_int64(s, 0),
+                       Box2{{{sqlite3_column_double(s, 1), sqlite3_column_double(s, 3)}},
+                            {{sqlite3_column_double(s, 2), sqlite3_column_double(s, 4)}}}});
+    }
+  }
+  std::vector<RowId> dead;
+  {
+    struct R {
+      Statement& s;
+      ~R() { s.reset(); }
+    } r{read_dead};
+    while (read_dead.step())
+      dead.push_back(sqlite3_column_int64(read_dead.get(), 0));
+  }
+  return RTreeIndex::load(h, read, std::move(delta), std::move(dead));
+}
+
+RTreeIndex& RTreeTable::current() {
+  if (index && !index->has_touched()) {
+    unsigned v = 0;
+    const bool known =
+        sqlite3_file_control(db, schema.c_str(), SQLITE_FCNTL_DATA_VERSION, &v) == SQLITE_OK;
+    if (!(known && data_version_known && v == data_version)) {
+      sqlite3_int64 g = -1;
+      if (get_generation.step()) g = sqlite3_column_int64(get_generation.get(), 0);
+      get_generation.reset();
+      if (g != generation) index.reset();
+      data_version = v;
+      data_version_known = known;
+    }
+  }
+  if (!index) {
+    sqlite3_int64 g = -1;
+    if (get_generation.step()) g = sqlite3_column_int64(get_generation.get(), 0);
+    get_generation.reset();
+    try {
+      index = std::make_unique<RTreeIndex>(load_stored());
+    } catch (const Error& e) {
+      throw SqlError{
+          SQLITE_CORRUPT_VTAB,
+          format_sql("loci_rtree %s: the stored index is corrupt: %s", name.c_str(), e.what())};
+    }
+    generation = g;
+  }
+  return *index;
+}
+
+void RTreeTable::bump_generation() {
+  set_generation.bind(1, sqlite3_int64(generation + 1));
+  set_generation.run();
+  ++generation;
+}
+
+void RTreeTable::write_base() {
+  clear_node.run();
+  const RTreeIndex::Header h = index->header();
+  write_node.bind(1, sqlite3_int64(0));
+  sqlite3_bind_blob(write_node.get(), 2, &h, int(sizeof h), SQLITE_STATIC);
+  write_node.run();
+  std::vector<std::byte> chunk;
+  chunk.reserve(kChunkBytes);
+  sqlite3_int64 n = 1;
+  const auto emit = [&] {
+    write_node.bind(1, n++);
+    sqlite3_bind_blob(write_node.get(), 2, chunk.data(), int(chunk.size()), SQLITE_STATIC);
+    write_node.run();
+    chunk.clear();
+  };
+  for (std::span<const std::byte> part : index->payload()) {
+    while (!part.empty()) {
+      const std::size_t take = std::min(part.size(), kChunkBytes - chunk.size());
+      chunk.insert(chunk.end(), part.begin(), part.begin() + std::ptrdiff_t(take));
+      part = part.subspan(take);
+      if (chunk.size() == kChunkBytes) emit();
+    }
+  }
+  if (!chunk.empty()) emit();
+  clear_delta.run();
+  clear_dead.run();
+}
+
+void RTreeTable::flush(bool may_repack) {
+  if (!index || !index->has_touched()) return;
+  if (may_repack && index->wants_repack()) {
+    index->repack();
+    write_base();
+  } else {
+    for (RowId id : index->take_touched()) {
+      if (auto b = index->delta_box(id)) {
+        put_delta.bind(1, sqlite3_int64(id));
+        put_delta.bind(2, b->min[0]);
+        put_delta.bind(3, b->max[0]);
+        put_delta.bind(4, b->min[1]);
+        put_delta.bind(5, b->max[1]);
+        put_delta.run();
+      } else {
+        drop_delta.bind(1, sqlite3_int64(id));
+        drop_delta.run();
+      }
+      if (index->is_dead(id)) {
+        put_dead.bind(1, sqlite3_int64(id));
+        put_dead.run();
+      }
+    }
+  }
+  bump_generation();
+}
+
+std::string RTreeTable::check() {
+  try {
+    RTreeIndex stored = load_stored();
+    stored.validate();
+    RTreeIndex& live = current();
+    live.validate();
+    if (!live.has_touched() && !live.same_rows(stored))
+      return "the index in memory differs from the stored one";
+    if (aux_count) {
+      Statement ids;
+      ids.prepare(db, format_sql("SELECT id FROM %s", shadow("aux").c_str()));
+      std::size_t count = 0;
+      while (ids.step()) {
+        ++count;
+        const RowId id = sqlite3_column_int64(ids.get(), 0);
+        if (!live.find(id))
+          return format_sql("%%_aux holds id %lld, which has no box", (long long)id);
+      }
+      if (count != live.size())
+        return format_sql("%%_aux holds %lld rows for %lld boxes", (long long)count,
+                          (long long)live.size());
+    }
+    return "ok";
+  } catch (const SqlError& e) {
+    return e.message;
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+}
+
+RTreeTable* Registry::find(std::string_view name) const {
+  RTreeTable* found = nullptr;
+  for (RTreeTable* t : tables) {
+    const std::string qualified = t->schema + "." + t->name;
+    const auto same = [&](const std::string& s) {
+      return s.size() == name.size() && strncasecmp(s.data(), name.data(), s.size()) == 0;
+    };
+    if (same(qualified)) return t;
+    if (same(t->name) && (!found || t->schema == "main")) found = t;
+  }
+  return found;
+}
+
+RTreeTable& table_named(sqlite3* db, const Registry& registry, const char* name,
+                        const char* function) {
+  if (!name) throw SqlError{SQLITE_ERROR, format_sql("%s: the table name is NULL", function)};
+  if (RTreeTable* t = registry.find(name)) return *t;
+  // Not connected on this connection yet: naming it in a statement connects it.
+  sqlite3_stmt* s = nullptr;
+  const std::string dot = name;
+  std::string sql;
+  if (const auto p = dot.find('.'); p != std::string::npos && !registry.find(dot.substr(p + 1)))
+    sql = format_sql("SELECT 1 FROM \"%w\".\"%w\" LIMIT 0", dot.substr(0, p).c_str(),
+                     dot.substr(p + 1).c_str());
+  else
+    sql = format_sql("SELECT 1 FROM \"%w\" LIMIT 0", name);
+  const int rc = sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr);
+  sqlite3_finalize(s);
+  if (rc != SQLITE_OK)
+    throw SqlError{SQLITE_ERROR, format_sql("%s: no such table: %s", function, name)};
+  if (RTreeTable* t = registry.find(name)) return *t;
+  throw SqlError{SQLITE_ERROR, format_sql("%s: %s is not a loci_rtree table", function, name)};
+}
+
+int register_rtree(sqlite3* db, const std::shared_ptr<Registry>& registry) {
+  return sqlite3_create_module_v2(db, "loci_rtree", &kRTreeModule,
+                                  new std::shared_ptr<Registry>(registry), free_registry);
+}
+
+}  // namespace loci::sqlite
