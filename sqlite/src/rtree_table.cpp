@@ -64,14 +64,18 @@ double double_above(sqlite3_int64 i) {
   return sqlite3_int64(d) < i ? std::nextafter(d, INFINITY) : d;
 }
 
-// Adds "column op value" to the window with SQL's comparison rules: the columns hold reals, an
-// integer operand compares exactly, NULL matches nothing, text and blobs sort above numbers.
+// Adds "column op value" to the window with SQL's comparison rules for a REAL column: an
+// integer operand compares exactly, NULL matches nothing, text that reads as a number is that
+// number, other text and blobs sort above every number.
 void add_constraint(Window& w, int column, Op op, sqlite3_value* v) {
   switch (sqlite3_value_type(v)) {
     case SQLITE_NULL:
       w.make_empty();
       return;
     case SQLITE_TEXT:
+      // The coordinate columns are REAL: text that reads as a number compares as one.
+      if (sqlite3_value_numeric_type(v) != SQLITE_TEXT) return add_constraint(w, column, op, v);
+      [[fallthrough]];
     case SQLITE_BLOB:
       if (op == Op::eq || op == Op::gt || op == Op::ge) w.make_empty();
       return;
@@ -182,9 +186,10 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
     table->aux_count = int(aux_names.size());
     table->registry = *static_cast<std::shared_ptr<Registry>*>(aux);
 
+    // Typed like the values they hold, so SQL's comparison rules are those of REAL columns.
     std::string decl = "CREATE TABLE x(";
     for (std::size_t i = 0; i < names.size(); ++i)
-      decl += (i ? ", " : "") + names[i];
+      decl += (i ? ", " : "") + names[i] + (i ? " REAL" : " INTEGER");
     for (const auto& a : aux_names)
       decl += ", " + a;
     decl += ")";

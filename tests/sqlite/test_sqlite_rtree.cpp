@@ -1,0 +1,514 @@
+// The loci SQLite extension through the real SQLite library: loci_rtree against a plain table
+// answering the same SQL (brute force, exact) and against SQLite's own rtree, loci_nearest
+// against brute force, transactions, reopening, a killed writer, errors and corruption.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "sqlite_support.hpp"
+#include "support/random_data.hpp"
+#ifdef LOCI_HAVE_IO
+#include "loci/io/layer_reader.hpp"
+#endif
+
+namespace fs = std::filesystem;
+using loci::Box;
+using loci::test::Db;
+using loci::test::real;
+using loci::test::Row;
+
+namespace {
+
+// m(id, minx, maxx, miny, maxy): the plain table every answer is checked against.
+void make_tables(Db& db, const std::vector<Box<2>>& boxes, bool with_rtree = false) {
+  db.exec("CREATE TABLE m(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, miny REAL, maxy REAL)");
+  db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy)");
+  if (with_rtree) db.exec("CREATE VIRTUAL TABLE r USING rtree(id, minx, maxx, miny, maxy)");
+  // nums(value): 1 .. 10000, for bulk statements.
+  db.exec(
+      "CREATE TABLE nums AS WITH RECURSIVE s(value) AS (SELECT 1 UNION ALL SELECT value + 1 "
+      "FROM s WHERE value < 10000) SELECT value FROM s");
+  db.exec("BEGIN");
+  sqlite3_stmt* s = nullptr;
+  sqlite3_prepare_v2(db.get(), "INSERT INTO m VALUES(?, ?, ?, ?, ?)", -1, &s, nullptr);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    sqlite3_bind_int64(s, 1, sqlite3_int64(i + 1));
+    sqlite3_bind_double(s, 2, boxes[i].min[0]);
+    sqlite3_bind_double(s, 3, boxes[i].max[0]);
+    sqlite3_bind_double(s, 4, boxes[i].min[1]);
+    sqlite3_bind_double(s, 5, boxes[i].max[1]);
+    sqlite3_step(s);
+    sqlite3_reset(s);
+  }
+  sqlite3_finalize(s);
+  db.exec("INSERT INTO t SELECT * FROM m");
+  if (with_rtree) db.exec("INSERT INTO r SELECT * FROM m");
+  db.exec("COMMIT");
+}
+
+std::vector<Row> ids(Db& db, const std::string& table, const std::string& where) {
+  return db.rows("SELECT id FROM " + table + " WHERE " + where + " ORDER BY id");
+}
+
+std::vector<Row> all(Db& db, const std::string& table) {
+  return db.rows("SELECT id, minx, maxx, miny, maxy FROM " + table + " ORDER BY id");
+}
+
+// A random WHERE clause over the coordinate columns, in every form SQL allows.
+std::string random_where(std::mt19937_64& rng, const std::vector<Box<2>>& boxes) {
+  static const char* cols[] = {"minx", "maxx", "miny", "maxy"};
+  std::uniform_real_distribution<double> u(-50, 1050);
+  const auto value = [&](int col) -> std::string {
+    switch (rng() % 6) {
+      case 0: {  // exactly a stored coordinate
+        const auto& b = boxes[rng() % boxes.size()];
+        const double v = col == 0 ? b.min[0] : col == 1 ? b.max[0] : col == 2 ? b.min[1] : b.max[1];
+        return real(v);
+      }
+      case 1:
+        return std::to_string(int(u(rng)));  // an integer literal
+      default:
+        return real(u(rng));
+    }
+  };
+  const int form = int(rng() % 4);
+  if (form == 0) {  // the window of SQLite's rtree documentation
+    double x1 = u(rng), x2 = u(rng), y1 = u(rng), y2 = u(rng);
+    if (x1 > x2) std::swap(x1, x2);
+    if (y1 > y2) std::swap(y1, y2);
+    return "minx <= " + real(x2) + " AND maxx >= " + real(x1) + " AND miny <= " + real(y2) +
+           " AND maxy >= " + real(y1);
+  }
+  static const char* ops[] = {"<=", ">=", "<", ">", "="};
+  std::string w;
+  const int n = 1 + int(rng() % 4);
+  for (int i = 0; i < n; ++i) {
+    const int col = int(rng() % 4);
+    if (!w.empty()) w += " AND ";
+    if (rng() % 5 == 0) {
+      std::string a = value(col), b = value(col);
+      w += std::string(cols[col]) + " BETWEEN " + a + " AND " + b;
+    } else {
+      w += std::string(cols[col]) + " " + ops[rng() % (form == 3 ? 5 : 4)] + " " + value(col);
+    }
+  }
+  return w;
+}
+
+class SqliteRtree : public ::testing::TestWithParam<loci::test::Shape> {};
+
+TEST_P(SqliteRtree, WindowsMatchBruteForceAndSqliteRtreeWithoutItsFalseHits) {
+  const auto boxes = loci::test::make_boxes<2>(GetParam(), 3000, 11);
+  Db db;
+  make_tables(db, boxes, true);
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+  std::mt19937_64 rng(5);
+  for (int q = 0; q < 300; ++q) {
+    const std::string where = random_where(rng, boxes);
+    ASSERT_EQ(ids(db, "t", where), ids(db, "m", where)) << where;
+  }
+  // Windows starting a hair beyond a box's corner: SQLite's rtree rounds its float32 boxes
+  // outward and reports the box; loci does not.
+  std::size_t rtree_false_hits = 0;
+  for (std::size_t i = 0; i < 200; ++i) {
+    const auto& b = boxes[(i * 7919) % boxes.size()];
+    const double x1 = std::nextafter(b.max[0], INFINITY), y1 = std::nextafter(b.max[1], INFINITY);
+    const std::string where = "minx <= " + real(x1 + 1) + " AND maxx >= " + real(x1) +
+                              " AND miny <= " + real(y1 + 1) + " AND maxy >= " + real(y1);
+    const auto exact = ids(db, "m", where);
+    ASSERT_EQ(ids(db, "t", where), exact) << where;
+    const auto rtree = ids(db, "r", where);
+    for (const auto& row : exact)
+      ASSERT_TRUE(std::find(rtree.begin(), rtree.end(), row) != rtree.end())
+          << "rtree missed a row";
+    rtree_false_hits += rtree.size() - exact.size();
+  }
+  if (GetParam() != loci::test::Shape::on_a_line) EXPECT_GT(rtree_false_hits, 0u);
+}
+
+TEST_P(SqliteRtree, NearestMatchesBruteForce) {
+  const auto boxes = loci::test::make_boxes<2>(GetParam(), 2000, 12);
+  Db db;
+  make_tables(db, boxes);
+  // Some rows written after the packed build, some packed rows deleted and moved: the answer
+  // comes from the base and the delta at once.
+  db.exec("DELETE FROM t WHERE id % 17 = 0; DELETE FROM m WHERE id % 17 = 0;");
+  db.exec(
+      "UPDATE t SET minx = minx - 3, maxx = maxx + 1 WHERE id % 13 = 0;"
+      "UPDATE m SET minx = minx - 3, maxx = maxx + 1 WHERE id % 13 = 0;");
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(-100, 1100);
+  for (int q = 0; q < 100; ++q) {
+    const double x = u(rng), y = u(rng);
+    const std::size_t k = std::size_t(std::vector<int>{1, 5, 37, 3000}[q % 4]);
+    std::vector<std::pair<double, std::string>> brute;
+    for (const Row& r : all(db, "m")) {
+      const double dx = std::max({std::stod(r[1]) - x, 0.0, x - std::stod(r[2])});
+      const double dy = std::max({std::stod(r[3]) - y, 0.0, y - std::stod(r[4])});
+      brute.push_back({std::sqrt(dx * dx + dy * dy), r[0]});
+    }
+    std::sort(brute.begin(), brute.end());
+    const auto got = db.rows("SELECT id, distance FROM loci_nearest('t', " + real(x) + ", " +
+                             real(y) + ", " + std::to_string(k) + ")");
+    ASSERT_EQ(got.size(), std::min(k, brute.size()));
+    std::set<std::string> inside, expected_inside;
+    const std::string kth = got.empty() ? "" : got.back()[1];
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      ASSERT_EQ(got[i][1], real(brute[i].first)) << "rank " << i;  // nearest first, exact
+      if (got[i][1] != kth) inside.insert(got[i][0]), expected_inside.insert(brute[i].second);
+    }
+    EXPECT_EQ(inside, expected_inside);  // ties at the k-th distance may come in any order
+  }
+  // Usable in joins: three neighbours for every probe point.
+  db.exec(
+      "CREATE TABLE probes(x REAL, y REAL); INSERT INTO probes VALUES (0, 0), (500, 500), "
+      "(1000, 0)");
+  EXPECT_EQ(db.value("SELECT count(*) FROM probes p, loci_nearest('t', p.x, p.y, 3) n"), "9");
+  EXPECT_EQ(db.value("SELECT count(*) FROM loci_nearest('t', 1, 2, 0)"), "0");
+}
+
+INSTANTIATE_TEST_SUITE_P(Shapes, SqliteRtree, ::testing::ValuesIn(loci::test::kAllShapes),
+                         [](const auto& info) { return loci::test::name(info.param); });
+
+TEST(SqliteRtreeSql, ComparisonsFollowSqlRulesForEveryOperandType) {
+  Db db;
+  std::vector<Box<2>> boxes;
+  for (int i = 0; i < 50; ++i)
+    boxes.push_back({{{double(i), double(i % 7)}}, {{i + 0.5, i % 7 + 2.0}}});
+  boxes.push_back({{{9007199254740992.0, 0}}, {{9007199254740994.0, 1}}});  // 2^53, 2^53 + 2
+  make_tables(db, boxes);
+  for (const char* where : {"minx <= '3'",
+                            "minx >= '3'",
+                            "minx = 'a'",
+                            "minx < x'00'",
+                            "minx > NULL",
+                            "maxx <= NULL",
+                            "minx = 3",
+                            "minx = 3.0",
+                            "minx BETWEEN 4 AND 9",
+                            "maxy > 7",
+                            "minx >= 9007199254740993",
+                            "minx <= 9007199254740993",
+                            "maxx = 9007199254740994",
+                            "maxx < 9007199254740993",
+                            "maxx > 9007199254740993",
+                            "minx = 9007199254740993",
+                            "minx <= 10 AND minx >= 12",
+                            "minx >= 1e999",
+                            "minx <= -1e999",
+                            "maxx < 1e999",
+                            "miny > -1e308 AND maxy < 1e308 AND minx > 20.25"}) {
+    EXPECT_EQ(ids(db, "t", where), ids(db, "m", where)) << where;
+  }
+  // Lookups by id, with the id in any type SQLite accepts.
+  for (const char* where : {"id = 7", "rowid = 7", "id = 7.0", "id = '7'", "id = 7.5", "id = 0",
+                            "id = NULL", "id = 52"})
+    EXPECT_EQ(ids(db, "t", where), ids(db, "m", where)) << where;
+}
+
+TEST(SqliteRtreeSql, ThePlannerUsesTheIndex) {
+  Db db;
+  make_tables(db, loci::test::make_boxes<2>(loci::test::Shape::uniform, 100, 1));
+  const auto plan = [&](const std::string& q) {
+    std::string all;
+    for (const Row& r : db.rows("EXPLAIN QUERY PLAN " + q))
+      all += r.back() + "\n";
+    return all;
+  };
+  EXPECT_NE(plan("SELECT id FROM t WHERE minx <= 5 AND maxx >= 1 AND miny <= 5 AND maxy >= 1")
+                .find("VIRTUAL TABLE INDEX 2"),
+            std::string::npos);
+  EXPECT_NE(plan("SELECT * FROM t WHERE id = 5").find("VIRTUAL TABLE INDEX 1"), std::string::npos);
+  EXPECT_NE(plan("SELECT * FROM t WHERE maxy BETWEEN 1 AND 2").find("VIRTUAL TABLE INDEX 2"),
+            std::string::npos);
+  // A join probing the index for every row of another table.
+  db.exec("CREATE TABLE w(x1, y1, x2, y2)");
+  EXPECT_NE(plan("SELECT w.rowid, t.id FROM w JOIN t ON t.minx <= w.x2 AND t.maxx >= w.x1 AND "
+                 "t.miny <= w.y2 AND t.maxy >= w.y1")
+                .find("VIRTUAL TABLE INDEX 2"),
+            std::string::npos);
+}
+
+TEST(SqliteRtreeSql, AuxColumnsTravelWithTheirRows) {
+  Db db;
+  db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, x0, x1, y0, y1, +name, +weight)");
+  db.exec("INSERT INTO t VALUES (1, 0, 1, 0, 1, 'one', 1.5), (2, 2, 3, 2, 3, 'two', NULL)");
+  db.exec("INSERT INTO t(x0, x1, y0, y1, name) VALUES (5, 6, 5, 6, 'auto')");
+  EXPECT_EQ(db.rows("SELECT id, name, weight FROM t WHERE x0 >= 1 ORDER BY id"),
+            (std::vector<Row>{{"2", "two", "NULL"}, {"3", "auto", "NULL"}}));
+  db.exec("UPDATE t SET id = 10, name = 'ten' WHERE id = 1");
+  EXPECT_EQ(db.rows("SELECT id, name, weight FROM t WHERE id = 10"),
+            (std::vector<Row>{{"10", "ten", "1.5"}}));
+  db.exec("INSERT OR REPLACE INTO t VALUES (2, 7, 8, 7, 8, 'two again', 2)");
+  EXPECT_EQ(db.rows("SELECT id, x0, name FROM t ORDER BY id"),
+            (std::vector<Row>{{"2", "7", "two again"}, {"3", "5", "auto"}, {"10", "0", "ten"}}));
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+}
+
+// Random INSERT, UPDATE, DELETE, bulk inserts and deletes, applied to t and m alike, under
+// BEGIN / COMMIT / ROLLBACK, SAVEPOINT / RELEASE / ROLLBACK TO; after every step t answers
+// like m and loci_check passes.
+TEST(SqliteRtreeSql, RandomWritesFollowRollbackAndSavepoints) {
+  Db db;
+  make_tables(db, loci::test::make_boxes<2>(loci::test::Shape::uniform, 500, 3));
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(0, 1000);
+  int depth = 0;  // open savepoints, BEGIN counted as one
+  const auto both = [&](const std::string& sql) {
+    for (const char* table : {"t", "m"}) {
+      std::string s = sql;
+      for (std::size_t p; (p = s.find("$T")) != std::string::npos;)
+        s.replace(p, 2, table);
+      db.exec(s);
+    }
+  };
+  for (int step = 0; step < 400; ++step) {
+    const int what = int(rng() % 20);
+    const std::string x = real(u(rng)), y = real(u(rng));
+    const std::string id = std::to_string(1 + rng() % 900);
+    if (what < 5) {
+      both("INSERT OR REPLACE INTO $T VALUES(" + id + ", " + x + ", " + x + " + 4, " + y + ", " +
+           y + " + 2)");
+    } else if (what < 8) {
+      both("UPDATE $T SET minx = minx + 1, maxx = maxx + 2 WHERE id % 29 = " + id + " % 29");
+    } else if (what < 10) {
+      both("DELETE FROM $T WHERE id = " + id + " OR (minx < " + x + " AND minx > " + x + " - 5)");
+    } else if (what == 10) {  // a bulk insert, large enough for a repack at commit
+      both(
+          "INSERT OR REPLACE INTO $T SELECT value + 1000, value % 997, value % 997 + 1, value "
+          "% 991, value % 991 + 3 FROM nums WHERE value <= 6000");
+    } else if (what == 11) {
+      both("DELETE FROM $T WHERE id > 1000 AND id % 3 != 0");
+    } else if (what == 12) {
+      db.exec(depth == 0 ? "BEGIN" : "SAVEPOINT s" + std::to_string(depth));
+      ++depth;
+    } else if (what == 13 && depth > 0) {
+      --depth;
+      db.exec(depth == 0 ? "COMMIT" : "RELEASE s" + std::to_string(depth));
+    } else if (what == 14 && depth > 0) {
+      --depth;
+      db.exec(depth == 0 ? "ROLLBACK"
+                         : "ROLLBACK TO s" + std::to_string(depth) + "; RELEASE s" +
+                               std::to_string(depth));
+    } else if (what == 15) {
+      const std::string where = "minx <= " + x + " + 100 AND maxx >= " + x + " AND miny <= " + y +
+                                " + 100 AND maxy >= " + y;
+      ASSERT_EQ(ids(db, "t", where), ids(db, "m", where)) << "step " << step;
+    } else if (what == 16) {
+      ASSERT_EQ(all(db, "t"), all(db, "m")) << "step " << step;
+      ASSERT_EQ(db.value("SELECT loci_check('t')"), "ok") << "step " << step;
+    }
+  }
+  while (depth-- > 0)
+    db.exec(depth == 0 ? "COMMIT" : "RELEASE s" + std::to_string(depth));
+  EXPECT_EQ(all(db, "t"), all(db, "m"));
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    char tmpl[] = "/tmp/loci-sqlite-XXXXXX";
+    path_ = ::mkdtemp(tmpl);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+TEST(SqliteRtreeSql, SurvivesCloseAndReopen) {
+  TempDir dir;
+  const auto boxes = loci::test::make_boxes<2>(loci::test::Shape::clustered, 6000, 4);
+  std::vector<Row> before;
+  {
+    Db db(dir.file("a.db"));
+    make_tables(db, boxes);
+    db.exec("DELETE FROM t WHERE id % 5 = 0; DELETE FROM m WHERE id % 5 = 0");
+    db.exec("INSERT INTO t VALUES (99999, 1, 2, 3, 4); INSERT INTO m VALUES (99999, 1, 2, 3, 4)");
+    before = all(db, "t");
+    EXPECT_EQ(before, all(db, "m"));
+  }
+  Db db(dir.file("a.db"));
+  EXPECT_EQ(all(db, "t"), before);
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+  const std::string where = "minx <= 600 AND maxx >= 400 AND miny <= 600 AND maxy >= 400";
+  EXPECT_EQ(ids(db, "t", where), ids(db, "m", where));
+  // A second connection's write is seen by the first.
+  {
+    Db other(dir.file("a.db"));
+    other.exec("INSERT INTO t VALUES (123456, 500, 501, 500, 501)");
+  }
+  EXPECT_EQ(db.value("SELECT count(*) FROM t WHERE id = 123456"), "1");
+  EXPECT_EQ(db.value("SELECT id FROM loci_nearest('t', 500.5, 500.5, 1)"), "123456");
+}
+
+// A writer killed with SIGKILL in the middle of its transactions (including the repack at
+// commit) leaves database and index consistent: SQLite's journal puts the shadow tables back.
+TEST(SqliteRtreeSql, AWriterKilledMidTransactionLeavesItConsistent) {
+  TempDir dir;
+  const std::string path = dir.file("k.db");
+  {
+    Db db(path);
+    make_tables(db, loci::test::make_boxes<2>(loci::test::Shape::uniform, 2000, 6));
+  }
+  for (int round = 0; round < 4; ++round) {
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      sqlite3* raw = nullptr;
+      sqlite3_open(path.c_str(), &raw);
+      sqlite3_enable_load_extension(raw, 1);
+      if (sqlite3_load_extension(raw, LOCI_SQLITE_EXTENSION, nullptr, nullptr) != SQLITE_OK)
+        ::_exit(3);
+      for (int i = 0;; ++i) {
+        const std::string base = std::to_string(100000 + (round * 1000 + i) * 10000);
+        const std::string sql =
+            "BEGIN;"
+            "INSERT INTO t SELECT value + " +
+            base +
+            ", value % 1000, value % 1000 + 1, value % "
+            "777, value % 777 + 1 FROM nums WHERE value <= 5000;"
+            "INSERT INTO m SELECT value + " +
+            base +
+            ", value % 1000, value % 1000 + 1, value % "
+            "777, value % 777 + 1 FROM nums WHERE value <= 5000;"
+            "DELETE FROM t WHERE id % 7 = " +
+            std::to_string(i % 7) +
+            ";"
+            "DELETE FROM m WHERE id % 7 = " +
+            std::to_string(i % 7) +
+            ";"
+            "COMMIT;";
+        if (sqlite3_exec(raw, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) ::_exit(4);
+      }
+    }
+    ::usleep(useconds_t(60000 + round * 45000));
+    ::kill(pid, SIGKILL);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the writer stopped by itself, status " << status;
+    Db db(path);
+    ASSERT_EQ(db.value("SELECT loci_check('t')"), "ok") << "round " << round;
+    ASSERT_EQ(all(db, "t"), all(db, "m")) << "round " << round;
+  }
+}
+
+TEST(SqliteRtreeSql, BadInputIsAnSqlErrorWithAClearMessage) {
+  Db db;
+  EXPECT_NE(db.try_exec("CREATE VIRTUAL TABLE a USING loci_rtree(id, minx, maxx)")
+                .find("expected (id, minx, maxx, miny, maxy"),
+            std::string::npos);
+  EXPECT_NE(db.try_exec("CREATE VIRTUAL TABLE a USING loci_rtree(id, x0, x1, y0, y1, z0, z1)")
+                .find("2-dimensional"),
+            std::string::npos);
+  EXPECT_NE(
+      db.try_exec("CREATE VIRTUAL TABLE a USING loci_rtree(id, x0, +a, x1, y0, y1)").find("+aux"),
+      std::string::npos);
+  db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy)");
+  EXPECT_NE(db.try_exec("INSERT INTO t VALUES (1, NULL, 1, 0, 1)").find("minx is NULL"),
+            std::string::npos);
+  EXPECT_NE(db.try_exec("INSERT INTO t VALUES (1, 0, 'abc', 0, 1)").find("maxx is not a number"),
+            std::string::npos);
+  EXPECT_NE(db.try_exec("INSERT INTO t VALUES (1, 0, 1e999, 0, 1)").find("not finite"),
+            std::string::npos);
+  EXPECT_NE(db.try_exec("INSERT INTO t VALUES (1, 2, 1, 0, 1)").find("minx > maxx"),
+            std::string::npos);
+  EXPECT_NE(db.try_exec("INSERT INTO t VALUES ('x', 0, 1, 0, 1)").find("id must be an integer"),
+            std::string::npos);
+  {  // NaN bound from C arrives as NULL
+    sqlite3_stmt* s = nullptr;
+    sqlite3_prepare_v2(db.get(), "INSERT INTO t VALUES (1, ?, 1, 0, 1)", -1, &s, nullptr);
+    sqlite3_bind_double(s, 1, std::nan(""));
+    EXPECT_NE(sqlite3_step(s), SQLITE_DONE);
+    sqlite3_finalize(s);
+  }
+  db.exec("INSERT INTO t VALUES (1, 0, 1, 0, 1)");
+  EXPECT_NE(db.try_exec("INSERT INTO t VALUES (1, 0, 1, 0, 1)").find("UNIQUE constraint failed"),
+            std::string::npos);
+  // A failed statement in a transaction leaves the rows it had written undone.
+  db.exec("BEGIN");
+  EXPECT_NE(db.try_exec("INSERT INTO t VALUES (2, 0, 1, 0, 1), (3, 0, 1, 0, 1), (1, 0, 1, 0, 1)"),
+            "");
+  EXPECT_EQ(db.value("SELECT count(*) FROM t"), "1");
+  db.exec("COMMIT");
+  EXPECT_EQ(db.value("SELECT count(*) FROM t"), "1");
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+
+  EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('nosuch', 0, 0, 1)").find("no such table"),
+            std::string::npos);
+  db.exec("CREATE TABLE plain(a)");
+  EXPECT_NE(
+      db.error_of("SELECT * FROM loci_nearest('plain', 0, 0, 1)").find("not a loci_rtree table"),
+      std::string::npos);
+  EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', NULL, 0, 1)").find("x is NULL"),
+            std::string::npos);
+  EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', 0, 0, -1)").find("k must be"),
+            std::string::npos);
+  EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', 0, 0)").find("four arguments"),
+            std::string::npos);
+  EXPECT_NE(db.error_of("SELECT loci_check('nosuch')").find("no such table"), std::string::npos);
+}
+
+TEST(SqliteRtreeSql, CorruptShadowTablesAreReportedNotTrusted) {
+  TempDir dir;
+  const std::string path = dir.file("c.db");
+  {
+    Db db(path);
+    make_tables(db, loci::test::make_boxes<2>(loci::test::Shape::uniform, 5000, 8));
+    db.exec("UPDATE t_node SET data = substr(data, 1, 1000) WHERE n = 1");
+  }
+  {
+    Db db(path);
+    EXPECT_NE(db.error_of("SELECT count(*) FROM t").find("corrupt"), std::string::npos);
+    EXPECT_NE(db.value("SELECT loci_check('t')"), "ok");
+  }
+  {
+    Db db(path);
+    db.exec("DELETE FROM t_node WHERE n = 1; INSERT INTO t_node VALUES (1, zeroblob(1048576))");
+    EXPECT_NE(db.error_of("SELECT count(*) FROM t").find("corrupt"), std::string::npos);
+  }
+  {
+    Db db(path);
+    db.exec("DELETE FROM t_node; INSERT INTO t_delta VALUES (5, 2, 1, 0, 0)");
+    EXPECT_NE(db.error_of("SELECT count(*) FROM t").find("corrupt"), std::string::npos);
+  }
+}
+
+#ifdef LOCI_HAVE_IO
+// Real boxes: every segment of the bundled coastline sample.
+TEST(SqliteRtreeSql, BundledSampleSegmentsMatchBruteForce) {
+  const auto segs = loci::io::read_segments(std::string(LOCI_DATASETS_DIR) +
+                                            "/samples/coastline-denmark.geojson");
+  ASSERT_GT(segs.size(), 1000u);
+  std::vector<Box<2>> boxes;
+  for (const auto& s : segs)
+    boxes.push_back(s.segment.box());
+  Db db;
+  make_tables(db, boxes, true);
+  std::mt19937_64 rng(21);
+  for (int q = 0; q < 200; ++q) {
+    const auto& b = boxes[rng() % boxes.size()];
+    const double w = 0.01 * double(1 + rng() % 30);
+    const std::string where = "minx <= " + real(b.max[0] + w) + " AND maxx >= " + real(b.min[0]) +
+                              " AND miny <= " + real(b.max[1] + w) +
+                              " AND maxy >= " + real(std::nextafter(b.max[1], INFINITY));
+    ASSERT_EQ(ids(db, "t", where), ids(db, "m", where)) << where;
+  }
+  const auto near = db.rows("SELECT id FROM loci_nearest('t', 10.5, 55.5, 10)");
+  EXPECT_EQ(near.size(), 10u);
+}
+#endif
+
+}  // namespace
