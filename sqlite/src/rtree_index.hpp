@@ -51,75 +51,72 @@ inline double column_of(const Box2& b, int column) {
 
 enum class Op : std::uint8_t { eq, lt, le, gt, ge };
 
-// The coordinate constraints of a WHERE clause, answered exactly. `prune` is a box every
-// matching row's box meets (what the trees are searched with); matches() is the exact test.
+// The coordinate constraints of a WHERE clause, answered exactly. Each of the four columns
+// gets a lower and an upper bound (strict or not); `prune` is a box every matching row's box
+// meets (what the trees are searched with), matches() the exact test.
 class Window {
  public:
   // Adds "column op value". The value is exact: the caller has already turned SQL integers and
   // text into the double bound that compares the same way with every double.
   void add(int column, Op op, double value) {
-    if (count_ == kMax) return;  // more constraints than columns*ops: repeats add nothing
-    bounds_[count_++] = {column, op, value};
-    const int axis = (column == col_minx || column == col_maxx) ? 0 : 1;
-    // A row's minx and maxx lie inside its box's x extent, so either column >= v needs
-    // box.max >= v, and either column <= v needs box.min <= v.
-    if (op == Op::eq || op == Op::ge || op == Op::gt) lo_[axis] = std::max(lo_[axis], value);
-    if (op == Op::eq || op == Op::le || op == Op::lt) hi_[axis] = std::min(hi_[axis], value);
+    const int c = column - col_minx;
+    if (op == Op::eq || op == Op::ge || op == Op::gt) tighten_lo(c, value, op == Op::gt);
+    if (op == Op::eq || op == Op::le || op == Op::lt) tighten_hi(c, value, op == Op::lt);
+    bounded_ = true;
   }
   // A constraint no row can meet (a NULL operand, or a number compared above every text).
   void make_empty() { never_ = true; }
 
   bool empty() const {
-    for (int a = 0; a < 2; ++a)
-      if (lo_[a] > hi_[a] || lo_[a] > kMaxDouble || hi_[a] < -kMaxDouble) return true;
-    return never_;
+    if (never_) return true;
+    const Box2 p = prune();
+    for (int c = 0; c < 4; ++c)
+      if (lo_[c] > hi_[c] || (lo_[c] == hi_[c] && (lo_strict_[c] || hi_strict_[c]))) return true;
+    return p.min[0] > p.max[0] || p.min[1] > p.max[1];
   }
-  bool unbounded() const { return count_ == 0; }
+  bool unbounded() const { return !bounded_; }
+
+  // A row's minx and maxx lie inside its box's x extent, so a lower bound on either needs
+  // box.max >= it and an upper bound on either needs box.min <= it.
   Box2 prune() const {
     Box2 b;
     for (int a = 0; a < 2; ++a) {
-      b.min[a] = std::max(lo_[a], -kMaxDouble);
-      b.max[a] = std::min(hi_[a], kMaxDouble);
+      b.min[a] = std::max({lo_[2 * a], lo_[2 * a + 1], -kMaxDouble});
+      b.max[a] = std::min({hi_[2 * a], hi_[2 * a + 1], kMaxDouble});
     }
     return b;
   }
+  // True when every box meeting prune() (closed) matches: only "min <= v" and "max >= v"
+  // constraints, none strict, which is the window form of SQLite's rtree documentation.
+  bool prune_is_exact() const {
+    for (int c = 0; c < 4; ++c)
+      if (lo_strict_[c] || hi_strict_[c]) return false;
+    return lo_[0] == -kInf && hi_[1] == kInf && lo_[2] == -kInf && hi_[3] == kInf;
+  }
   bool matches(const Box2& b) const {
-    for (int i = 0; i < count_; ++i) {
-      const double v = column_of(b, bounds_[i].column), w = bounds_[i].value;
-      switch (bounds_[i].op) {
-        case Op::eq:
-          if (!(v == w)) return false;
-          break;
-        case Op::lt:
-          if (!(v < w)) return false;
-          break;
-        case Op::le:
-          if (!(v <= w)) return false;
-          break;
-        case Op::gt:
-          if (!(v > w)) return false;
-          break;
-        case Op::ge:
-          if (!(v >= w)) return false;
-          break;
-      }
+    const double v[4] = {b.min[0], b.max[0], b.min[1], b.max[1]};
+    bool ok = true;
+    for (int c = 0; c < 4; ++c) {
+      ok &= lo_strict_[c] ? v[c] > lo_[c] : v[c] >= lo_[c];
+      ok &= hi_strict_[c] ? v[c] < hi_[c] : v[c] <= hi_[c];
     }
-    return true;
+    return ok;
   }
 
  private:
-  static constexpr int kMax = 32;
   static constexpr double kMaxDouble = std::numeric_limits<double>::max();
   static constexpr double kInf = std::numeric_limits<double>::infinity();
-  struct Bound {
-    int column;
-    Op op;
-    double value;
-  };
-  Bound bounds_[kMax];
-  int count_ = 0;
-  double lo_[2] = {-kInf, -kInf};
-  double hi_[2] = {kInf, kInf};
+  void tighten_lo(int c, double v, bool strict) {
+    if (v > lo_[c] || (v == lo_[c] && strict)) lo_[c] = v, lo_strict_[c] = strict;
+  }
+  void tighten_hi(int c, double v, bool strict) {
+    if (v < hi_[c] || (v == hi_[c] && strict)) hi_[c] = v, hi_strict_[c] = strict;
+  }
+  double lo_[4] = {-kInf, -kInf, -kInf, -kInf};
+  double hi_[4] = {kInf, kInf, kInf, kInf};
+  bool lo_strict_[4] = {};
+  bool hi_strict_[4] = {};
+  bool bounded_ = false;
   bool never_ = false;
 };
 
@@ -204,11 +201,18 @@ class RTreeIndex {
   void window(const Window& w, std::vector<Hit>& out) {
     if (w.empty()) return;
     const Box2 prune = w.prune();
-    base_.query(prune, [&](Id item, const Box2& b) {
-      const RowId id = ids_[item];
-      if (w.matches(b) && (dead_.empty() || !dead_.count(id))) out.push_back({id, b});
-      return true;
-    });
+    if (w.prune_is_exact() && dead_.empty()) {
+      base_.query(prune, [&](Id item, const Box2& b) {
+        out.push_back({ids_[item], b});
+        return true;
+      });
+    } else {
+      base_.query(prune, [&](Id item, const Box2& b) {
+        const RowId id = ids_[item];
+        if (w.matches(b) && (dead_.empty() || !dead_.count(id))) out.push_back({id, b});
+        return true;
+      });
+    }
     if (delta_.empty()) return;
     if (delta_.size() < 64) {
       for (const auto& [id, b] : delta_)

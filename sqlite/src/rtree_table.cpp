@@ -311,14 +311,22 @@ int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
 
 // ---- Reading ------------------------------------------------------------------------------
 
-int x_open(sqlite3_vtab*, sqlite3_vtab_cursor** out) {
+// A cursor takes the table's spare hit buffer, so a run of queries allocates nothing.
+int x_open(sqlite3_vtab* v, sqlite3_vtab_cursor** out) {
   auto* c = new (std::nothrow) Cursor();
   if (!c) return SQLITE_NOMEM;
+  c->hits.swap(table_of(v).spare_hits);
   *out = c;
   return SQLITE_OK;
 }
-int x_close(sqlite3_vtab_cursor* c) {
-  delete static_cast<Cursor*>(c);
+int x_close(sqlite3_vtab_cursor* cur) {
+  auto* c = static_cast<Cursor*>(cur);
+  auto& spare = table_of(cur->pVtab).spare_hits;
+  if (c->hits.capacity() > spare.capacity() && c->hits.capacity() <= (1u << 16)) {
+    c->hits.clear();
+    spare.swap(c->hits);
+  }
+  delete c;
   return SQLITE_OK;
 }
 
@@ -404,16 +412,18 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
       return SQLITE_OK;
     }
     // argv[1] the new rowid, argv[2] the id column, argv[3..6] the box, then the aux values.
+    // The id column is the rowid, as in an INTEGER PRIMARY KEY: a NULL id takes a new one.
     RowId id = 0;
-    sqlite3_value* given = sqlite3_value_type(argv[2]) != SQLITE_NULL   ? argv[2]
-                           : sqlite3_value_type(argv[1]) != SQLITE_NULL ? argv[1]
-                                                                        : nullptr;
-    if (given) {
+    sqlite3_value* given = argv[2];
+    if (has_old && sqlite3_value_type(argv[1]) != SQLITE_NULL &&
+        sqlite3_value_int64(argv[1]) != old_id)
+      given = argv[1];  // UPDATE ... SET rowid = ...
+    else if (!has_old && sqlite3_value_type(argv[2]) == SQLITE_NULL)
+      given = argv[1];  // INSERT INTO t(rowid, ...)
+    if (sqlite3_value_type(given) != SQLITE_NULL) {
       if (!row_id(given, id))
         throw SqlError{SQLITE_MISMATCH,
                        format_sql("loci_rtree %s: the id must be an integer", t.name.c_str())};
-    } else if (has_old) {
-      id = old_id;
     } else {
       if (index.max_id() == std::numeric_limits<RowId>::max())
         throw SqlError{SQLITE_FULL, format_sql("loci_rtree %s: no id left", t.name.c_str())};

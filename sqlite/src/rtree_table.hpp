@@ -44,6 +44,7 @@ struct RTreeTable : sqlite3_vtab {
   std::shared_ptr<Registry> registry;
 
   std::unique_ptr<RTreeIndex> index;  // null until read
+  std::vector<Hit> spare_hits;        // a cursor's buffer, kept between queries
   sqlite3_int64 generation = -1;
   unsigned data_version = 0;
   bool data_version_known = false;

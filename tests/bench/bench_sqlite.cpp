@@ -1,0 +1,330 @@
+// The loci SQLite extension against SQLite's own rtree module and SpatiaLite's KNN, through
+// SQL on the same SQLite library, on the boxes of real coastline segments (Natural Earth
+// countries-coastline-1m, datasets/fetch.sh):
+//   build    BEGIN; INSERT INTO x SELECT * FROM src; COMMIT   (loci_rtree vs rtree)
+//   windows  10,000 windows of about 100 hits each, every row stepped (loci vs rtree; the rtree's
+//            float32 false hits are counted, and loci's answer is checked against the exact one)
+//   nearest  10,000 nearest-10 queries: loci_nearest vs SpatiaLite's KNN (mod_spatialite; the
+//            VirtualKNN of Debian's SpatiaLite 5.0), distances compared
+// Medians of --repeat runs. Usage: bench_sqlite [--rows N] [--queries N] [--repeat N] [--no-knn]
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "loci/index/packed_rtree.hpp"
+#include "loci/io/layer_reader.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Box2 = loci::Box<2>;
+
+struct Options {
+  std::size_t rows = 1000000;
+  std::size_t queries = 10000;
+  int repeat = 3;
+  bool knn = true;
+};
+
+[[noreturn]] void die(const std::string& what) {
+  std::fprintf(stderr, "bench_sqlite: %s\n", what.c_str());
+  std::exit(1);
+}
+
+void exec(sqlite3* db, const std::string& sql) {
+  char* err = nullptr;
+  if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK)
+    die(sql.substr(0, 80) + ": " + (err ? err : "?"));
+}
+
+sqlite3_stmt* prepare(sqlite3* db, const std::string& sql) {
+  sqlite3_stmt* s = nullptr;
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) != SQLITE_OK)
+    die(sql + ": " + sqlite3_errmsg(db));
+  return s;
+}
+
+sqlite3* open_db(const std::string& path) {
+  sqlite3* db = nullptr;
+  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) die("cannot open " + path);
+  sqlite3_enable_load_extension(db, 1);
+  return db;
+}
+
+void load(sqlite3* db, const char* file) {
+  char* err = nullptr;
+  if (sqlite3_load_extension(db, file, nullptr, &err) != SQLITE_OK)
+    die(std::string("cannot load ") + file + ": " + (err ? err : "?"));
+}
+
+double seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+bool meets(const Box2& b, const Box2& w) {
+  return b.min[0] <= w.max[0] && b.max[0] >= w.min[0] && b.min[1] <= w.max[1] &&
+         b.max[1] >= w.min[1];
+}
+
+// Runs every window through `sql`, collecting the ids of each; returns the seconds taken.
+double run_windows(sqlite3* db, const char* table, const std::vector<Box2>& windows,
+                   std::vector<std::vector<sqlite3_int64>>& out) {
+  sqlite3_stmt* s = prepare(db, std::string("SELECT id FROM ") + table +
+                                    " WHERE minx <= ?3 AND maxx >= ?1 AND miny <= ?4 AND "
+                                    "maxy >= ?2");
+  out.assign(windows.size(), {});
+  const auto t0 = Clock::now();
+  for (std::size_t q = 0; q < windows.size(); ++q) {
+    const Box2& w = windows[q];
+    sqlite3_bind_double(s, 1, w.min[0]);
+    sqlite3_bind_double(s, 2, w.min[1]);
+    sqlite3_bind_double(s, 3, w.max[0]);
+    sqlite3_bind_double(s, 4, w.max[1]);
+    while (sqlite3_step(s) == SQLITE_ROW)
+      out[q].push_back(sqlite3_column_int64(s, 0));
+    sqlite3_reset(s);
+  }
+  const double t = seconds(t0, Clock::now());
+  sqlite3_finalize(s);
+  return t;
+}
+
+struct Near {
+  sqlite3_int64 id;
+  double distance;
+};
+
+double run_nearest(sqlite3* db, const std::string& sql, const std::vector<loci::Point2>& points,
+                   std::vector<std::vector<Near>>& out) {
+  sqlite3_stmt* s = prepare(db, sql);
+  out.assign(points.size(), {});
+  const auto t0 = Clock::now();
+  for (std::size_t q = 0; q < points.size(); ++q) {
+    sqlite3_bind_double(s, 1, points[q][0]);
+    sqlite3_bind_double(s, 2, points[q][1]);
+    while (sqlite3_step(s) == SQLITE_ROW)
+      out[q].push_back({sqlite3_column_int64(s, 0), sqlite3_column_double(s, 1)});
+    sqlite3_reset(s);
+  }
+  const double t = seconds(t0, Clock::now());
+  sqlite3_finalize(s);
+  return t;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto next = [&] { return i + 1 < argc ? std::strtoull(argv[++i], nullptr, 10) : 0ull; };
+    if (a == "--rows")
+      o.rows = next();
+    else if (a == "--queries")
+      o.queries = next();
+    else if (a == "--repeat")
+      o.repeat = int(std::max(1ull, next()));
+    else if (a == "--no-knn")
+      o.knn = false;
+    else
+      die("usage: bench_sqlite [--rows N] [--queries N] [--repeat N] [--no-knn]");
+  }
+
+  const std::string layer =
+      std::string(LOCI_DATASETS_DIR) + "/cache/countries-coastline-1m/map.geo.json";
+  if (!std::filesystem::exists(layer)) die(layer + " is missing: run datasets/fetch.sh");
+  std::vector<Box2> boxes;
+  for (const auto& s : loci::io::read_segments(layer)) {
+    if (boxes.size() == o.rows) break;
+    boxes.push_back(s.segment.box());
+  }
+  std::printf("bench_sqlite: %zu coastline segment boxes, SQLite %s\n", boxes.size(),
+              sqlite3_libversion());
+
+  const std::string dir = std::filesystem::temp_directory_path() / "loci-bench-sqlite";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  sqlite3* db = open_db(dir + "/bench.db");
+  load(db, LOCI_SQLITE_EXTENSION);
+  exec(db, "CREATE TABLE src(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, miny REAL, maxy REAL)");
+  exec(db, "BEGIN");
+  {
+    sqlite3_stmt* s = prepare(db, "INSERT INTO src VALUES(?, ?, ?, ?, ?)");
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      sqlite3_bind_int64(s, 1, sqlite3_int64(i + 1));
+      sqlite3_bind_double(s, 2, boxes[i].min[0]);
+      sqlite3_bind_double(s, 3, boxes[i].max[0]);
+      sqlite3_bind_double(s, 4, boxes[i].min[1]);
+      sqlite3_bind_double(s, 5, boxes[i].max[1]);
+      sqlite3_step(s);
+      sqlite3_reset(s);
+    }
+    sqlite3_finalize(s);
+  }
+  exec(db, "COMMIT");
+
+  // ---- Build ----
+  std::vector<double> build_loci, build_rtree;
+  for (int r = 0; r < o.repeat; ++r) {
+    exec(db, "DROP TABLE IF EXISTS t; DROP TABLE IF EXISTS r;");
+    exec(db, "CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy)");
+    exec(db, "CREATE VIRTUAL TABLE r USING rtree(id, minx, maxx, miny, maxy)");
+    auto t0 = Clock::now();
+    exec(db, "BEGIN; INSERT INTO t SELECT * FROM src; COMMIT;");
+    build_loci.push_back(seconds(t0, Clock::now()));
+    t0 = Clock::now();
+    exec(db, "BEGIN; INSERT INTO r SELECT * FROM src; COMMIT;");
+    build_rtree.push_back(seconds(t0, Clock::now()));
+  }
+  const double bl = median(build_loci), br = median(build_rtree);
+  std::printf("\nbuild (INSERT INTO x SELECT * FROM src, one transaction)\n");
+  std::printf(
+      "  loci_rtree  %8.3f s\n  rtree       %8.3f s\n  ratio       %8.1fx  (target >= 10x)\n", bl,
+      br, br / bl);
+
+  // ---- Windows of about 100 hits ----
+  const auto tree = loci::PackedRTree<2>::build(boxes);
+  std::mt19937_64 rng(42);
+  std::vector<loci::Point2> centres(o.queries);
+  for (auto& c : centres) {
+    const Box2& b = boxes[rng() % boxes.size()];
+    c = b.center();
+  }
+  const auto windows_of = [&](double side) {
+    std::vector<Box2> w(centres.size());
+    for (std::size_t i = 0; i < w.size(); ++i)
+      w[i] = {{{centres[i][0] - side / 2, centres[i][1] - side / 2}},
+              {{centres[i][0] + side / 2, centres[i][1] + side / 2}}};
+    return w;
+  };
+  double lo = 1e-4, hi = 10;
+  for (int it = 0; it < 30; ++it) {  // side giving a median of ~100 hits on 500 windows
+    const double mid = std::sqrt(lo * hi);
+    std::vector<double> hits;
+    const auto w = windows_of(mid);
+    for (std::size_t i = 0; i < std::min<std::size_t>(500, w.size()); ++i)
+      hits.push_back(double(tree.query(w[i]).size()));
+    (median(hits) < 100 ? lo : hi) = mid;
+  }
+  const auto windows = windows_of(std::sqrt(lo * hi));
+  std::vector<std::vector<sqlite3_int64>> got_loci, got_rtree;
+  std::vector<double> win_loci, win_rtree;
+  for (int r = 0; r < o.repeat; ++r) {
+    win_loci.push_back(run_windows(db, "t", windows, got_loci));
+    win_rtree.push_back(run_windows(db, "r", windows, got_rtree));
+  }
+  std::size_t hits = 0, false_hits = 0, wrong = 0;
+  for (std::size_t q = 0; q < windows.size(); ++q) {
+    std::vector<sqlite3_int64> exact;
+    for (sqlite3_int64 id : got_rtree[q])
+      if (meets(boxes[std::size_t(id - 1)], windows[q]))
+        exact.push_back(id);
+      else
+        ++false_hits;
+    auto mine = got_loci[q];
+    std::sort(mine.begin(), mine.end());
+    std::sort(exact.begin(), exact.end());
+    if (mine != exact || mine.size() != tree.query(windows[q]).size()) ++wrong;
+    hits += mine.size();
+  }
+  const double wl = median(win_loci), wr = median(win_rtree);
+  std::printf("\n%zu windows, %.1f hits each on average (every row stepped)\n", windows.size(),
+              double(hits) / double(windows.size()));
+  std::printf("  loci_rtree  %10.0f queries/s  %6.1f ns per hit  0 false hits\n",
+              double(windows.size()) / wl, wl * 1e9 / double(std::max<std::size_t>(hits, 1)));
+  std::printf("  rtree       %10.0f queries/s  %6.1f ns per hit  %zu false hits (float32 boxes)\n",
+              double(windows.size()) / wr, wr * 1e9 / double(std::max<std::size_t>(hits, 1)),
+              false_hits);
+  std::printf("  ratio       %10.2fx  (target >= 2x)   answers identical to the exact ones: %s\n",
+              wr / wl, wrong == 0 ? "yes" : "NO");
+  if (wrong) std::printf("  %zu windows differ\n", wrong);
+
+  // ---- Nearest-10 ----
+  std::vector<loci::Point2> points(o.queries);
+  std::uniform_real_distribution<double> jitter(-0.5, 0.5);
+  for (auto& p : points) {
+    const Box2& b = boxes[rng() % boxes.size()];
+    p = {{b.center()[0] + jitter(rng), b.center()[1] + jitter(rng)}};
+  }
+  std::vector<std::vector<Near>> near_loci;
+  std::vector<double> nl;
+  for (int r = 0; r < o.repeat; ++r)
+    nl.push_back(run_nearest(db, "SELECT id, distance FROM loci_nearest('t', ?1, ?2, 10)", points,
+                             near_loci));
+  const double nlm = median(nl);
+  std::printf("\n%zu nearest-10 queries\n  loci_nearest %9.0f queries/s  (target >= 20,000)\n",
+              points.size(), double(points.size()) / nlm);
+  sqlite3_close(db);
+
+  if (o.knn) {
+    sqlite3* sp = open_db(dir + "/spatialite.db");
+    char* err = nullptr;
+    if (sqlite3_load_extension(sp, "mod_spatialite", nullptr, &err) != SQLITE_OK) {
+      std::printf("  SpatiaLite: not measured (%s; apt-get install libsqlite3-mod-spatialite)\n",
+                  err ? err : "?");
+    } else {
+      const auto t0 = Clock::now();
+      exec(sp, "SELECT InitSpatialMetadata(1)");
+      exec(sp, "CREATE TABLE s(id INTEGER PRIMARY KEY)");
+      exec(sp, "SELECT AddGeometryColumn('s', 'geom', 3857, 'POLYGON', 'XY')");
+      exec(sp, "BEGIN");
+      sqlite3_stmt* s = prepare(sp, "INSERT INTO s VALUES(?1, BuildMbr(?2, ?3, ?4, ?5, 3857))");
+      for (std::size_t i = 0; i < boxes.size(); ++i) {
+        sqlite3_bind_int64(s, 1, sqlite3_int64(i + 1));
+        sqlite3_bind_double(s, 2, boxes[i].min[0]);
+        sqlite3_bind_double(s, 3, boxes[i].min[1]);
+        sqlite3_bind_double(s, 4, boxes[i].max[0]);
+        sqlite3_bind_double(s, 5, boxes[i].max[1]);
+        sqlite3_step(s);
+        sqlite3_reset(s);
+      }
+      sqlite3_finalize(s);
+      exec(sp, "COMMIT");
+      exec(sp, "SELECT CreateSpatialIndex('s', 'geom')");
+      std::printf("  (SpatiaLite table and index of the same boxes built in %.1f s)\n",
+                  seconds(t0, Clock::now()));
+      // SpatiaLite's KNN answers on the polygons; at most 1,024 rows, sized by max_items.
+      const std::size_t knn_queries = std::min<std::size_t>(points.size(), 1000);
+      std::vector<loci::Point2> few(points.begin(), points.begin() + std::ptrdiff_t(knn_queries));
+      std::vector<std::vector<Near>> near_knn;
+      std::vector<double> nk;
+      for (int r = 0; r < o.repeat; ++r)
+        nk.push_back(run_nearest(sp,
+                                 "SELECT fid, distance FROM KNN WHERE f_table_name = 's' AND "
+                                 "ref_geometry = MakePoint(?1, ?2, 3857) AND max_items = 10",
+                                 few, near_knn));
+      const double nkm = median(nk);
+      std::size_t differ = 0;
+      for (std::size_t q = 0; q < few.size(); ++q) {
+        const auto& a = near_loci[q];
+        const auto& b = near_knn[q];
+        bool same = a.size() == b.size();
+        for (std::size_t i = 0; same && i < a.size(); ++i)
+          same = std::abs(a[i].distance - b[i].distance) <= 1e-9 * std::max(1.0, a[i].distance);
+        differ += !same;
+      }
+      std::printf("  SpatiaLite KNN %7.0f queries/s  (%zu queries)\n", double(few.size()) / nkm,
+                  few.size());
+      std::printf("  ratio        %9.1fx  (target >= 10x)   distances identical: %s\n",
+                  (nkm / double(few.size())) / (nlm / double(points.size())),
+                  differ == 0 ? "yes" : ("NO, " + std::to_string(differ) + " differ").c_str());
+    }
+    sqlite3_close(sp);
+  }
+  std::filesystem::remove_all(dir);
+  return 0;
+}
