@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/sidecar.hpp"
 
@@ -45,6 +46,9 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t n, const 
     double d = 0;
     const auto r = std::from_chars(text.data() + first, text.data() + last, d);
     if (r.ec != std::errc() || r.ptr != text.data() + last || !std::isfinite(d)) throw bad();
+    if (std::abs(d) > kMaxCoordinate)
+      throw InvalidArgument(std::string("bad ") + what + " " + quoted(text) +
+                            ": values beyond +-1e150 are too large for exact distances");
     v.push_back(d);
     at = comma + 1;
   }
@@ -218,12 +222,31 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin) {
   if (!dynamic && file_exists(path)) {
     Sidecar sc = Sidecar::open(path);
     const Fingerprint now = fingerprint_of(o.layer_path);
-    if (!(now == sc.info().source))
+    if (!(now == sc.info().source)) {
+      // A sidecar of another layer altogether says so, rather than "stale".
+      std::string actual;
+      try {
+        actual = detail::open_layer(o.layer_path, o.layer_name).layer->GetName();
+      } catch (const Error&) {
+      }
+      if (!actual.empty() && actual != sc.info().layer_name)
+        throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + actual +
+                    "' of " + o.layer_path + "; run 'loci index " + o.layer_path +
+                    "' or give its own index with --index");
       throw Error(path + ": stale index, " + o.layer_path + " changed since it was indexed (" +
                   stale_reason(sc.info().source, now) + "); run 'loci index " + o.layer_path + "'");
+    }
     if (!o.layer_name.empty() && o.layer_name != sc.info().layer_name)
       throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + o.layer_name +
                   "'; give another index file with --index");
+    // No --layer means the dataset's first layer; a sidecar of another layer must not answer.
+    if (o.layer_name.empty()) {
+      const std::string first = default_layer_name(o.layer_path);
+      if (!first.empty() && first != sc.info().layer_name)
+        throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not the default '" +
+                    first + "'; give --layer " + sc.info().layer_name +
+                    ", or another index file with --index");
+    }
     const bool same_per = !o.per || *o.per == sc.info().per;
     const bool same_packing = !o.structure || (*o.structure == Structure::packed_str) ==
                                                   (sc.info().packing == Packing::str);

@@ -2,6 +2,8 @@
 // geometries, choosing an output driver.
 #include "gdal_layer.hpp"
 
+#include <cstdio>
+
 #include <cpl_conv.h>
 #include <sys/stat.h>
 
@@ -62,6 +64,15 @@ OpenLayer open_layer(const std::string& path, const std::string& name) {
   return ol;
 }
 
+void check_layer_point(const Point2& p, const std::string& what) {
+  if (!is_finite(p)) throw InvalidGeometry(what + " has a NaN or infinite coordinate");
+  if (!within_coordinate_range(p)) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, " has coordinate (%.6g, %.6g), beyond +-1e150", p[0], p[1]);
+    throw InvalidGeometry(what + buf + ": too large for exact distances");
+  }
+}
+
 std::string where(const std::string& path, std::int64_t fid) {
   return path + ": feature " + std::to_string(fid);
 }
@@ -106,7 +117,7 @@ void add_points(const OGRGeometry* g, FlatGeometry& out, const std::string& what
     const OGRPoint* p = g->toPoint();
     if (p->IsEmpty()) return;
     const Point2 q{p->getX(), p->getY()};
-    if (!is_finite(q)) throw InvalidGeometry(what + " has a NaN or infinite coordinate");
+    check_layer_point(q, what);
     const auto at = std::uint32_t(out.points.size());
     out.points.push_back(q);
     out.parts.push_back({at, at + 1, PartKind::point, 0});
@@ -138,7 +149,7 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
     const auto at = std::uint32_t(out.points.size());
     for (int i = 0; i < n; ++i) {
       const Point2 q{c.getX(i), c.getY(i)};
-      if (!is_finite(q)) throw InvalidGeometry(what + " has a NaN or infinite coordinate");
+      check_layer_point(q, what);
       out.points.push_back(q);
     }
     out.parts.push_back(

@@ -24,6 +24,10 @@ OpenLayer open_layer(const std::string& path, const std::string& name);
 
 std::string where(const std::string& path, std::int64_t fid);
 
+// Throws InvalidGeometry naming `what` for a NaN or infinite coordinate, or one beyond
+// +-kMaxCoordinate (1e150), which loci's distance arithmetic cannot carry.
+void check_layer_point(const Point2& p, const std::string& what);
+
 // Calls f(curve, is_ring, polygon) for every line string and ring of g, in reading order;
 // `polygon` counts the polygons met so far (rings of one polygon share it).
 void for_each_curve(const OGRGeometry* g,

@@ -2,6 +2,7 @@
 #include "loci/io/layer_reader.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <map>
 #include <memory>
 
@@ -25,8 +26,10 @@ std::vector<SegmentRecord> read_segments(const std::string& path, const std::str
           const int n = c.getNumPoints();
           for (int i = 0; i + 1 < n; ++i) {
             const Segment<2> s{{c.getX(i), c.getY(i)}, {c.getX(i + 1), c.getY(i + 1)}};
-            if (!is_finite(s.a) || !is_finite(s.b))
-              throw InvalidGeometry(where(path, fid) + " has a NaN or infinite coordinate");
+            if (!within_coordinate_range(s.a) || !within_coordinate_range(s.b)) {
+              detail::check_layer_point(s.a, where(path, fid));
+              detail::check_layer_point(s.b, where(path, fid));
+            }
             out.push_back({s, fid, part});
           }
           ++part;
@@ -68,8 +71,10 @@ void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& pat
     const int n = c.getNumPoints();
     for (int i = 0; i + 1 < n; ++i) {
       const Point2 a{c.getX(i), c.getY(i)}, b{c.getX(i + 1), c.getY(i + 1)};
-      if (!is_finite(a) || !is_finite(b))
-        throw InvalidGeometry(where(path, fid) + " has a NaN or infinite coordinate");
+      if (!within_coordinate_range(a) || !within_coordinate_range(b)) {
+        detail::check_layer_point(a, where(path, fid));
+        detail::check_layer_point(b, where(path, fid));
+      }
       const Segment2 s{a, b};
       // The box keeps the segment when we also know which diagonal of it the segment is.
       const bool anti = (a[0] < b[0]) != (a[1] < b[1]) && a[0] != b[0] && a[1] != b[1];
@@ -123,6 +128,16 @@ LayerItems read_items(const std::string& path, const std::string& layer, Per per
   }
   read_check.finish();
   return out;
+}
+
+std::string default_layer_name(const std::string& path) {
+  std::string ext = path.substr(
+      path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'));
+  for (char& c : ext)
+    c = char(std::tolower(static_cast<unsigned char>(c)));
+  for (const char* single : {".shp", ".geojson", ".json", ".fgb", ".geojsonl", ".geojsons"})
+    if (ext == single) return "";
+  return open_layer(path, "").layer->GetName();
 }
 
 LayerSummary summarize_layer(const std::string& path, const std::string& layer,

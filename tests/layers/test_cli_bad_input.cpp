@@ -264,3 +264,119 @@ TEST_F(BadInput, SignalsRemoveTheTemporaries) {
 }
 
 }  // namespace
+
+namespace {
+
+// A GeoPackage with layers a and b: the sidecar says which layer it indexes, and a query of the
+// default (first) layer does not use a sidecar of b.
+TEST_F(BadInput, ASidecarAnswersOnlyForTheLayerItIndexes) {
+  const std::string a = write("a.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}}]})");
+  const std::string b = write("b.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[5,5],[6,6]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[7,5],[8,6]]}}]})");
+  const std::string gpkg = path("multi.gpkg");
+  if (std::system(("ogr2ogr -f GPKG " + shell_quote(gpkg) + " " + shell_quote(a) +
+                   " -nln a >/dev/null 2>&1 && ogr2ogr -update " + shell_quote(gpkg) + " " +
+                   shell_quote(b) + " -nln b >/dev/null 2>&1")
+                      .c_str()) != 0)
+    GTEST_SKIP() << "ogr2ogr (gdal-bin) is needed to make a two-layer GeoPackage";
+  ASSERT_EQ(run_loci("index " + shell_quote(gpkg) + " --layer b -q").status, 0);
+  // The default layer is a: the sidecar of b must not answer for it.
+  const CliRun r = run_loci("query " + shell_quote(gpkg) + " --bbox -10,-10,10,10 -f ids");
+  expect_one_line_error(r);
+  EXPECT_NE(r.err.find("indexes layer 'b', not the default 'a'"), std::string::npos) << r.err;
+  // Asked for b, it answers from the sidecar; an in-memory structure answers for a.
+  EXPECT_EQ(
+      lines(run_loci("query " + shell_quote(gpkg) + " --layer b --bbox -10,-10,10,10 -f ids").out)
+          .size(),
+      2u);
+  EXPECT_EQ(lines(run_loci("query " + shell_quote(gpkg) +
+                           " --structure rstar --bbox -10,-10,10,10 -f ids")
+                      .out)
+                .size(),
+            1u);
+}
+
+}  // namespace
+
+namespace {
+
+// Clip writes a piece for every feature query reports: a bowtie polygon is made valid and cut,
+// and a square the window touches at one corner leaves that corner, a point.
+TEST_F(BadInput, ClipAgreesWithQueryOnBowtiesAndTouchingWindows) {
+  const std::string l = write("shapes.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"n":1},"geometry":{"type":"Polygon","coordinates":[[[0,0],[2,2],[2,0],[0,2],[0,0]]]}},
+{"type":"Feature","properties":{"n":2},"geometry":{"type":"Polygon","coordinates":[[[5,5],[6,5],[6,6],[5,6],[5,5]]]}}]})");
+  for (const char* bbox : {"0.5,0.5,1.5,1.5", "6,6,7,7", "-1,-1,9,9"}) {
+    const CliRun q = run_loci("query " + shell_quote(l) + " --bbox " + bbox + " -f ids");
+    ASSERT_EQ(q.status, 0) << q.err;
+    const std::string out = path("clip.geojson");
+    const CliRun c =
+        run_loci("clip " + shell_quote(l) + " --bbox " + bbox + " -o " + shell_quote(out));
+    ASSERT_EQ(c.status, 0) << c.err;
+    EXPECT_EQ(lines(c.err).size(), 1u) << "GEOS or GDAL messages leaked: " << c.err;
+    EXPECT_NE(c.err.find("clipped into"), std::string::npos) << c.err;
+    const std::string text = read_text(out);
+    std::size_t features = 0;
+    for (std::size_t p = 0; (p = text.find("\"Feature\"", p)) != std::string::npos; ++p)
+      ++features;
+    EXPECT_EQ(features, lines(q.out).size()) << bbox << "\n" << text;
+    EXPECT_EQ(features > 0, text.find("\"coordinates\": [ ]") == std::string::npos);
+  }
+  const std::string corner = path("corner.geojson");
+  ASSERT_EQ(run_loci("clip " + shell_quote(l) + " --bbox 6,6,7,7 -o " + shell_quote(corner)).status,
+            0);
+  EXPECT_NE(read_text(corner).find("\"Point\""), std::string::npos) << read_text(corner);
+}
+
+}  // namespace
+
+namespace {
+
+// Coordinates whose squared distances would overflow are refused, in layers and in queries,
+// rather than answered with infinite distances and a wrong ranking.
+TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {
+  const std::string l = write("huge.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1e300,1],[2,2]]}}]})");
+  for (const char* per : {"feature", "segment"}) {
+    const CliRun r = run_loci("index " + shell_quote(l) + " --per " + per);
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("feature 1"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("1e150"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(l + ".loci"));
+  }
+  const std::string ok = lines_layer();
+  for (const char* q : {"--bbox 0,0,1e301,1", "--nearest 1e200,0 -k 1", "--within 0,0,1e160"}) {
+    const CliRun r = run_loci("query " + shell_quote(ok) + " " + q);
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("1e150"), std::string::npos) << q << ": " << r.err;
+  }
+  // Large but carryable coordinates still answer exactly.
+  const std::string big = write("big.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1e149,1e149]}},
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[-1e149,-1e149]}},
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[0,0]}}]})");
+  const CliRun r = run_loci("query " + shell_quote(big) + " --nearest 9e148,9e148 -k 3 -f ids");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lines(r.out), (std::vector<std::string>{"0", "2", "1"}));
+}
+
+}  // namespace
+
+namespace {
+
+// The sidecar of another layer given with --index is named as such, not called stale.
+TEST_F(BadInput, AForeignSidecarIsNamedForTheLayerItIndexes) {
+  const std::string lines = lines_layer();
+  const std::string grid = write("grid.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[0,0]}}]})");
+  ASSERT_EQ(run_loci("index " + shell_quote(grid) + " -q").status, 0);
+  const CliRun r = run_loci("query " + shell_quote(lines) + " --index " +
+                            shell_quote(grid + ".loci") + " --bbox 0,0,9,9");
+  expect_one_line_error(r);
+  EXPECT_NE(r.err.find("indexes layer 'grid', not 'lines'"), std::string::npos) << r.err;
+}
+
+}  // namespace

@@ -46,6 +46,18 @@ std::string to_string(const Point<D>& p) {
 }
 
 // Throws InvalidGeometry naming `what` when a coordinate is NaN or infinite.
+// The largest coordinate magnitude read from layers and query arguments. Squared distances
+// between points within it stay finite (8 * 1e300 < 1.8e308), so distances and nearest-n
+// rankings never overflow; larger values are refused with a message rather than misranked.
+inline constexpr double kMaxCoordinate = 1e150;
+
+template <int D>
+constexpr bool within_coordinate_range(const Point<D>& p) {
+  for (int i = 0; i < D; ++i)
+    if (!(p[i] >= -kMaxCoordinate && p[i] <= kMaxCoordinate)) return false;
+  return true;
+}
+
 template <int D>
 void check_point(const Point<D>& p, const char* what = "point") {
   if (!is_finite(p))

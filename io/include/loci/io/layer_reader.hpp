@@ -62,6 +62,11 @@ struct LayerSummary {
   std::vector<std::pair<std::string, std::string>> fields;  // name, type
 };
 
+// The name of the layer a command reads when no --layer is given: the dataset's first. For
+// formats that hold one layer (shapefile, GeoJSON, FlatGeobuf) this is "" without opening the
+// file: there is nothing to choose. Throws like read_segments.
+std::string default_layer_name(const std::string& path);
+
 // Reads every feature to count geometry types. Throws like read_segments.
 LayerSummary summarize_layer(const std::string& path, const std::string& layer,
                              const Progress& progress = {});
