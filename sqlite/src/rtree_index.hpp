@@ -288,11 +288,27 @@ class RTreeIndex {
     std::vector<Hit> rows;
     scan(rows);
     std::vector<Box2> boxes(rows.size());
-    ids_.resize(rows.size());
     for (std::size_t i = 0; i < rows.size(); ++i)
-      boxes[i] = rows[i].box, ids_[i] = rows[i].id;
-    base_ = Packed::build(boxes, Packing::hilbert);
-    base_arrays_.reset();
+      boxes[i] = rows[i].box;
+    const Packed built = Packed::build(boxes, Packing::hilbert);
+    // Renumber the items in packed order, so a query reads the ids of its hits one after the
+    // other instead of all over a large array.
+    const std::size_t n = rows.size();
+    auto arrays = std::make_shared<Arrays>();
+    const auto blocks = built.blocks();
+    arrays->blocks.reset(new Block[blocks.size()]);
+    std::copy(blocks.begin(), blocks.end(), arrays->blocks.get());
+    const auto items = built.item_indices();
+    arrays->items.resize(items.size());
+    ids_.assign(n, 0);
+    for (std::size_t pos = 0; pos < items.size(); ++pos) {
+      arrays->items[pos] = pos < n ? std::uint32_t(pos) : items[pos];  // unused slots as built
+      if (pos < n) ids_[pos] = rows[items[pos]].id;
+    }
+    base_ = Packed::adopt(n, Packing::hilbert,
+                          std::span<const Block>(arrays->blocks.get(), blocks.size()),
+                          arrays->items, arrays);
+    base_arrays_ = arrays;
     index_by_id();
     dead_.clear();
     delta_.clear();
