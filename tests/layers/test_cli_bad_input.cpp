@@ -380,3 +380,61 @@ TEST_F(BadInput, AForeignSidecarIsNamedForTheLayerItIndexes) {
 }
 
 }  // namespace
+
+namespace {
+
+// Unusual but valid layers answer exactly; broken shapefiles fail in one line; two `loci index`
+// runs on one layer at once leave one whole sidecar.
+TEST_F(BadInput, UnusualLayersAnswerAndBrokenOnesFailInOneLine) {
+  const std::string mixed = write("mixed.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1,1]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[2,2],[2,2]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[4,4],[5,4],[5,5],[4,5],[4,4]]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"GeometryCollection","geometries":[]}},
+{"type":"Feature","properties":{},"geometry":{"type":"MultiPoint","coordinates":[[8,8],[9,9]]}}]})");
+  for (const char* per : {"feature", "segment"}) {
+    ASSERT_EQ(run_loci("index " + shell_quote(mixed) + " --per " + per + " -q").status, 0);
+    const CliRun r = run_loci("query " + shell_quote(mixed) + " --bbox 0,0,4.5,4.5 -f ids");
+    ASSERT_EQ(r.status, 0) << r.err;
+    // the point, the zero-length line and the polygon's corner; not the empty collection
+    EXPECT_EQ(lines(r.out), (std::vector<std::string>{"0", "1", "2"})) << per;
+  }
+  // A shapefile without its .shx or its .dbf.
+  ASSERT_EQ(run_loci("clip " + shell_quote(lines_layer()) + " --bbox -1,-1,9,9 -o " +
+                     shell_quote(path("roads.shp")))
+                .status,
+            0);
+  for (const char* missing : {".shx", ".dbf"}) {
+    for (const char* ext : {".shp", ".shx", ".dbf"})
+      fs::copy_file(path(std::string("roads") + ext), path(std::string("cut") + ext),
+                    fs::copy_options::overwrite_existing);
+    fs::remove(path(std::string("cut") + missing));
+    const CliRun r = run_loci("query " + shell_quote(path("cut.shp")) + " --bbox -1,-1,9,9 -f ids");
+    if (r.status == 0)
+      EXPECT_EQ(lines(r.out).size(), 2u) << missing;  // GDAL managed without it: exact answers
+    else
+      expect_one_line_error(r);
+  }
+  // Two index runs at once: both finish, and the sidecar left is whole and answers.
+  const std::string l = lines_layer();
+  pid_t pids[2];
+  for (pid_t& pid : pids) {
+    pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const CliRun r = run_loci("index " + shell_quote(l) + " --per segment -q");
+      ::_exit(r.status);
+    }
+  }
+  for (pid_t pid : pids) {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+  }
+  const CliRun q = run_loci("query " + shell_quote(l) + " --bbox -1,-1,9,9 -f ids");
+  ASSERT_EQ(q.status, 0) << q.err;
+  EXPECT_EQ(lines(q.out).size(), 2u);
+  EXPECT_TRUE(temporaries().empty());
+}
+
+}  // namespace
