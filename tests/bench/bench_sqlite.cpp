@@ -263,9 +263,10 @@ int main(int argc, char** argv) {
               wr / wl, wrong == 0 ? "yes" : "NO");
   if (wrong) std::printf("  %zu windows differ\n", wrong);
   const double tl = median(txn_loci), tr = median(txn_rtree);
-  std::printf("  inside one read transaction: loci_rtree %.0f queries/s, rtree %.0f queries/s, "
-              "ratio %.2fx\n",
-              double(windows.size()) / tl, double(windows.size()) / tr, tr / tl);
+  std::printf(
+      "  inside one read transaction: loci_rtree %.0f queries/s, rtree %.0f queries/s, "
+      "ratio %.2fx\n",
+      double(windows.size()) / tl, double(windows.size()) / tr, tr / tl);
 
   // ---- Nearest-10 ----
   std::vector<loci::Point2> points(o.queries);
