@@ -15,14 +15,10 @@ namespace loci::sqlite {
 
 namespace {
 
-void free_registry(void* p) {
-  delete static_cast<std::shared_ptr<Registry>*>(p);
-}
-
 // loci_check('t'): 'ok' or what is wrong with t's index.
 void check_function(sqlite3_context* ctx, int, sqlite3_value** argv) {
   try {
-    auto& registry = **static_cast<std::shared_ptr<Registry>*>(sqlite3_user_data(ctx));
+    auto& registry = *registry_of(sqlite3_user_data(ctx));
     const char* name = reinterpret_cast<const char*>(sqlite3_value_text(argv[0]));
     RTreeTable& t = table_named(sqlite3_context_db_handle(ctx), registry, name, "loci_check");
     const std::string verdict = t.check();
@@ -44,8 +40,8 @@ int register_all(sqlite3* db, char** err) {
     if (rc == SQLITE_OK) rc = register_nearest(db, registry);
     if (rc == SQLITE_OK)
       rc = sqlite3_create_function_v2(db, "loci_check", 1, SQLITE_UTF8 | SQLITE_DIRECTONLY,
-                                      new std::shared_ptr<Registry>(registry), check_function,
-                                      nullptr, nullptr, free_registry);
+                                      new_registry_handle(registry), check_function, nullptr,
+                                      nullptr, free_registry_handle);
     if (rc != SQLITE_OK && err) *err = sqlite3_mprintf("loci: %s", sqlite3_errmsg(db));
     return rc;
   } catch (...) {

@@ -31,7 +31,7 @@ int x_connect(sqlite3* db, void* aux, int, const char* const*, sqlite3_vtab** ou
   auto* t = new (std::nothrow) NearestTable();
   if (!t) return SQLITE_NOMEM;
   t->db = db;
-  t->registry = *static_cast<std::shared_ptr<Registry>*>(aux);
+  t->registry = registry_of(aux);
   sqlite3_vtab_config(db, SQLITE_VTAB_INNOCUOUS);
   *out = t;
   return SQLITE_OK;
@@ -152,15 +152,11 @@ sqlite3_module nearest_module() {
 
 const sqlite3_module kNearestModule = nearest_module();
 
-void free_registry(void* p) {
-  delete static_cast<std::shared_ptr<Registry>*>(p);
-}
-
 }  // namespace
 
 int register_nearest(sqlite3* db, const std::shared_ptr<Registry>& registry) {
   return sqlite3_create_module_v2(db, "loci_nearest", &kNearestModule,
-                                  new std::shared_ptr<Registry>(registry), free_registry);
+                                  new_registry_handle(registry), free_registry_handle);
 }
 
 }  // namespace loci::sqlite

@@ -184,7 +184,7 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
     table->schema = argv[1];
     table->name = argv[2];
     table->aux_count = int(aux_names.size());
-    table->registry = *static_cast<std::shared_ptr<Registry>*>(aux);
+    table->registry = registry_of(aux);
 
     // Typed like the values they hold, so SQL's comparison rules are those of REAL columns.
     std::string decl = "CREATE TABLE x(";
@@ -543,10 +543,6 @@ sqlite3_module rtree_module() {
 
 const sqlite3_module kRTreeModule = rtree_module();
 
-void free_registry(void* p) {
-  delete static_cast<std::shared_ptr<Registry>*>(p);
-}
-
 }  // namespace
 
 // ---- RTreeTable ---------------------------------------------------------------------------
@@ -617,10 +613,7 @@ RTreeIndex RTreeTable::load_stored() {
     }
   } reader{read_node};
 
-  struct ResetOnExit {
-    Statement& s;
-    ~ResetOnExit() { s.reset(); }
-  } reset_node{read_node};
+  const ResetOnExit reset_node{read_node};
   if (read_node.step()) {
     if (sqlite3_column_int64(read_node.get(), 0) != 0 ||
         sqlite3_column_bytes(read_node.get(), 1) != int(sizeof h))
@@ -643,10 +636,7 @@ RTreeIndex RTreeTable::load_stored() {
 
   std::vector<Hit> delta;
   {
-    struct R {
-      Statement& s;
-      ~R() { s.reset(); }
-    } r{read_delta};
+    const ResetOnExit reset_delta{read_delta};
     while (read_delta.step()) {
       sqlite3_stmt* s = read_delta.get();
       for (int i = 1; i <= 4; ++i)
@@ -660,14 +650,16 @@ RTreeIndex RTreeTable::load_stored() {
   }
   std::vector<RowId> dead;
   {
-    struct R {
-      Statement& s;
-      ~R() { s.reset(); }
-    } r{read_dead};
+    const ResetOnExit reset_dead{read_dead};
     while (read_dead.step())
       dead.push_back(sqlite3_column_int64(read_dead.get(), 0));
   }
   return RTreeIndex::load(h, read, std::move(delta), std::move(dead));
+}
+
+sqlite3_int64 RTreeTable::stored_generation() {
+  const ResetOnExit reset{get_generation};
+  return get_generation.step() ? sqlite3_column_int64(get_generation.get(), 0) : -1;
 }
 
 RTreeIndex& RTreeTable::current() {
@@ -676,18 +668,13 @@ RTreeIndex& RTreeTable::current() {
     const bool known =
         sqlite3_file_control(db, schema.c_str(), SQLITE_FCNTL_DATA_VERSION, &v) == SQLITE_OK;
     if (!(known && data_version_known && v == data_version)) {
-      sqlite3_int64 g = -1;
-      if (get_generation.step()) g = sqlite3_column_int64(get_generation.get(), 0);
-      get_generation.reset();
-      if (g != generation) index.reset();
+      if (stored_generation() != generation) index.reset();
       data_version = v;
       data_version_known = known;
     }
   }
   if (!index) {
-    sqlite3_int64 g = -1;
-    if (get_generation.step()) g = sqlite3_column_int64(get_generation.get(), 0);
-    get_generation.reset();
+    const sqlite3_int64 g = stored_generation();
     try {
       index = std::make_unique<RTreeIndex>(load_stored());
     } catch (const Error& e) {
@@ -826,8 +813,8 @@ RTreeTable& table_named(sqlite3* db, const Registry& registry, const char* name,
 }
 
 int register_rtree(sqlite3* db, const std::shared_ptr<Registry>& registry) {
-  return sqlite3_create_module_v2(db, "loci_rtree", &kRTreeModule,
-                                  new std::shared_ptr<Registry>(registry), free_registry);
+  return sqlite3_create_module_v2(db, "loci_rtree", &kRTreeModule, new_registry_handle(registry),
+                                  free_registry_handle);
 }
 
 }  // namespace loci::sqlite

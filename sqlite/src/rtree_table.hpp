@@ -73,8 +73,21 @@ struct RTreeTable : sqlite3_vtab {
   void prepare_statements();
   void finalize_statements();
   void bump_generation();
+  sqlite3_int64 stored_generation();  // 'generation' in %_meta, -1 when missing
   void write_base();
 };
+
+// The registry as SQLite carries it (a module's or a function's client data): a heap copy of
+// the shared pointer, freed by free_registry_handle when SQLite drops the module or function.
+inline void* new_registry_handle(const std::shared_ptr<Registry>& r) {
+  return new std::shared_ptr<Registry>(r);
+}
+inline const std::shared_ptr<Registry>& registry_of(void* handle) {
+  return *static_cast<std::shared_ptr<Registry>*>(handle);
+}
+inline void free_registry_handle(void* handle) {
+  delete static_cast<std::shared_ptr<Registry>*>(handle);
+}
 
 // Registers the loci_rtree module (and the shared registry) on a connection.
 int register_rtree(sqlite3* db, const std::shared_ptr<Registry>& registry);

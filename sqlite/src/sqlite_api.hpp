@@ -101,6 +101,12 @@ class Statement {
   sqlite3_stmt* stmt_ = nullptr;
 };
 
+// Resets a statement when the scope that steps it ends, however it ends.
+struct ResetOnExit {
+  Statement& statement;
+  ~ResetOnExit() { statement.reset(); }
+};
+
 // Runs SQL that returns nothing; throws SqlError.
 inline void exec(sqlite3* db, const std::string& sql) {
   char* err = nullptr;

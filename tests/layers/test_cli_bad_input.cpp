@@ -276,11 +276,12 @@ TEST_F(BadInput, ASidecarAnswersOnlyForTheLayerItIndexes) {
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[5,5],[6,6]]}},
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[7,5],[8,6]]}}]})");
   const std::string gpkg = path("multi.gpkg");
-  if (std::system(("ogr2ogr -f GPKG " + shell_quote(gpkg) + " " + shell_quote(a) +
-                   " -nln a >/dev/null 2>&1 && ogr2ogr -update " + shell_quote(gpkg) + " " +
-                   shell_quote(b) + " -nln b >/dev/null 2>&1")
-                      .c_str()) != 0)
-    GTEST_SKIP() << "ogr2ogr (gdal-bin) is needed to make a two-layer GeoPackage";
+  ASSERT_EQ(std::system(("ogr2ogr -f GPKG " + shell_quote(gpkg) + " " + shell_quote(a) +
+                         " -nln a >/dev/null 2>&1 && ogr2ogr -update " + shell_quote(gpkg) + " " +
+                         shell_quote(b) + " -nln b >/dev/null 2>&1")
+                            .c_str()),
+            0)
+      << "ogr2ogr (gdal-bin, from scripts/install-deps.sh) could not make a two-layer GeoPackage";
   ASSERT_EQ(run_loci("index " + shell_quote(gpkg) + " --layer b -q").status, 0);
   // The default layer is a: the sidecar of b must not answer for it.
   const CliRun r = run_loci("query " + shell_quote(gpkg) + " --bbox -10,-10,10,10 -f ids");
