@@ -1,0 +1,627 @@
+// TprTree<D>: the TPR*-tree of Tao, Papadias and Sun ("The TPR*-Tree: An Optimized
+// Spatio-Temporal Access Method for Predictive Queries", VLDB 2003), in main memory.
+//
+// What it is. An R-tree over moving points whose node bounds are time-parameterized boxes
+// (moving/detail/tpbr.hpp): each bound moves with the extreme velocity of what it holds, so a
+// node keeps bounding its points as they move, without updates. The TPR-tree (Saltenis et al.
+// 2000) chose insertion paths and splits with R*-tree heuristics integrated over time; the
+// TPR* version replaces them with one cost, the area a node's box sweeps over the horizon
+// after being grown by the expected query extent (the probability that a query issued during
+// the horizon visits the node), and uses it everywhere:
+//
+// - Choose_Path (section 5.1): the insertion path is the one with the least total increase of
+//   that cost over all its nodes, found by a best-first search over the whole tree: partial
+//   paths wait in a priority queue keyed by the cost increase so far, and since increases are
+//   never negative the first node of the target level taken from the queue ends the best path.
+//   The greedy descent of R-trees looks at one node per level and can miss it.
+// - Pick_Worst (section 5.2): on the first overflow of a level during one insertion, the
+//   entries whose removal shrinks the node's cost most are reinserted instead of splitting:
+//   for each of the 4 D orders (lower or upper end, position at now or velocity, per axis) the
+//   30% of entries at the extreme are taken out, and the order whose removal gains most wins.
+// - Split: over the same 4 D orders and every distribution leaving at least 40% of the
+//   entries on each side, the one with the least summed cost of the two groups.
+// - Deletion as in R-trees: the leaf is found at once through an id -> leaf table (the
+//   secondary index that makes main-memory updates cheap, Sidlauskas et al. 2009); nodes left
+//   below 40% are dissolved and their entries reinserted; every node on the path gets its
+//   bounds recomputed from its entries at the current time (tightening). An update is an
+//   erasure and an insertion.
+//
+// Parameters (TprParams): the horizon H over which costs are integrated (the paper's
+// H = update interval + how far ahead queries look) and the expected query extent per axis.
+//
+// Time. Bounds are kept relative to the tree's epoch (the time of its first report), so that
+// epoch-second timestamps lose no precision. A node's bounds are tightened at the tree's
+// clock, the latest report time it has been given, and hold from then on; queries at or after
+// the clock prune with them. A query reaching back before the clock is answered exactly by
+// looking at every object (the bounds do not hold backwards).
+//
+// Layout: nodes in detail::NodePool with up to M entries (TPBR and child index) stored
+// inline, parent links for condensing; objects in flat arrays by slot (id, report, leaf);
+// ids map to slots through detail::IdMap.
+//
+// Complexity: insertion O(explored nodes x M) (the best-first search is usually a few paths);
+// erasure O(log n) plus reinsertion of dissolved nodes; window queries O(log n + visited);
+// nearest-n best-first (detail/best_first.hpp) over the boxes at the query time. Memory
+// about (4 D + 1) x 8 bytes an entry.
+//
+// Thread-safety: const members may run concurrently with each other.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <queue>
+#include <string>
+#include <vector>
+
+#include "loci/index/broadphase/detail/proxy_table.hpp"
+#include "loci/index/detail/best_first.hpp"
+#include "loci/index/detail/node_pool.hpp"
+#include "loci/index/moving/detail/tpbr.hpp"
+#include "loci/index/moving/moving_index.hpp"
+
+namespace loci {
+
+template <int D>
+struct TprParams {
+  double horizon = 60;      // H: how far ahead costs are integrated
+  Point<D> query_extent{};  // expected side lengths of query windows
+};
+
+template <int D, int M = 32>
+class TprTree {
+  static_assert(M >= 4 && M <= 63, "node entries are tracked in 64-bit masks");
+
+ public:
+  static constexpr int dimension = D;
+  static constexpr const char* kName = "TprTree";
+  static constexpr int kMinFill = std::max(2, M * 2 / 5);
+
+  explicit TprTree(const TprParams<D>& params = {}) : params_(params) {
+    if (!(params.horizon >= 0) || !std::isfinite(params.horizon))
+      throw InvalidArgument("TprTree: the horizon must be a finite number >= 0");
+    for (int i = 0; i < D; ++i)
+      if (!(params.query_extent[i] >= 0) || !std::isfinite(params.query_extent[i]))
+        throw InvalidArgument("TprTree: query extents must be finite numbers >= 0");
+  }
+
+  const TprParams<D>& params() const { return params_; }
+
+  void insert(Id id, const Motion<D>& m) {
+    check_motion(m);
+    if (map_.find(id) != kNone)
+      throw InvalidArgument(std::string(kName) + ": id " + std::to_string(id) + " is already held");
+    add(id, m);
+  }
+
+  void update(Id id, const Motion<D>& m) {
+    check_motion(m);
+    const std::uint32_t s = map_.find(id);
+    if (s != kNone) remove_slot(s);
+    add(id, m);
+  }
+
+  bool erase(Id id) {
+    const std::uint32_t s = map_.find(id);
+    if (s == kNone) return false;
+    remove_slot(s);
+    return true;
+  }
+
+  void clear() { *this = TprTree(params_); }
+
+  bool contains(Id id) const { return map_.find(id) != kNone; }
+  std::size_t size() const { return count_; }
+  bool empty() const { return count_ == 0; }
+  double clock() const { return clock_; }
+  int height() const { return root_ == kNone ? 0 : nodes_[root_].level + 1; }
+  std::size_t memory_bytes() const {
+    return nodes_.memory_bytes() + obj_motion_.capacity() * (sizeof(Motion<D>) + 12);
+  }
+  // Nodes examined by the most expensive Choose_Path so far (the price of TPR* insertions).
+  std::size_t max_choose_path_nodes() const { return max_choose_nodes_; }
+
+  Motion<D> at(Id id) const {
+    const std::uint32_t s = map_.find(id);
+    if (s == kNone) throw InvalidArgument(std::string(kName) + ": no object " + std::to_string(id));
+    return obj_motion_[s];
+  }
+
+  template <MotionVisitor<D> F>
+  QueryStats query(const MovingWindow<D>& w, F&& visit) const {
+    check_window(w);
+    QueryStats st;
+    if (root_ == kNone) return st;
+    if (w.t1 < clock_) return scan(w, visit);
+    thread_local std::vector<std::uint32_t> stack;
+    stack.clear();
+    stack.push_back(root_);
+    while (!stack.empty()) {
+      const Node& n = nodes_[stack.back()];
+      stack.pop_back();
+      ++st.nodes_visited;
+      st.entries_tested += n.count;
+      if (n.level == 0) {
+        for (int e = 0; e < n.count; ++e) {
+          const std::uint32_t s = n.child[e];
+          if (!inside(obj_motion_[s], w)) continue;
+          ++st.results;
+          if (!visit(obj_id_[s], obj_motion_[s])) return st;
+        }
+      } else {
+        for (int e = 0; e < n.count; ++e)
+          if (detail::tpbr_meets(n.box[e], epoch_, w)) stack.push_back(n.child[e]);
+      }
+    }
+    return st;
+  }
+  std::vector<Id> query(const MovingWindow<D>& w) const {
+    return collect_ids([&](auto&& v) { return query(w, v); });
+  }
+
+  template <MotionNearestVisitor<D> F>
+  QueryStats nearest(const Point<D>& q, double s, std::size_t k, F&& visit) const {
+    check_point(q, "nearest point");
+    check_coordinate(s, "nearest time");
+    if (root_ == kNone || k == 0) return {};
+    const double r = s - epoch_;
+    const bool prune = s >= clock_;
+    auto expand = [&](std::uint64_t ref, detail::BestFirstSink& sink) -> std::size_t {
+      const Node& n = nodes_[std::uint32_t(ref)];
+      double d2[M + 1];
+      if (n.level == 0) {
+        for (int e = 0; e < n.count; ++e)
+          d2[e] = squared_distance(position(obj_motion_[n.child[e]], s), q);
+        sink.push_entries(
+            d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); },
+            [&](int e) { return obj_id_[n.child[e]]; });
+      } else {
+        for (int e = 0; e < n.count; ++e)
+          d2[e] = prune ? detail::tpbr_distance2(n.box[e], r, q) : 0.0;
+        sink.push_subtrees(d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); });
+      }
+      return n.count;
+    };
+    return detail::best_first(root_, k, expand, [&](Id id, std::uint64_t ref, double d) {
+      return visit(id, obj_motion_[std::uint32_t(ref)], d);
+    });
+  }
+  std::vector<Neighbor> nearest(const Point<D>& q, double s, std::size_t k) const {
+    std::vector<Neighbor> out;
+    nearest(q, s, k, [&](Id id, const Motion<D>&, double d) {
+      return out.push_back({id, d}), true;
+    });
+    return out;
+  }
+
+  template <MotionVisitor<D> F>
+  void for_each(F&& visit) const {
+    for (std::uint32_t s = 0; s < obj_id_.size(); ++s)
+      if (obj_leaf_[s] != kNone && !visit(obj_id_[s], obj_motion_[s])) return;
+  }
+
+  void validate() const {
+    const std::string who(kName);
+    std::size_t objects = 0;
+    if (root_ != kNone) {
+      if (nodes_[root_].parent != kNone) throw Error(who + ": the root has a parent");
+      std::vector<bool> seen(nodes_.size(), false);
+      validate_node(root_, seen, objects);
+      if (!nodes_.validate_free(seen)) throw Error(who + ": a node is both in use and free");
+      for (std::uint32_t n = 0; n < nodes_.size(); ++n)
+        if (!seen[n]) throw Error(who + ": node " + std::to_string(n) + " is lost");
+    }
+    if (objects != count_) throw Error(who + ": the leaves hold a different number of objects");
+    std::size_t live = 0;
+    for (std::uint32_t s = 0; s < obj_id_.size(); ++s) {
+      if (obj_leaf_[s] == kNone) continue;
+      ++live;
+      if (map_.find(obj_id_[s]) != s)
+        throw Error(who + ": id " + std::to_string(obj_id_[s]) + " does not map to its slot");
+    }
+    if (live != count_) throw Error(who + ": object table and count disagree");
+  }
+
+ private:
+  struct Node {
+    std::uint32_t parent = kNone;  // also the free-list link
+    std::uint8_t level = 0;        // 0: leaf (children are object slots)
+    std::uint8_t count = 0;
+    detail::Tpbr<D> box[M + 1];  // one spare entry while overflowing
+    std::uint32_t child[M + 1];
+  };
+  using Pool = detail::NodePool<Node, &Node::parent>;
+  using Box_ = detail::Tpbr<D>;
+
+  double rel_clock() const { return clock_ - epoch_; }
+  double cost(const Box_& b) const {
+    return detail::swept_cost(b, rel_clock(), params_.horizon, params_.query_extent);
+  }
+  Box_ bound(const Node& n) const {
+    Box_ b = n.box[0];
+    for (int e = 1; e < n.count; ++e)
+      b.enclose(n.box[e], rel_clock());
+    return b;
+  }
+
+  // Where entry e of node n records its place: an object's leaf, a child node's parent.
+  void adopt(std::uint32_t n, int e) {
+    Node& node = nodes_[n];
+    if (node.level == 0)
+      obj_leaf_[node.child[e]] = n;
+    else
+      nodes_[node.child[e]].parent = n;
+  }
+  int slot_in_parent(std::uint32_t n) const {
+    const Node& p = nodes_[nodes_[n].parent];
+    for (int e = 0; e < p.count; ++e)
+      if (p.child[e] == n) return e;
+    throw Error(std::string(kName) + ": a node is missing from its parent");
+  }
+
+  void add(Id id, const Motion<D>& m) {
+    if (count_ == 0 && root_ == kNone) epoch_ = m.t;
+    clock_ = std::max(clock_, m.t);
+    std::uint32_t s;
+    if (!free_slots_.empty()) {
+      s = free_slots_.back();
+      free_slots_.pop_back();
+    } else {
+      if (obj_id_.size() + 1 >= kNone)
+        throw InvalidArgument(std::string(kName) + ": too many objects");
+      s = std::uint32_t(obj_id_.size());
+      obj_id_.push_back(0);
+      obj_motion_.push_back({});
+      obj_leaf_.push_back(kNone);
+    }
+    obj_id_[s] = id;
+    obj_motion_[s] = m;
+    map_.insert(id, s, count_ + 1);
+    ++count_;
+    if (root_ == kNone) {
+      root_ = nodes_.allocate(kName);
+      Node& r = nodes_[root_];
+      r.parent = kNone;
+      r.level = 0;
+      r.count = 0;
+    }
+    std::uint32_t reinserted = 0;
+    insert_entry(Box_::of(m, epoch_), s, 0, reinserted);
+  }
+
+  // Choose_Path: the node of `level` whose taking `b` raises the summed cost of the path to
+  // it least.
+  std::uint32_t choose_path(const Box_& b, int level) {
+    if (nodes_[root_].level == level) return root_;
+    struct Item {
+      double key;
+      std::uint32_t node;
+      bool operator<(const Item& o) const { return key > o.key; }
+    };
+    thread_local std::vector<Item> heap;
+    heap.clear();
+    heap.push_back({0, root_});
+    std::size_t explored = 0;
+    const double c = rel_clock();
+    while (!heap.empty()) {
+      std::pop_heap(heap.begin(), heap.end());
+      const Item top = heap.back();
+      heap.pop_back();
+      const Node& n = nodes_[top.node];
+      if (n.level == level) {
+        max_choose_nodes_ = std::max(max_choose_nodes_, explored);
+        return top.node;
+      }
+      ++explored;
+      for (int e = 0; e < n.count; ++e) {
+        Box_ grown = n.box[e];
+        grown.enclose(b, c);
+        const double pen = top.key + std::max(0.0, cost(grown) - cost(n.box[e]));
+        heap.push_back({pen, n.child[e]});
+        std::push_heap(heap.begin(), heap.end());
+      }
+    }
+    throw Error(std::string(kName) + ": no node of level " + std::to_string(level) + " found");
+  }
+
+  // Inserts the entry (b, child) into a node of `level`, handling overflow.
+  void insert_entry(const Box_& b, std::uint32_t child, int level, std::uint32_t& reinserted) {
+    const std::uint32_t n = choose_path(b, level);
+    Node& node = nodes_[n];
+    node.box[node.count] = b;
+    node.child[node.count] = child;
+    ++node.count;
+    adopt(n, node.count - 1);
+    // Grow the path's bounds.
+    const double c = rel_clock();
+    for (std::uint32_t x = n; nodes_[x].parent != kNone; x = nodes_[x].parent)
+      nodes_[nodes_[x].parent].box[slot_in_parent(x)].enclose(b, c);
+    if (node.count > M) overflow(n, reinserted);
+  }
+
+  void overflow(std::uint32_t n, std::uint32_t& reinserted) {
+    const int level = nodes_[n].level;
+    if (n != root_ && !(reinserted & (1u << level))) {
+      reinserted |= 1u << level;
+      pick_worst(n, reinserted);
+    } else {
+      split(n, reinserted);
+    }
+  }
+
+  // Sort key k of entry b: k / D picks lo at now, hi at now, vlo, vhi; k % D the axis.
+  double key(const Box_& b, int k) const {
+    const int axis = k % D, what = k / D;
+    switch (what) {
+      case 0:
+        return b.lo_at(axis, rel_clock());
+      case 1:
+        return b.hi_at(axis, rel_clock());
+      case 2:
+        return b.vlo[axis];
+      default:
+        return b.vhi[axis];
+    }
+  }
+
+  void order_by(const Node& node, int k, bool descending, std::uint8_t* order) const {
+    for (int e = 0; e < node.count; ++e)
+      order[e] = std::uint8_t(e);
+    std::sort(order, order + node.count, [&](int a, int b) {
+      const double ka = key(node.box[a], k), kb = key(node.box[b], k);
+      return descending ? ka > kb : ka < kb;
+    });
+  }
+
+  Box_ union_of(const Node& node, const std::uint8_t* order, int from, int to) const {
+    Box_ b = node.box[order[from]];
+    for (int e = from + 1; e < to; ++e)
+      b.enclose(node.box[order[e]], rel_clock());
+    return b;
+  }
+
+  // Pick_Worst: removes the entries whose absence shrinks the node's cost most and reinserts
+  // them.
+  void pick_worst(std::uint32_t n, std::uint32_t& reinserted) {
+    Node& node = nodes_[n];
+    const int total = node.count;
+    const int take = std::max(1, int(0.3 * total));
+    std::uint8_t order[M + 1], best_order[M + 1];
+    double best_gain = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 4 * D; ++k)
+      for (bool descending : {true, false}) {
+        order_by(node, k, descending, order);
+        const double rest = cost(union_of(node, order, take, total));
+        const double gain = -rest;
+        if (gain > best_gain) {
+          best_gain = gain;
+          std::copy(order, order + total, best_order);
+        }
+      }
+    // Take the chosen entries out, keep the rest in place.
+    Box_ out_box[M + 1];
+    std::uint32_t out_child[M + 1];
+    bool leaving[M + 1] = {};
+    for (int e = 0; e < take; ++e) {
+      leaving[best_order[e]] = true;
+      out_box[e] = node.box[best_order[e]];
+      out_child[e] = node.child[best_order[e]];
+    }
+    int kept = 0;
+    for (int e = 0; e < total; ++e)
+      if (!leaving[e]) {
+        node.box[kept] = node.box[e];
+        node.child[kept] = node.child[e];
+        ++kept;
+      }
+    node.count = std::uint8_t(kept);
+    const int level = node.level;
+    tighten_upwards(n);
+    for (int e = 0; e < take; ++e)
+      insert_entry(out_box[e], out_child[e], level, reinserted);
+  }
+
+  // Recomputes the bounds of n and its ancestors from their entries at the clock.
+  void tighten_upwards(std::uint32_t n) {
+    for (std::uint32_t x = n; nodes_[x].parent != kNone; x = nodes_[x].parent)
+      nodes_[nodes_[x].parent].box[slot_in_parent(x)] = bound(nodes_[x]);
+  }
+
+  void split(std::uint32_t n, std::uint32_t& reinserted) {
+    Node& node = nodes_[n];
+    const int total = node.count;
+    std::uint8_t order[M + 1], best_order[M + 1];
+    int best_cut = 0;
+    double best = std::numeric_limits<double>::infinity();
+    Box_ prefix[M + 1], suffix[M + 1];
+    for (int k = 0; k < 4 * D; ++k) {
+      order_by(node, k, false, order);
+      prefix[0] = node.box[order[0]];
+      for (int e = 1; e < total; ++e)
+        (prefix[e] = prefix[e - 1]).enclose(node.box[order[e]], rel_clock());
+      suffix[total - 1] = node.box[order[total - 1]];
+      for (int e = total - 2; e >= 0; --e)
+        (suffix[e] = suffix[e + 1]).enclose(node.box[order[e]], rel_clock());
+      for (int cut = kMinFill; cut <= total - kMinFill; ++cut) {
+        const double c = cost(prefix[cut - 1]) + cost(suffix[cut]);
+        if (c < best) {
+          best = c;
+          best_cut = cut;
+          std::copy(order, order + total, best_order);
+        }
+      }
+    }
+    const std::uint32_t sib = nodes_.allocate(kName);
+    Node& a = nodes_[n];  // allocation may have moved the pool
+    Node& b = nodes_[sib];
+    b.level = a.level;
+    b.count = 0;
+    Box_ box[M + 1];
+    std::uint32_t child[M + 1];
+    for (int e = 0; e < total; ++e) {
+      box[e] = a.box[best_order[e]];
+      child[e] = a.child[best_order[e]];
+    }
+    a.count = 0;
+    for (int e = 0; e < total; ++e) {
+      Node& to = e < best_cut ? a : b;
+      to.box[to.count] = box[e];
+      to.child[to.count] = child[e];
+      ++to.count;
+    }
+    for (int e = 0; e < b.count; ++e)
+      adopt(sib, e);
+    if (n == root_) {
+      const std::uint32_t r = nodes_.allocate(kName);
+      Node& root = nodes_[r];
+      root.parent = kNone;
+      root.level = std::uint8_t(nodes_[n].level + 1);
+      root.count = 2;
+      root.box[0] = bound(nodes_[n]);
+      root.child[0] = n;
+      root.box[1] = bound(nodes_[sib]);
+      root.child[1] = sib;
+      nodes_[n].parent = r;
+      nodes_[sib].parent = r;
+      root_ = r;
+      return;
+    }
+    const std::uint32_t p = nodes_[n].parent;
+    nodes_[p].box[slot_in_parent(n)] = bound(nodes_[n]);
+    Node& parent = nodes_[p];
+    parent.box[parent.count] = bound(nodes_[sib]);
+    parent.child[parent.count] = sib;
+    ++parent.count;
+    nodes_[sib].parent = p;
+    tighten_upwards(p);
+    if (parent.count > M) overflow(p, reinserted);
+  }
+
+  void remove_slot(std::uint32_t s) {
+    const std::uint32_t leaf = obj_leaf_[s];
+    Node& node = nodes_[leaf];
+    int e = 0;
+    while (node.child[e] != s)
+      ++e;
+    node.box[e] = node.box[node.count - 1];
+    node.child[e] = node.child[node.count - 1];
+    --node.count;
+    map_.erase(obj_id_[s]);
+    obj_leaf_[s] = kNone;
+    free_slots_.push_back(s);
+    --count_;
+    condense(leaf);
+  }
+
+  // Dissolves underfull nodes from n up, tightens the rest of the path, reinserts orphans.
+  void condense(std::uint32_t n) {
+    struct Orphan {
+      Box_ box;
+      std::uint32_t child;
+      int level;
+    };
+    thread_local std::vector<Orphan> orphans;
+    orphans.clear();
+    std::uint32_t x = n;
+    while (x != root_) {
+      const std::uint32_t p = nodes_[x].parent;
+      Node& node = nodes_[x];
+      const int e = slot_in_parent(x);
+      if (node.count < kMinFill) {
+        for (int i = 0; i < node.count; ++i)
+          orphans.push_back({node.box[i], node.child[i], node.level});
+        Node& parent = nodes_[p];
+        parent.box[e] = parent.box[parent.count - 1];
+        parent.child[e] = parent.child[parent.count - 1];
+        --parent.count;
+        nodes_.release(x);
+      } else {
+        nodes_[p].box[e] = bound(node);
+      }
+      x = p;
+    }
+    // Higher levels first, so that their subtrees find a level to go to.
+    std::sort(orphans.begin(), orphans.end(),
+              [](const Orphan& a, const Orphan& b) { return a.level > b.level; });
+    for (const Orphan& o : orphans) {
+      std::uint32_t reinserted = 0;
+      insert_entry(o.box, o.child, o.level, reinserted);
+    }
+    // A root with one child hands over to it; an empty leaf root goes.
+    while (nodes_[root_].level > 0 && nodes_[root_].count == 1) {
+      const std::uint32_t old = root_;
+      root_ = nodes_[old].child[0];
+      nodes_[root_].parent = kNone;
+      nodes_.release(old);
+    }
+    if (count_ == 0) {
+      nodes_.clear();
+      root_ = kNone;
+    }
+  }
+
+  template <class F>
+  QueryStats scan(const MovingWindow<D>& w, F& visit) const {
+    QueryStats st;
+    st.nodes_visited = 1;
+    for (std::uint32_t s = 0; s < obj_id_.size(); ++s) {
+      if (obj_leaf_[s] == kNone) continue;
+      ++st.entries_tested;
+      if (!inside(obj_motion_[s], w)) continue;
+      ++st.results;
+      if (!visit(obj_id_[s], obj_motion_[s])) break;
+    }
+    return st;
+  }
+
+  void validate_node(std::uint32_t n, std::vector<bool>& seen, std::size_t& objects) const {
+    const std::string who(kName);
+    if (seen[n]) throw Error(who + ": node " + std::to_string(n) + " is reachable twice");
+    seen[n] = true;
+    const Node& node = nodes_[n];
+    if (node.count > M) throw Error(who + ": node over capacity");
+    if (n != root_ && node.count < kMinFill) throw Error(who + ": node under the minimum fill");
+    if (n == root_ && node.level > 0 && node.count < 2) throw Error(who + ": root with one child");
+    const double c = rel_clock();
+    if (n != root_) {
+      const Box_& mine = nodes_[node.parent].box[slot_in_parent(n)];
+      for (int e = 0; e < node.count; ++e)
+        if (!mine.encloses(node.box[e], c))
+          throw Error(who + ": an entry of node " + std::to_string(n) + " escapes its bound");
+    }
+    for (int e = 0; e < node.count; ++e) {
+      if (node.level == 0) {
+        const std::uint32_t s = node.child[e];
+        if (s >= obj_id_.size() || obj_leaf_[s] != n)
+          throw Error(who + ": an object does not point back to its leaf");
+        if (!node.box[e].encloses(Box_::of(obj_motion_[s], epoch_), c))
+          throw Error(who + ": an object's entry does not hold its report");
+        ++objects;
+      } else {
+        const std::uint32_t ch = node.child[e];
+        if (nodes_[ch].parent != n) throw Error(who + ": a child does not point to its parent");
+        if (nodes_[ch].level + 1 != node.level) throw Error(who + ": levels are inconsistent");
+        validate_node(ch, seen, objects);
+      }
+    }
+  }
+
+  TprParams<D> params_;
+  Pool nodes_;
+  std::uint32_t root_ = kNone;
+  std::vector<Id> obj_id_;
+  std::vector<Motion<D>> obj_motion_;
+  std::vector<std::uint32_t> obj_leaf_;  // kNone: a free slot
+  std::vector<std::uint32_t> free_slots_;
+  detail::IdMap map_;
+  std::size_t count_ = 0;
+  double epoch_ = 0;
+  double clock_ = -std::numeric_limits<double>::infinity();
+  std::size_t max_choose_nodes_ = 0;
+};
+
+static_assert(MovingIndex<TprTree<2>>);
+static_assert(MovingIndex<TprTree<3>>);
+
+}  // namespace loci

@@ -1,0 +1,97 @@
+// Conflicts (pairs within D during a horizon) against every pair's exact closest approach, on
+// fixed-seed fleets with the degenerate cases, for several slicings of the horizon.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "loci/index/moving/conflicts.hpp"
+#include "support/fleet_data.hpp"
+
+namespace loci {
+namespace {
+
+std::vector<Conflict> brute(const std::vector<Id>& ids, const std::vector<Motion2>& objs,
+                            double within, double now, double horizon) {
+  std::vector<Conflict> out;
+  for (std::size_t i = 0; i < objs.size(); ++i)
+    for (std::size_t j = i + 1; j < objs.size(); ++j)
+      if (auto ap = closest_approach(objs[i], objs[j], now, horizon, within))
+        out.push_back({std::min(ids[i], ids[j]), std::max(ids[i], ids[j]), *ap});
+  std::sort(out.begin(), out.end(), [](const Conflict& x, const Conflict& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  });
+  return out;
+}
+
+void expect_same(const std::vector<Conflict>& got, const std::vector<Conflict>& want,
+                 const std::string& what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    ASSERT_EQ(got[i].a, want[i].a) << what;
+    ASSERT_EQ(got[i].b, want[i].b) << what;
+    EXPECT_EQ(got[i].approach.tcpa, want[i].approach.tcpa) << what;
+    EXPECT_EQ(got[i].approach.dcpa, want[i].approach.dcpa) << what;
+    EXPECT_EQ(got[i].approach.t_enter, want[i].approach.t_enter) << what;
+    EXPECT_EQ(got[i].approach.t_exit, want[i].approach.t_exit) << what;
+  }
+}
+
+TEST(Conflicts, MatchBruteForceOnEveryFleet) {
+  for (test::Fleet f : test::kAllFleets) {
+    const auto fleet = test::make_fleet(f, 900, 17);
+    std::vector<Id> ids(fleet.size());
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      ids[i] = 1000 - i;  // ids in the other order than the objects
+    const double now = test::fleet_epoch(f);
+    for (double within : {0.0, 4.0, 25.0})
+      for (double horizon : {0.0, 10.0, 60.0}) {
+        const auto want = brute(ids, fleet, within, now, horizon);
+        for (std::size_t slices : {0, 1, 3, 16}) {
+          std::vector<Conflict> got;
+          find_conflicts<2>(
+              fleet, within, now, horizon,
+              [&](std::uint32_t i, std::uint32_t j, const Approach& ap) {
+                EXPECT_LT(i, j);
+                got.push_back({std::min(ids[i], ids[j]), std::max(ids[i], ids[j]), ap});
+                return true;
+              },
+              slices);
+          std::sort(got.begin(), got.end(), [](const Conflict& x, const Conflict& y) {
+            return x.a != y.a ? x.a < y.a : x.b < y.b;
+          });
+          expect_same(got, want,
+                      test::name(f) + " D=" + std::to_string(within) +
+                          " H=" + std::to_string(horizon) + " slices=" + std::to_string(slices));
+        }
+        if (f == test::Fleet::head_on && within == 4.0 && horizon == 60.0)
+          EXPECT_GT(want.size(), 0u);
+      }
+  }
+}
+
+TEST(Conflicts, ByIdsSortedAndChecked) {
+  const auto fleet = test::make_fleet(test::Fleet::clustered, 400, 2);
+  std::vector<Id> ids(fleet.size());
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    ids[i] = i * 13 % 401;
+  const auto got = find_conflicts<2>(ids, fleet, 10, 0, 30);
+  expect_same(got, brute(ids, fleet, 10, 0, 30), "by ids");
+  EXPECT_GT(got.size(), 0u);
+  EXPECT_THROW(find_conflicts<2>(std::span<const Id>(ids).first(3), fleet, 10, 0, 30),
+               InvalidArgument);
+  EXPECT_THROW(find_conflicts<2>(ids, fleet, -1, 0, 30), InvalidArgument);
+  EXPECT_THROW(find_conflicts<2>(ids, fleet, 1, 0, std::nan("")), InvalidArgument);
+  EXPECT_TRUE(
+      find_conflicts<2>(std::span<const Id>(), std::span<const Motion2>(), 1, 0, 1).empty());
+}
+
+TEST(Conflicts, VisitorStops) {
+  const auto fleet = test::make_fleet(test::Fleet::identical, 300, 2);
+  int seen = 0;
+  find_conflicts<2>(fleet, 1, 0, 10,
+                    [&](std::uint32_t, std::uint32_t, const Approach&) { return ++seen < 4; });
+  EXPECT_EQ(seen, 4);
+}
+
+}  // namespace
+}  // namespace loci

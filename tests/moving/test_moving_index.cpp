@@ -1,0 +1,167 @@
+// Every moving index against brute force: timeslice windows, windows over an interval, moving
+// windows and nearest-n at a time, on fixed-seed fleets with the degenerate cases, through
+// updates and erasures, and before the index's clock.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <unordered_map>
+#include <vector>
+
+#include "loci/index/moving/moving_scan.hpp"
+#include "loci/index/moving/tpr_tree.hpp"
+#include "support/fleet_data.hpp"
+
+namespace loci {
+namespace {
+
+using Objects = std::unordered_map<Id, Motion2>;
+
+std::vector<Id> brute_window(const Objects& objs, const MovingWindow<2>& w) {
+  std::vector<Id> out;
+  for (const auto& [id, m] : objs)
+    if (inside(m, w)) out.push_back(id);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<double> brute_nearest(const Objects& objs, const Point2& q, double s, std::size_t k) {
+  std::vector<double> d;
+  for (const auto& [id, m] : objs)
+    d.push_back(std::sqrt(squared_distance(position(m, s), q)));
+  std::sort(d.begin(), d.end());
+  d.resize(std::min(k, d.size()));
+  return d;
+}
+
+template <class T>
+class MovingIndexTest : public ::testing::Test {};
+
+using Structures = ::testing::Types<MovingScan<2>, TprTree<2>, TprTree<2, 6>>;
+TYPED_TEST_SUITE(MovingIndexTest, Structures);
+
+MovingWindow<2> random_window(std::mt19937_64& rng, double now, int kind) {
+  std::uniform_real_distribution<double> u(-100, 1000), len(0, 150), ahead(0, 60), v(-3, 3);
+  const double x = u(rng), y = u(rng), wx = len(rng), wy = len(rng);
+  const Box2 b{{x, y}, {x + wx, y + wy}};
+  const double t1 = now + ahead(rng);
+  if (kind == 0) return MovingWindow<2>::at(b, t1);
+  const double t2 = t1 + ahead(rng) / 4;
+  if (kind == 1) return MovingWindow<2>::during(b, t1, t2);
+  const double dx = v(rng) * (t2 - t1), dy = v(rng) * (t2 - t1);
+  return {b, {{x + dx, y + dy}, {x + wx + dx, y + wy + dy}}, t1, t2};
+}
+
+void check_queries(const auto& index, const Objects& objs, double now, std::uint64_t seed,
+                   const std::string& what) {
+  std::mt19937_64 rng(seed);
+  for (int q = 0; q < 60; ++q) {
+    const MovingWindow<2> w = random_window(rng, now, q % 3);
+    std::vector<Id> got = index.query(w);
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, brute_window(objs, w)) << what << " query " << q;
+  }
+  std::uniform_real_distribution<double> u(0, 1000), ahead(0, 60);
+  for (int q = 0; q < 30; ++q) {
+    const Point2 p{u(rng), u(rng)};
+    const double s = now + ahead(rng);
+    const std::size_t k = 1 + q % 12;
+    const auto got = index.nearest(p, s, k);
+    const auto want = brute_nearest(objs, p, s, k);
+    ASSERT_EQ(got.size(), want.size()) << what;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      ASSERT_DOUBLE_EQ(got[i].distance, want[i]) << what << " nearest " << q << " rank " << i;
+      ASSERT_DOUBLE_EQ(std::sqrt(squared_distance(position(objs.at(got[i].id), s), p)),
+                       got[i].distance);
+    }
+  }
+}
+
+TYPED_TEST(MovingIndexTest, MatchesBruteForceOnEveryFleet) {
+  for (test::Fleet f : test::kAllFleets) {
+    const auto fleet = test::make_fleet(f, 1500, 42);
+    TypeParam index;
+    Objects objs;
+    for (std::size_t i = 0; i < fleet.size(); ++i) {
+      index.insert(Id(i * 7 + 3), fleet[i]);
+      objs[Id(i * 7 + 3)] = fleet[i];
+    }
+    index.validate();
+    EXPECT_EQ(index.size(), fleet.size());
+    check_queries(index, objs, test::fleet_epoch(f), 5, test::name(f));
+  }
+}
+
+TYPED_TEST(MovingIndexTest, UpdatesErasuresAndTicks) {
+  const auto fleet = test::make_fleet(test::Fleet::uniform, 3000, 9);
+  TypeParam index;
+  Objects objs;
+  for (std::size_t i = 0; i < fleet.size(); ++i) {
+    index.insert(i, fleet[i]);
+    objs[i] = fleet[i];
+  }
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<std::size_t> pick(0, fleet.size() + 200);
+  std::uniform_real_distribution<double> v(-3, 3), jitter(-2, 2);
+  double now = 0;
+  for (int tick = 1; tick <= 20; ++tick) {
+    now = tick * 1.0;
+    for (int u = 0; u < 120; ++u) {
+      const Id id = pick(rng);
+      if (u % 11 == 0) {
+        EXPECT_EQ(index.erase(id), objs.erase(id) == 1);
+        continue;
+      }
+      // A new report: the object where it is now (plus noise), a new velocity.
+      Motion2 m{now, {jitter(rng) + 500, jitter(rng) + 500}, {v(rng), v(rng)}};
+      if (auto it = objs.find(id); it != objs.end()) {
+        const Point2 p = position(it->second, now);
+        m.p = {p[0] + jitter(rng), p[1] + jitter(rng)};
+      }
+      index.update(id, m);
+      objs[id] = m;
+    }
+    EXPECT_EQ(index.size(), objs.size());
+    if (tick % 5 == 0) {
+      index.validate();
+      check_queries(index, objs, now, tick, "tick " + std::to_string(tick));
+    }
+  }
+  // Queries before the clock are still exact.
+  EXPECT_EQ(index.clock(), now);
+  check_queries(index, objs, now - 15, 77, "before the clock");
+  for (const auto& [id, m] : objs)
+    EXPECT_TRUE(index.erase(id));
+  EXPECT_TRUE(index.empty());
+  index.validate();
+}
+
+TYPED_TEST(MovingIndexTest, RefusesBadInput) {
+  TypeParam index;
+  index.insert(1, Motion2{0, {0, 0}, {1, 1}});
+  EXPECT_THROW(index.insert(1, Motion2{0, {0, 0}, {1, 1}}), InvalidArgument);
+  EXPECT_THROW(index.insert(2, Motion2{std::nan(""), {0, 0}, {1, 1}}), InvalidGeometry);
+  EXPECT_THROW(index.update(1, Motion2{0, {0, 0}, {INFINITY, 1}}), InvalidGeometry);
+  EXPECT_THROW(index.query(MovingWindow<2>::during({{0, 0}, {1, 1}}, 3, 2)), InvalidGeometry);
+  EXPECT_FALSE(index.erase(99));
+  EXPECT_TRUE(index.nearest(Point2{0, 0}, 0, 0).empty());
+  EXPECT_EQ(index.size(), 1u);
+  index.validate();
+}
+
+TYPED_TEST(MovingIndexTest, VisitorStopsEarly) {
+  const auto fleet = test::make_fleet(test::Fleet::clustered, 500, 1);
+  TypeParam index;
+  for (std::size_t i = 0; i < fleet.size(); ++i)
+    index.insert(i, fleet[i]);
+  int seen = 0;
+  index.query(MovingWindow<2>::during({{-1e4, -1e4}, {1e4, 1e4}}, 0, 10),
+              [&](Id, const Motion2&) { return ++seen < 5; });
+  EXPECT_EQ(seen, 5);
+  seen = 0;
+  index.nearest(Point2{500, 500}, 3, 50, [&](Id, const Motion2&, double) { return ++seen < 3; });
+  EXPECT_EQ(seen, 3);
+}
+
+}  // namespace
+}  // namespace loci
