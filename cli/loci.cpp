@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -20,6 +21,7 @@
 #include "bench.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
+#include "loci/io/fleet_commands.hpp"
 #include "loci/io/intersections.hpp"
 #include "loci/io/layer_cells.hpp"
 
@@ -260,6 +262,130 @@ int run_bench(const Args& a) {
   return 0;
 }
 
+// ---- loci fleet ----
+
+// A real number given to `flag`, finite and >= 0.
+double parse_nonnegative(const char* flag, const std::string& text) {
+  double v = 0;
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() ||
+      !std::isfinite(v) || v < 0)
+    throw UsageError(std::string("bad ") + flag + " '" + text.substr(0, 40) +
+                     "': expected a finite number >= 0");
+  return v;
+}
+
+const std::string& fleet_file(const Args& a, const char* command) {
+  if (a.positional.size() != 1)
+    throw UsageError(std::string("loci fleet ") + command +
+                     " needs exactly one FILE (see loci fleet " + command + " --help)");
+  return a.positional[0];
+}
+
+std::optional<double> at_flag(const Args& a) {
+  if (!a.has("--at")) return std::nullopt;
+  return parse_flag("--at", a.get("--at"), parse_time);
+}
+
+// The summary line of what was read, and for AIS input what the output's units are.
+void print_fleet_run(const Args& a, const FleetRun& r) {
+  if (a.has("--quiet")) return;
+  std::fprintf(stderr, "loci: %s\n", r.summary.c_str());
+  if (!r.units.empty()) std::fprintf(stderr, "loci: %s\n", r.units.c_str());
+}
+
+int run_fleet_query(const Args& a) {
+  FleetQueryOptions o;
+  o.path = fleet_file(a, "query");
+  if (a.has("--bbox") == a.has("--nearest"))
+    throw UsageError("loci fleet query needs exactly one of --bbox and --nearest");
+  if (a.has("--at") && a.has("--during")) throw UsageError("give --at or --during, not both");
+  if (a.has("--bbox")) {
+    o.box = parse_flag("--bbox", a.get("--bbox"), parse_bbox);
+  } else {
+    o.kind = FleetQueryOptions::Kind::nearest;
+    o.point = parse_flag("--nearest", a.get("--nearest"), parse_point);
+    if (a.has("--during"))
+      throw UsageError("--nearest answers at one time: use --at, not --during");
+  }
+  if (a.has("-k")) o.k = parse_count("-k", a.get("-k"), 1, kMaxK);
+  o.at = at_flag(a);
+  if (a.has("--during"))
+    o.during = parse_flag("--during", a.get("--during"),
+                          [](const std::string& t) { return parse_range(t, "interval"); });
+  o.format = parse_flag("--format", a.get("--format", "ids"), parse_format);
+  o.out_path = a.get("--output");
+  print_fleet_run(a, fleet_query(o, stdout));
+  return 0;
+}
+
+int run_fleet_conflicts(const Args& a) {
+  FleetConflictOptions o;
+  o.path = fleet_file(a, "conflicts");
+  if (!a.has("--within") || !a.has("--horizon"))
+    throw UsageError("loci fleet conflicts needs --within D and --horizon H");
+  o.within = parse_nonnegative("--within", a.get("--within"));
+  o.horizon = parse_nonnegative("--horizon", a.get("--horizon"));
+  o.at = at_flag(a);
+  o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
+  if (o.format == Format::ids) throw UsageError("--format: conflicts are csv or geojson");
+  o.out_path = a.get("--output");
+  const FleetRun r = fleet_conflicts(o, stdout);
+  print_fleet_run(a, r);
+  if (!a.has("--quiet")) std::fprintf(stderr, "loci: %zu pairs in conflict\n", r.answers);
+  return 0;
+}
+
+int run_fleet_generate(const Args& a) {
+  if (!a.positional.empty()) throw UsageError("loci fleet generate takes no FILE, only -o OUT");
+  FleetGenerateOptions o;
+  if (!a.has("--count")) throw UsageError("loci fleet generate needs --count N");
+  if (!a.has("--output")) throw UsageError("loci fleet generate needs -o OUT");
+  o.count = parse_count("--count", a.get("--count"), 1, 100000000);
+  if (a.has("--seed")) o.seed = parse_count("--seed", a.get("--seed"), 0, std::size_t(-1) / 2);
+  if (a.has("--distribution"))
+    o.distribution = parse_flag("--distribution", a.get("--distribution"), parse_distribution);
+  o.along = a.get("--along");
+  if (a.has("--format")) o.format = parse_flag("--format", a.get("--format"), parse_fleet_format);
+  if (a.has("--bbox")) o.bbox = parse_flag("--bbox", a.get("--bbox"), parse_bbox);
+  if (a.has("--speed"))
+    o.speed = parse_flag("--speed", a.get("--speed"),
+                         [](const std::string& t) { return parse_range(t, "speed range"); });
+  if (a.has("--time")) o.time = parse_flag("--time", a.get("--time"), parse_time);
+  if (a.has("--reports")) o.reports = parse_count("--reports", a.get("--reports"), 1, 100000);
+  if (a.has("--interval")) o.interval = parse_nonnegative("--interval", a.get("--interval"));
+  o.out_path = a.get("--output");
+  const std::size_t n = fleet_generate(o, stdout);
+  if (!a.has("--quiet"))
+    std::fprintf(stderr, "loci: %zu reports of %zu objects written into %s\n", n, o.count,
+                 o.out_path.c_str());
+  return 0;
+}
+
+int run_fleet_simulate(const Args& a) {
+  FleetSimulateOptions o;
+  o.path = fleet_file(a, "simulate");
+  if (!a.has("--ticks") || !a.has("--within") || !a.has("--horizon"))
+    throw UsageError("loci fleet simulate needs --ticks N, --within D and --horizon H");
+  o.ticks = parse_count("--ticks", a.get("--ticks"), 1, 10000000);
+  o.within = parse_nonnegative("--within", a.get("--within"));
+  o.horizon = parse_nonnegative("--horizon", a.get("--horizon"));
+  if (a.has("--update-fraction"))
+    o.update_fraction = parse_nonnegative("--update-fraction", a.get("--update-fraction"));
+  if (a.has("--tick")) o.tick = parse_nonnegative("--tick", a.get("--tick"));
+  if (a.has("--seed")) o.seed = parse_count("--seed", a.get("--seed"), 0, std::size_t(-1) / 2);
+  o.out_path = a.get("--output");
+  o.progress = progress_bar(a, "simulating");
+  const FleetSimulateReport r = fleet_simulate(o, stdout);
+  print_fleet_run(a, r.run);
+  if (!a.has("--quiet"))
+    std::fprintf(stderr,
+                 "loci: %zu objects, %zu ticks: %.3f ms updating and %.3f ms finding conflicts "
+                 "per tick on average, %.1f pairs\n",
+                 r.objects, o.ticks, r.mean_update_ms, r.mean_conflict_ms, r.mean_pairs);
+  return 0;
+}
+
 const Flag kLayer{"--layer", nullptr, "NAME",
                   "layer of a multi-layer dataset (default: the first)"};
 const Flag kQuiet{"--quiet", "-q", nullptr, "no progress bar and no summary line"};
@@ -355,6 +481,82 @@ const std::vector<Command>& commands() {
        "  loci draw countries.shp -o countries-index.svg --levels 2\n"
        "  loci draw countries.shp -o countries-cells.svg --cells 8\n",
        run_draw},
+      {"fleet query",
+       "loci fleet query FILE (--bbox XMIN,YMIN,XMAX,YMAX [--at T | --during T1,T2] | "
+       "--nearest X,Y [-k N] [--at T]) [-f ids|csv|geojson] [-o OUT]",
+       "moving objects in a window at a time or over an interval, or the k nearest a point "
+       "(FILE: CSV id,t,x,y[,vx,vy] or AIS CSV MMSI,BaseDateTime,LAT,LON,SOG,COG,...)",
+       {{"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX",
+         "objects in the closed window (lon/lat for AIS input)"},
+        {"--nearest", "-n", "X,Y",
+         "the k objects nearest the point, nearest first (lon/lat for AIS)"},
+        {"-k", nullptr, "N", "how many neighbours (default 1)"},
+        {"--at", nullptr, "T",
+         "the time asked about: a number, or a UTC date 2023-01-01T00:00:07 (default: now, the "
+         "latest report)"},
+        {"--during", nullptr, "T1,T2", "objects in the window at some time of [T1, T2]"},
+        {"--format", "-f", "ids|csv|geojson",
+         "ids (default), CSV id,[distance,]t,x,y (AIS: lon,lat, metres), GeoJSON points"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        kQuiet},
+       "  loci fleet query fleet.csv --bbox 0,0,100,100 --at 30\n"
+       "  loci fleet query ais.csv --nearest 10.5,56.0 -k 5 -f csv\n",
+       run_fleet_query},
+      {"fleet conflicts",
+       "loci fleet conflicts FILE --within D --horizon H [--at T] [-f csv|geojson] [-o OUT]",
+       "pairs of moving objects within distance D at some time of [now, now + H], with their "
+       "closest approach",
+       {{"--within", nullptr, "D", "the distance (planar units; metres for AIS input)"},
+        {"--horizon", nullptr, "H", "how far ahead (time units; seconds for AIS input)"},
+        {"--at", nullptr, "T", "now (default: the latest report time)"},
+        {"--format", "-f", "csv|geojson",
+         "CSV id_a,id_b,tcpa,dcpa,t_enter,t_exit,... (default) or GeoJSON lines between the "
+         "two positions at tcpa"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        kQuiet},
+       "  loci fleet conflicts fleet.csv --within 5 --horizon 60\n"
+       "  loci fleet conflicts ais.csv --within 1852 --horizon 1800 -f geojson -o cpa.geojson\n",
+       run_fleet_conflicts},
+      {"fleet generate",
+       "loci fleet generate --count N [--seed S] [--distribution uniform|clustered|lanes "
+       "--along LAYER] [--format csv|ais] [--bbox ...] [--speed MIN,MAX] [--time T0] -o OUT",
+       "a synthetic fleet, in the planar CSV or the AIS CSV format",
+       {{"--count", nullptr, "N", "objects (vessels) to generate"},
+        {"--seed", nullptr, "S", "random seed (default 1)"},
+        {"--distribution", nullptr, "uniform|clustered|lanes",
+         "where objects are: uniform (default), in clusters, or in lanes along --along's lines"},
+        {"--along", nullptr, "LAYER",
+         "line or polygon layer the lanes follow, off its lines and off its polygons (lon/lat "
+         "for AIS)"},
+        {"--format", "-f", "csv|ais", "planar id,t,x,y,vx,vy (default) or MarineCadastre AIS"},
+        {"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX",
+         "area (default 0,0,10000,10000; AIS 8,54.5,13,58 in lon/lat)"},
+        {"--speed", nullptr, "MIN,MAX", "speed range (default 1,10 per time unit; AIS 5,20 knots)"},
+        {"--time", nullptr, "T0", "time of the last reports (default 0; AIS 2023-01-01T00:00:00)"},
+        {"--reports", nullptr, "R", "reports per object (default 3)"},
+        {"--interval", nullptr, "S", "time between an object's reports (default 60)"},
+        {"--output", "-o", "OUT", "the fleet file"},
+        kQuiet},
+       "  loci fleet generate --count 1000 -o fleet.csv\n"
+       "  loci fleet generate --count 300 --format ais --distribution lanes --along "
+       "coastline.geojson -o ais.csv\n",
+       run_fleet_generate},
+      {"fleet simulate",
+       "loci fleet simulate FILE --ticks N --within D --horizon H [--update-fraction F] [--tick S]",
+       "ticks of position updates and conflict checks, timed (CSV "
+       "tick,t,updates,update_ms,conflict_ms,pairs)",
+       {{"--ticks", nullptr, "N", "how many ticks"},
+        {"--within", nullptr, "D", "conflict distance (metres for AIS input)"},
+        {"--horizon", nullptr, "H", "conflict horizon (seconds for AIS input)"},
+        {"--update-fraction", nullptr, "F",
+         "share of the fleet reporting each tick, round robin, with a small random turn (default "
+         "1/60)"},
+        {"--tick", nullptr, "S", "time between ticks (default 1)"},
+        {"--seed", nullptr, "S", "random seed of the turns (default 1)"},
+        {"--output", "-o", "OUT", "write the per-tick CSV to OUT instead of stdout"},
+        kQuiet},
+       "  loci fleet simulate ais.csv --ticks 600 --within 1852 --horizon 1800\n",
+       run_fleet_simulate},
       {"bench",
        "loci bench LAYER [--per feature|segment] [--queries N] [-k N]",
        "the layer's boxes in loci's packed R-tree and in Boost.Geometry's rtree, side by side",
@@ -385,16 +587,26 @@ void print_help() {
       "usage: loci COMMAND [options]\n\n"
       "Spatial indexes for map layers (any vector layer GDAL opens).\n\ncommands:\n");
   for (const auto& c : commands())
-    std::printf("  %-13s %s\n", c.name, c.summary);
+    std::printf("  %-16s %s\n", c.name, c.summary);
   std::printf(
-      "\nloci COMMAND --help documents every option of COMMAND.\n"
+      "\nloci COMMAND --help (loci fleet SUB --help) documents every option of COMMAND.\n"
       "Exit status 0 on success, 1 on failure with one line 'loci: error: ...' on stderr.\n\n"
       "example:\n  loci index countries.shp && loci query countries.shp --bbox 5,45,15,55\n");
 }
 
-Args parse(const Command& c, int argc, char** argv) {
+void print_fleet_help() {
+  std::printf(
+      "usage: loci fleet SUBCOMMAND [options]\n\nMoving fleets: planar CSV "
+      "(id,t,x,y[,vx,vy]) or AIS CSV (MMSI,BaseDateTime,LAT,LON,SOG,COG,...).\n\n"
+      "subcommands:\n");
+  for (const auto& c : commands())
+    if (std::strncmp(c.name, "fleet ", 6) == 0) std::printf("  %-10s %s\n", c.name + 6, c.summary);
+  std::printf("\nloci fleet SUBCOMMAND --help documents every option.\n");
+}
+
+Args parse(const Command& c, int first, int argc, char** argv) {
   Args a;
-  for (int i = 2; i < argc; ++i) {
+  for (int i = first; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg.size() < 2 || arg[0] != '-') {
       a.positional.push_back(arg);
@@ -424,15 +636,26 @@ int main(int argc, char** argv) {
     print_help();
     return argc < 2 ? 1 : 0;
   }
+  // `loci fleet SUB ...` is the command "fleet SUB" of the table.
+  std::string name = argv[1];
+  int first = 2;
+  if (name == "fleet") {
+    if (argc < 3 || argv[2][0] == '-') {
+      print_fleet_help();
+      return argc < 3 ? 1 : 0;
+    }
+    name += std::string(" ") + argv[2];
+    first = 3;
+  }
   for (const auto& c : commands()) {
-    if (c.name != std::string(argv[1])) continue;
-    for (int i = 2; i < argc; ++i)
+    if (c.name != name) continue;
+    for (int i = first; i < argc; ++i)
       if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
         print_command_help(c);
         return 0;
       }
     try {
-      const int status = c.run(parse(c, argc, argv));
+      const int status = c.run(parse(c, first, argc, argv));
       // Output that did not reach its destination (a full disk, a closed pipe) is a failure.
       if (std::fflush(stdout) != 0 || std::ferror(stdout))
         throw loci::Error(std::string("cannot write output (") +
@@ -444,6 +667,9 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::fprintf(stderr, "loci: error: unknown command '%s' (see loci --help)\n", argv[1]);
+  std::string shown;
+  for (unsigned char ch : name.substr(0, 40))
+    shown += ch < 0x20 || ch == 0x7f ? '?' : char(ch);
+  std::fprintf(stderr, "loci: error: unknown command '%s' (see loci --help)\n", shown.c_str());
   return 1;
 }

@@ -1,0 +1,632 @@
+// The library side of `loci fleet`: see fleet_commands.hpp.
+#include "loci/io/fleet_commands.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "gdal_layer.hpp"
+#include "loci/geom/error.hpp"
+#include "loci/index/moving/conflicts.hpp"
+#include "loci/index/moving/moving_scan.hpp"
+#include "loci/io/exact.hpp"
+
+namespace loci::io {
+
+// The moving index the fleet commands use.
+using FleetIndex = MovingScan<2>;
+
+namespace {
+
+constexpr double kNauticalMile = 1852.0;
+constexpr double kKnot = kNauticalMile / 3600.0;
+
+// The shortest text that reads back as the same double.
+std::string num(double d) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, d);
+  return std::string(buf, r.ptr);
+}
+
+std::string fixed(double d, int decimals) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, d);
+  return buf;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+const char* kAisUnits =
+    "AIS input: positions lon/lat (WGS 84), distances in metres (dcpa, distance) and nautical "
+    "miles (_nm), times in epoch seconds UTC (_utc: ISO dates, _min: minutes from now)";
+
+struct Loaded {
+  FleetData data;
+  double now = 0;
+  bool ais() const { return data.format == FleetFormat::ais; }
+};
+
+Loaded load(const std::string& path, std::optional<double> at) {
+  Loaded l{read_fleet_file(path), 0};
+  if (at)
+    l.now = *at;
+  else
+    l.now = l.data.reports.empty() ? 0.0 : l.data.latest();
+  return l;
+}
+
+FleetRun run_of(const Loaded& l) {
+  FleetRun r;
+  r.summary = l.data.summary();
+  if (l.ais()) r.units = kAisUnits;
+  r.now = l.now;
+  return r;
+}
+
+FleetIndex index_of(std::span<const FleetReport> reports) {
+  FleetIndex ix;
+  for (const FleetReport& r : reports)
+    ix.update(r.id, r.m);
+  return ix;
+}
+
+void check_lonlat(const Point2& p, const char* what) {
+  if (!(std::abs(p[0]) <= 180 && std::abs(p[1]) <= 90))
+    throw InvalidArgument(std::string(what) +
+                          " must be lon/lat for AIS input (lon in [-180, 180], lat in [-90, 90])");
+}
+
+// A lon/lat box as a polygon in the local frame, a vertex every 0.01 degree of its edges.
+FlatGeometry lonlat_window(const LocalFrame& frame, const Box2& b) {
+  check_lonlat(b.min, "the window");
+  check_lonlat(b.max, "the window");
+  FlatGeometry g;
+  const Point2 corners[] = {b.min, {b.max[0], b.min[1]}, b.max, {b.min[0], b.max[1]}};
+  for (int c = 0; c < 4; ++c) {
+    const Point2 a = corners[c], z = corners[(c + 1) % 4];
+    const double span = std::max(std::abs(z[0] - a[0]), std::abs(z[1] - a[1]));
+    const int n = int(std::clamp(std::ceil(span / 0.01), 1.0, 36000.0));
+    for (int i = 0; i < n; ++i) {
+      const double f = double(i) / n;
+      g.points.push_back(frame.to_local(a[0] + (z[0] - a[0]) * f, a[1] + (z[1] - a[1]) * f));
+    }
+  }
+  g.points.push_back(g.points.front());
+  g.parts.push_back({0, std::uint32_t(g.points.size()), PartKind::ring, 0});
+  g.polygons = 1;
+  return g;
+}
+
+// The first time in [lo, hi] at which the straight path of m is inside the polygon g (a hit
+// known to meet it): lo when it starts inside, else where it first crosses an edge.
+double first_time_in(const FlatGeometry& g, const Motion2& m, double lo, double hi) {
+  const Point2 a = position(m, lo), b = position(m, hi);
+  if (meets(g, Box2::of_point(a)) || lo == hi) return lo;
+  double best = 1;
+  const double dx = b[0] - a[0], dy = b[1] - a[1];
+  for (std::size_t i = 0; i + 1 < g.points.size(); ++i) {
+    const Point2 p = g.points[i], q = g.points[i + 1];
+    const double ex = q[0] - p[0], ey = q[1] - p[1];
+    const double den = dx * ey - dy * ex;
+    if (den == 0) continue;
+    const double s = ((p[0] - a[0]) * ey - (p[1] - a[1]) * ex) / den;
+    const double u = ((p[0] - a[0]) * dy - (p[1] - a[1]) * dx) / den;
+    if (s >= 0 && s <= 1 && u >= 0 && u <= 1) best = std::min(best, s);
+  }
+  return lo + (hi - lo) * best;
+}
+
+// A piece of an object's trajectory: the report in force over [lo, hi].
+struct Piece {
+  Id id;
+  Motion2 m;
+  double lo, hi;
+};
+
+// The pieces of every trajectory over [t1, t2]: each report in force at some time of it.
+std::vector<Piece> pieces_during(std::span<const FleetReport> sorted, double t1, double t2) {
+  std::vector<Piece> out;
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    const bool last = i + 1 == sorted.size() || sorted[i + 1].id != sorted[i].id;
+    const double from = std::max(t1, sorted[i].m.t);
+    const double to = last ? t2 : std::min(t2, sorted[i + 1].m.t);
+    if (sorted[i].m.t > t2 || (!last && sorted[i + 1].m.t <= t1)) continue;
+    if (from <= to) out.push_back({sorted[i].id, sorted[i].m, from, to});
+  }
+  return out;
+}
+
+struct Hit {
+  Id id;
+  double t;  // when it is in the window (the first time, for an interval)
+  Point2 p;  // where, in the frame
+  double distance = 0;
+};
+
+std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
+  std::optional<FlatGeometry> poly;
+  Box2 box = o.box;
+  if (l.ais()) {
+    if (!l.data.frame) return {};
+    poly = lonlat_window(*l.data.frame, o.box);
+    box = poly->envelope();
+  }
+  std::vector<Hit> hits;
+  if (!o.during) {
+    const auto now = in_force(l.data.reports, l.now);
+    const FleetIndex ix = index_of(now);
+    ix.query(MovingWindow<2>::at(box, l.now), [&](Id id, const Motion2& m) {
+      const Point2 p = position(m, l.now);
+      if (!poly || meets(*poly, Box2::of_point(p))) hits.push_back({id, l.now, p});
+      return true;
+    });
+  } else {
+    const auto [t1, t2] = *o.during;
+    const std::vector<Piece> pieces = pieces_during(l.data.reports, t1, t2);
+    FleetIndex ix;
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+      ix.insert(i, pieces[i].m);
+    ix.query(MovingWindow<2>::during(box, t1, t2), [&](Id i, const Motion2& m) {
+      const Piece& pc = pieces[i];
+      const LinearSpan s = meets(m, MovingWindow<2>::during(box, pc.lo, pc.hi));
+      if (s.empty()) return true;
+      double t = s.lo;
+      if (poly) {
+        const Segment2 path{position(m, pc.lo), position(m, pc.hi)};
+        if (!meets(*poly, path)) return true;
+        t = first_time_in(*poly, m, pc.lo, pc.hi);
+      }
+      hits.push_back({pc.id, t, position(m, t)});
+      return true;
+    });
+  }
+  // One row per id, its earliest time in the window.
+  std::sort(hits.begin(), hits.end(),
+            [](const Hit& a, const Hit& b) { return a.id != b.id ? a.id < b.id : a.t < b.t; });
+  hits.erase(std::unique(hits.begin(), hits.end(),
+                         [](const Hit& a, const Hit& b) { return a.id == b.id; }),
+             hits.end());
+  return hits;
+}
+
+std::vector<Hit> nearest_hits(const Loaded& l, const FleetQueryOptions& o) {
+  Point2 q = o.point;
+  if (l.ais()) {
+    check_lonlat(q, "the point");
+    if (!l.data.frame) return {};
+    q = l.data.frame->to_local(q[0], q[1]);
+  }
+  const FleetIndex ix = index_of(in_force(l.data.reports, l.now));
+  std::vector<Hit> hits;
+  ix.nearest(q, l.now, o.k, [&](Id id, const Motion2& m, double d) {
+    hits.push_back({id, l.now, position(m, l.now), d});
+    return true;
+  });
+  return hits;
+}
+
+// "lon,lat" (AIS) or "x,y" of a frame position, for CSV and GeoJSON.
+Point2 shown(const Loaded& l, const Point2& p) {
+  return l.ais() ? l.data.frame->to_lonlat(p) : p;
+}
+
+void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, Format format,
+                std::FILE* out) {
+  const bool ais = l.ais();
+  if (format == Format::ids) {
+    for (const Hit& h : hits)
+      std::fprintf(out, "%llu\n", static_cast<unsigned long long>(h.id));
+    return;
+  }
+  if (format == Format::csv) {
+    std::string head = nearest ? "id,distance" : "id";
+    if (nearest && ais) head += ",distance_nm";
+    head += ais ? ",t,time_utc,lon,lat" : ",t,x,y";
+    std::fprintf(out, "%s\n", head.c_str());
+    for (const Hit& h : hits) {
+      std::string row = std::to_string(h.id);
+      if (nearest) row += "," + num(h.distance);
+      if (nearest && ais) row += "," + fixed(h.distance / kNauticalMile, 4);
+      row += "," + num(h.t);
+      if (ais) row += "," + format_utc(h.t);
+      const Point2 p = shown(l, h.p);
+      row += "," + num(p[0]) + "," + num(p[1]);
+      std::fprintf(out, "%s\n", row.c_str());
+    }
+    return;
+  }
+  std::fprintf(out, "{\"type\":\"FeatureCollection\",\"features\":[");
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    const Hit& h = hits[i];
+    const Point2 p = shown(l, h.p);
+    std::fprintf(out, "%s\n{\"type\":\"Feature\",\"properties\":{\"id\":%llu,\"t\":%s",
+                 i ? "," : "", static_cast<unsigned long long>(h.id), num(h.t).c_str());
+    if (ais) std::fprintf(out, ",\"time_utc\":\"%s\"", format_utc(h.t).c_str());
+    if (nearest) std::fprintf(out, ",\"distance\":%s", num(h.distance).c_str());
+    std::fprintf(out, "},\"geometry\":{\"type\":\"Point\",\"coordinates\":[%s,%s]}}",
+                 num(p[0]).c_str(), num(p[1]).c_str());
+  }
+  std::fprintf(out, "\n]}\n");
+}
+
+}  // namespace
+
+FleetRun fleet_query(const FleetQueryOptions& o, std::FILE* fallback) {
+  if (o.kind == FleetQueryOptions::Kind::nearest && o.during)
+    throw InvalidArgument("--nearest answers at one time (--at), not --during");
+  if (o.during && !(o.during->first <= o.during->second))
+    throw InvalidArgument("--during T1,T2 needs T1 <= T2");
+  const Loaded l = load(o.path, o.at);
+  std::vector<Hit> hits;
+  if (o.kind == FleetQueryOptions::Kind::nearest)
+    hits = nearest_hits(l, o);
+  else
+    hits = window_hits(l, o);
+  OutputFile out(o.out_path, fallback);
+  write_hits(l, hits, o.kind == FleetQueryOptions::Kind::nearest, o.format, out.stream());
+  out.commit();
+  FleetRun r = run_of(l);
+  r.answers = hits.size();
+  return r;
+}
+
+FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
+  check_conflict_query(o.within, o.at.value_or(0), o.horizon);
+  if (o.format == Format::ids)
+    throw InvalidArgument("conflicts are written as csv or geojson, not ids");
+  const Loaded l = load(o.path, o.at);
+  const auto now = in_force(l.data.reports, l.now);
+  std::vector<Id> ids;
+  std::vector<Motion2> motions;
+  for (const FleetReport& r : now) {
+    ids.push_back(r.id);
+    motions.push_back(r.m);
+  }
+  const std::vector<Conflict> found = find_conflicts<2>(ids, motions, o.within, l.now, o.horizon);
+  auto motion_of = [&](Id id) {
+    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
+    return motions[std::size_t(it - ids.begin())];
+  };
+  const bool ais = l.ais();
+  OutputFile out(o.out_path, fallback);
+  std::FILE* f = out.stream();
+  if (o.format == Format::csv) {
+    std::fprintf(f, "id_a,id_b,tcpa,dcpa,t_enter,t_exit%s\n",
+                 ais ? ",dcpa_nm,tcpa_utc,tcpa_min,t_enter_utc,t_exit_utc,lon_a,lat_a,lon_b,lat_b"
+                     : ",x_a,y_a,x_b,y_b");
+  } else {
+    std::fprintf(f, "{\"type\":\"FeatureCollection\",\"features\":[");
+  }
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    const Conflict& c = found[i];
+    const Approach& ap = c.approach;
+    const Point2 a = shown(l, position(motion_of(c.a), ap.tcpa));
+    const Point2 b = shown(l, position(motion_of(c.b), ap.tcpa));
+    const std::string ia = std::to_string(c.a), ib = std::to_string(c.b);
+    if (o.format == Format::csv) {
+      std::string row = ia + "," + ib + "," + num(ap.tcpa) + "," + num(ap.dcpa) + "," +
+                        num(ap.t_enter) + "," + num(ap.t_exit);
+      if (ais)
+        row += "," + fixed(ap.dcpa / kNauticalMile, 4) + "," + format_utc(ap.tcpa) + "," +
+               fixed((ap.tcpa - l.now) / 60, 2) + "," + format_utc(ap.t_enter) + "," +
+               format_utc(ap.t_exit);
+      row += "," + num(a[0]) + "," + num(a[1]) + "," + num(b[0]) + "," + num(b[1]);
+      std::fprintf(f, "%s\n", row.c_str());
+      continue;
+    }
+    std::string props = "\"id_a\":" + ia + ",\"id_b\":" + ib + ",\"tcpa\":" + num(ap.tcpa) +
+                        ",\"dcpa\":" + num(ap.dcpa) + ",\"t_enter\":" + num(ap.t_enter) +
+                        ",\"t_exit\":" + num(ap.t_exit);
+    if (ais)
+      props += ",\"dcpa_nm\":" + fixed(ap.dcpa / kNauticalMile, 4) + ",\"tcpa_utc\":\"" +
+               format_utc(ap.tcpa) + "\",\"tcpa_min\":" + fixed((ap.tcpa - l.now) / 60, 2);
+    std::fprintf(f,
+                 "%s\n{\"type\":\"Feature\",\"properties\":{%s},\"geometry\":{\"type\":"
+                 "\"LineString\",\"coordinates\":[[%s,%s],[%s,%s]]}}",
+                 i ? "," : "", props.c_str(), num(a[0]).c_str(), num(a[1]).c_str(),
+                 num(b[0]).c_str(), num(b[1]).c_str());
+  }
+  if (o.format == Format::geojson) std::fprintf(f, "\n]}\n");
+  out.commit();
+  FleetRun r = run_of(l);
+  r.answers = found.size();
+  return r;
+}
+
+// ---- generate ----
+
+FleetGenerateOptions::Distribution parse_distribution(const std::string& name) {
+  if (name == "uniform") return FleetGenerateOptions::Distribution::uniform;
+  if (name == "clustered") return FleetGenerateOptions::Distribution::clustered;
+  if (name == "lanes") return FleetGenerateOptions::Distribution::lanes;
+  throw InvalidArgument("unknown distribution '" + name.substr(0, 40) +
+                        "' (choose uniform, clustered or lanes)");
+}
+
+FleetFormat parse_fleet_format(const std::string& name) {
+  if (name == "csv") return FleetFormat::planar;
+  if (name == "ais") return FleetFormat::ais;
+  throw InvalidArgument("unknown fleet format '" + name.substr(0, 40) + "' (choose csv or ais)");
+}
+
+std::pair<double, double> parse_range(const std::string& text, const char* what) {
+  const std::size_t comma = text.find(',');
+  auto bad = [&] {
+    return InvalidArgument(std::string("bad ") + what + " '" + text.substr(0, 40) +
+                           "': expected A,B with A <= B");
+  };
+  if (comma == std::string::npos) throw bad();
+  double a = 0, b = 0;
+  try {
+    a = parse_time(text.substr(0, comma));
+    b = parse_time(text.substr(comma + 1));
+  } catch (const Error&) {
+    throw bad();
+  }
+  if (!(a <= b)) throw bad();
+  return {a, b};
+}
+
+namespace {
+
+// A place and a direction for a generated object, in the generation frame.
+struct Start {
+  Point2 p;
+  double heading;  // radians, counterclockwise from +x
+};
+
+// Segments of a line layer (lon/lat for AIS: then in the frame), with their lengths, and the
+// polygons of the layer so that lane positions can stay off them.
+struct Lanes {
+  std::vector<Segment2> segments;
+  std::vector<double> cumulative;  // running length
+  std::vector<FlatGeometry> areas;
+
+  Lanes(const std::string& path, const LocalFrame* frame) {
+    auto ol = detail::open_layer(path, "");
+    auto map = [&](const Point2& p) { return frame ? frame->to_local(p[0], p[1]) : p; };
+    for (auto& f : *ol.layer) {
+      const OGRGeometry* g = f->GetGeometryRef();
+      if (!g) continue;
+      detail::for_each_curve(g, [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
+        for (int i = 0; i + 1 < c.getNumPoints(); ++i) {
+          const Segment2 s{map({c.getX(i), c.getY(i)}), map({c.getX(i + 1), c.getY(i + 1)})};
+          const double len = std::hypot(s.b[0] - s.a[0], s.b[1] - s.a[1]);
+          if (!(len > 0)) continue;
+          segments.push_back(s);
+          cumulative.push_back((cumulative.empty() ? 0 : cumulative.back()) + len);
+        }
+      });
+      if (OGR_GT_Flatten(g->getGeometryType()) == wkbPolygon ||
+          OGR_GT_Flatten(g->getGeometryType()) == wkbMultiPolygon) {
+        FlatGeometry fg = detail::flatten(g, path);
+        for (Point2& p : fg.points)
+          p = map(p);
+        areas.push_back(std::move(fg));
+      }
+    }
+    if (segments.empty()) throw Error(path + ": has no linework to lay lanes along");
+  }
+
+  bool on_land(const Point2& p) const {
+    for (const FlatGeometry& a : areas)
+      if (meets(a, Box2::of_point(p))) return true;
+    return false;
+  }
+};
+
+}  // namespace
+
+std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
+  using Dist = FleetGenerateOptions::Distribution;
+  const bool ais = o.format == FleetFormat::ais;
+  if (o.count == 0) throw InvalidArgument("--count must be >= 1");
+  if (o.reports == 0) throw InvalidArgument("reports per object must be >= 1");
+  if (!(o.interval > 0) || !std::isfinite(o.interval))
+    throw InvalidArgument("the interval between reports must be > 0");
+  if (o.distribution == Dist::lanes && o.along.empty())
+    throw InvalidArgument("--distribution lanes needs --along LAYER");
+  const Box2 bbox = o.bbox.value_or(ais ? Box2{{8, 54.5}, {13, 58}} : Box2{{0, 0}, {1e4, 1e4}});
+  if (ais) {
+    check_lonlat(bbox.min, "--bbox");
+    check_lonlat(bbox.max, "--bbox");
+  }
+  const auto [vmin, vmax] = o.speed.value_or(ais ? std::pair{5.0, 20.0} : std::pair{1.0, 10.0});
+  if (!(vmin >= 0) || (ais && vmax > 102.2))
+    throw InvalidArgument(ais ? "--speed must be in [0, 102.2] knots" : "--speed must be >= 0");
+  const double t_last = o.time.value_or(ais ? 1672531200.0 : 0.0);
+
+  // Generation happens in a planar frame: the input's own for CSV, a local frame for AIS.
+  std::optional<LocalFrame> frame;
+  Box2 area = bbox;
+  if (ais) {
+    frame.emplace(0.5 * (bbox.min[0] + bbox.max[0]), 0.5 * (bbox.min[1] + bbox.max[1]));
+    area = Box2::of_point(frame->to_local(bbox.min[0], bbox.min[1]));
+    for (const Point2& c :
+         {Point2{bbox.max[0], bbox.min[1]}, bbox.max, Point2{bbox.min[0], bbox.max[1]},
+          Point2{0.5 * (bbox.min[0] + bbox.max[0]), bbox.min[1]},
+          Point2{0.5 * (bbox.min[0] + bbox.max[0]), bbox.max[1]}})
+      area.expand(frame->to_local(c[0], c[1]));
+  }
+  auto inside = [&](const Point2& p) {
+    if (!ais) return contains(bbox, Box2::of_point(p));
+    const Point2 ll = frame->to_lonlat(p);
+    return contains(bbox, Box2::of_point(ll));
+  };
+  const double size = std::max(area.max[0] - area.min[0], area.max[1] - area.min[1]);
+
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  auto uniform_in = [&](const Box2& b) {
+    return Point2{b.min[0] + (b.max[0] - b.min[0]) * unit(rng),
+                  b.min[1] + (b.max[1] - b.min[1]) * unit(rng)};
+  };
+  std::optional<Lanes> lanes;
+  if (o.distribution == Dist::lanes) lanes.emplace(o.along, ais ? &*frame : nullptr);
+  std::vector<Point2> centres;
+  for (int i = 0; i < 8; ++i)
+    centres.push_back(uniform_in(area));
+  std::normal_distribution<double> spread(0, size / 40);
+
+  auto place = [&]() -> std::optional<Start> {
+    for (int attempt = 0; attempt < 1000; ++attempt) {
+      Start s{};
+      s.heading = 2 * std::numbers::pi * unit(rng);
+      if (o.distribution == Dist::uniform) {
+        s.p = uniform_in(area);
+      } else if (o.distribution == Dist::clustered) {
+        const Point2 c = centres[std::size_t(unit(rng) * double(centres.size())) % centres.size()];
+        s.p = {c[0] + spread(rng), c[1] + spread(rng)};
+      } else {
+        const double at = unit(rng) * lanes->cumulative.back();
+        const std::size_t i =
+            std::size_t(std::lower_bound(lanes->cumulative.begin(), lanes->cumulative.end(), at) -
+                        lanes->cumulative.begin());
+        const Segment2& seg = lanes->segments[std::min(i, lanes->segments.size() - 1)];
+        const double dx = seg.b[0] - seg.a[0], dy = seg.b[1] - seg.a[1];
+        const double len = std::hypot(dx, dy), f = unit(rng);
+        // Off the line by 1% to 4% of the area's size (2 to 8 km off a coast for AIS), on
+        // the side away from the layer's polygons; the lane runs either way along the line.
+        const double off = (ais ? 2000 + 6000 * unit(rng) : size * (0.01 + 0.03 * unit(rng)));
+        const double side = unit(rng) < 0.5 ? 1 : -1;
+        s.p = {seg.a[0] + dx * f - side * dy / len * off,
+               seg.a[1] + dy * f + side * dx / len * off};
+        if (lanes->on_land(s.p)) {
+          s.p = {seg.a[0] + dx * f + side * dy / len * off,
+                 seg.a[1] + dy * f - side * dx / len * off};
+          if (lanes->on_land(s.p)) continue;
+        }
+        s.heading =
+            std::atan2(dy, dx) + (unit(rng) < 0.5 ? 0 : std::numbers::pi) + 0.1 * (unit(rng) - 0.5);
+      }
+      if (inside(s.p)) return s;
+    }
+    return std::nullopt;
+  };
+
+  struct Out {
+    double t;
+    Id id;
+    Point2 p, v;
+  };
+  std::vector<Out> rows;
+  for (std::size_t n = 0; n < o.count; ++n) {
+    const auto s = place();
+    if (!s)
+      throw Error("cannot place object " + std::to_string(n + 1) +
+                  " inside --bbox (the lanes or clusters may lie outside it)");
+    const double speed = (vmin + (vmax - vmin) * unit(rng)) * (ais ? kKnot : 1.0);
+    const Id id = ais ? Id(219000000 + n) : Id(n + 1);
+    // The last report is at (about) t_last at the placed position; earlier ones trace back
+    // along the course, turning a little between reports.
+    double heading = s->heading;
+    Point2 p = s->p;
+    double t = t_last - std::floor(o.interval * unit(rng) * 0.5);
+    for (std::size_t r = 0; r < o.reports; ++r) {
+      const Point2 v{speed * std::cos(heading), speed * std::sin(heading)};
+      rows.push_back({t, id, p, v});
+      heading += 0.05 * (unit(rng) - 0.5);
+      const Point2 back{speed * std::cos(heading), speed * std::sin(heading)};
+      p = {p[0] - back[0] * o.interval, p[1] - back[1] * o.interval};
+      t -= o.interval;
+    }
+  }
+  std::sort(rows.begin(), rows.end(),
+            [](const Out& a, const Out& b) { return a.t != b.t ? a.t < b.t : a.id < b.id; });
+
+  OutputFile out(o.out_path, fallback);
+  std::FILE* f = out.stream();
+  if (ais) {
+    std::fprintf(f,
+                 "MMSI,BaseDateTime,LAT,LON,SOG,COG,Heading,VesselName,IMO,CallSign,VesselType,"
+                 "Status,Length,Width,Draft,Cargo,TransceiverClass\n");
+    for (const Out& r : rows) {
+      const Point2 ll = frame->to_lonlat(r.p);
+      auto [speed, cog] = frame->course(r.p, r.v);
+      cog = std::round(cog * 10) / 10;
+      if (cog >= 360) cog -= 360;
+      std::fprintf(f, "%llu,%s,%.5f,%.5f,%.1f,%.1f,%d,SYNTHETIC %llu,,,70,0,120,20,7.5,70,A\n",
+                   static_cast<unsigned long long>(r.id), format_utc(r.t).substr(0, 19).c_str(),
+                   ll[1], ll[0], speed / kKnot, cog, int(std::lround(cog)) % 360,
+                   static_cast<unsigned long long>(r.id - 219000000));
+    }
+  } else {
+    std::fprintf(f, "id,t,x,y,vx,vy\n");
+    for (const Out& r : rows)
+      std::fprintf(f, "%llu,%s,%s,%s,%s,%s\n", static_cast<unsigned long long>(r.id),
+                   num(r.t).c_str(), num(r.p[0]).c_str(), num(r.p[1]).c_str(), num(r.v[0]).c_str(),
+                   num(r.v[1]).c_str());
+  }
+  out.commit();
+  return rows.size();
+}
+
+// ---- simulate ----
+
+FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fallback) {
+  check_conflict_query(o.within, 0, o.horizon);
+  if (!(o.update_fraction >= 0 && o.update_fraction <= 1))
+    throw InvalidArgument("--update-fraction must be in [0, 1]");
+  if (!(o.tick > 0) || !std::isfinite(o.tick)) throw InvalidArgument("--tick must be > 0");
+  const Loaded l = load(o.path, std::nullopt);
+  const auto start = in_force(l.data.reports, l.now);
+  std::vector<Id> ids;
+  std::vector<Motion2> motions;
+  for (const FleetReport& r : start) {
+    ids.push_back(r.id);
+    motions.push_back(r.m);
+  }
+  FleetIndex ix = index_of(start);
+  FleetSimulateReport rep;
+  rep.run = run_of(l);
+  rep.objects = ids.size();
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> turn(0, 0.05);
+  const std::size_t per_tick =
+      ids.empty() ? 0
+                  : std::max<std::size_t>(
+                        1, std::size_t(std::llround(o.update_fraction * double(ids.size()))));
+  OutputFile out(o.out_path, fallback);
+  std::FILE* f = out.stream();
+  std::fprintf(f, "tick,t,updates,update_ms,conflict_ms,pairs\n");
+  ProgressTicker ticker(o.progress, double(o.ticks));
+  std::size_t next = 0;  // round robin: each tick the next per_tick objects report
+  double total_update = 0, total_conflict = 0, total_pairs = 0;
+  for (std::size_t tick = 1; tick <= o.ticks; ++tick) {
+    const double t = l.now + o.tick * double(tick);
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t u = 0; u < per_tick && o.update_fraction > 0; ++u, ++next) {
+      const std::size_t i = next % ids.size();
+      Motion2 m = motions[i];
+      const Point2 p = position(m, t);
+      const double a = turn(rng), c = std::cos(a), s = std::sin(a);
+      m = {t, p, {m.v[0] * c - m.v[1] * s, m.v[0] * s + m.v[1] * c}};
+      motions[i] = m;
+      ix.update(ids[i], m);
+    }
+    const double update_ms = 1e3 * seconds_since(t0);
+    const auto t1 = std::chrono::steady_clock::now();
+    const std::vector<Conflict> found = find_conflicts<2>(ids, motions, o.within, t, o.horizon);
+    const double conflict_ms = 1e3 * seconds_since(t1);
+    std::fprintf(f, "%zu,%s,%zu,%.3f,%.3f,%zu\n", tick, num(t).c_str(),
+                 o.update_fraction > 0 ? per_tick : 0, update_ms, conflict_ms, found.size());
+    total_update += update_ms;
+    total_conflict += conflict_ms;
+    total_pairs += double(found.size());
+    ticker.tick(double(tick));
+  }
+  out.commit();
+  if (o.ticks) {
+    rep.mean_update_ms = total_update / double(o.ticks);
+    rep.mean_conflict_ms = total_conflict / double(o.ticks);
+    rep.mean_pairs = total_pairs / double(o.ticks);
+  }
+  return rep;
+}
+
+}  // namespace loci::io
