@@ -1,0 +1,448 @@
+// `loci fleet` through the real executable: windows, intervals and nearest-n against a brute
+// force over the reports in force (computed here from the rows the test wrote), conflicts
+// against closest_approach over all pairs, at the latest time and at a time before it, with
+// epoch-second timestamps and sub-second motion, on planar and AIS input; and bad input, bad
+// flags and unwritable outputs as one-line errors that leave nothing behind.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "layers/cli_support.hpp"
+#include "loci/geom/motion.hpp"
+#include "loci/io/fleet.hpp"
+
+namespace fs = std::filesystem;
+using namespace loci;
+using namespace loci::test;
+
+namespace {
+
+const std::string kData = LOCI_FLEET_DATA;
+const std::string kSample = std::string(LOCI_DATASETS_DIR) + "/samples/ais-denmark-synthetic.csv";
+const std::string kCoast = std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson";
+
+struct Row {
+  Id id;
+  Motion2 m;
+};
+
+std::string num(double d) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", d);
+  return b;
+}
+
+// n objects with 1 to 3 reports each at times t0 + [0, span), written in shuffled order.
+std::vector<Row> make_rows(std::size_t n, std::uint64_t seed, double t0, double span, double extent,
+                           double speed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Row> rows;
+  for (std::size_t i = 0; i < n; ++i) {
+    const int reports = 1 + int(u(rng) * 3);
+    std::set<double> times;
+    while (int(times.size()) < reports)
+      times.insert(t0 + span * u(rng));
+    for (double t : times)
+      rows.push_back({Id(1000 + 7 * i),
+                      {t,
+                       {extent * u(rng), extent * u(rng)},
+                       {speed * (2 * u(rng) - 1), speed * (2 * u(rng) - 1)}}});
+  }
+  std::shuffle(rows.begin(), rows.end(), rng);
+  return rows;
+}
+
+std::string csv_of(const std::vector<Row>& rows) {
+  std::string s = "vy,id,x,t,y,vx,label\n";
+  for (const Row& r : rows)
+    s += num(r.m.v[1]) + "," + std::to_string(r.id) + "," + num(r.m.p[0]) + "," + num(r.m.t) + "," +
+         num(r.m.p[1]) + "," + num(r.m.v[0]) + ",\"boat, " + std::to_string(r.id) + "\"\n";
+  return s;
+}
+
+// The brute-force fleet at t: each id's latest report with time <= t.
+std::map<Id, Motion2> brute_in_force(const std::vector<Row>& rows, double t) {
+  std::map<Id, Motion2> out;
+  for (const Row& r : rows)
+    if (r.m.t <= t && (!out.count(r.id) || out[r.id].t < r.m.t)) out[r.id] = r.m;
+  return out;
+}
+
+double latest(const std::vector<Row>& rows) {
+  double t = -INFINITY;
+  for (const Row& r : rows)
+    t = std::max(t, r.m.t);
+  return t;
+}
+
+std::vector<Id> ids_of(const std::string& out) {
+  std::vector<Id> v;
+  for (const auto& l : lines(out))
+    v.push_back(std::stoull(l));
+  return v;
+}
+
+std::vector<std::vector<std::string>> csv_rows(const std::string& out) {
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& l : lines(out)) {
+    std::vector<std::string> f;
+    std::stringstream s(l);
+    for (std::string x; std::getline(s, x, ',');)
+      f.push_back(x);
+    rows.push_back(f);
+  }
+  return rows;
+}
+
+void expect_one_line_error(const CliRun& r, const std::string& what = "") {
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("loci: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+}
+
+class FleetCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("loci-fleet-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name), std::ios::binary) << text;
+    return path(name);
+  }
+  fs::path dir_;
+};
+
+// Windows at the latest time and at earlier ones, against the brute force.
+void check_windows(const std::string& file, const std::vector<Row>& rows, double extent,
+                   std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double t_end = latest(rows);
+  double t_first = INFINITY;
+  for (const Row& r : rows)
+    t_first = std::min(t_first, r.m.t);
+  const double span = t_end - t_first;
+  for (int q = 0; q < 12; ++q) {
+    const double x = extent * u(rng), y = extent * u(rng), w = extent * 0.4 * u(rng);
+    const Box2 box{{x, y}, {x + w, y + w}};
+    const bool at_latest = q % 3 == 0;
+    const double t = at_latest ? t_end : t_first + span * u(rng);
+    std::string args = "fleet query " + shell_quote(file) + " -q --bbox " + num(box.min[0]) + "," +
+                       num(box.min[1]) + "," + num(box.max[0]) + "," + num(box.max[1]);
+    if (!at_latest) args += " --at " + num(t);
+    const CliRun r = run_loci(args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::vector<Id> want;
+    for (const auto& [id, m] : brute_in_force(rows, t))
+      if (intersects(box, Box2::of_point(position(m, t)))) want.push_back(id);
+    EXPECT_EQ(ids_of(r.out), want) << args;
+  }
+}
+
+TEST_F(FleetCli, WindowsAtATimeMatchBruteForce) {
+  const auto rows = make_rows(400, 11, 0, 100, 1000, 3);
+  const std::string f = write("fleet.csv", csv_of(rows));
+  check_windows(f, rows, 1000, 12);
+}
+
+TEST_F(FleetCli, EpochSecondsWithSubSecondMotion) {
+  // Reports within one second of 1.7e9, moving a few units a second.
+  const auto rows = make_rows(300, 21, 1.7e9, 0.9, 100, 4);
+  const std::string f = write("epoch.csv", csv_of(rows));
+  check_windows(f, rows, 100, 22);
+  const double now = latest(rows);
+  const CliRun r = run_loci("fleet conflicts " + shell_quote(f) + " --within 3 --horizon 2 -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto fleet = brute_in_force(rows, now);
+  std::size_t want = 0;
+  for (auto a = fleet.begin(); a != fleet.end(); ++a)
+    for (auto b = std::next(a); b != fleet.end(); ++b)
+      want += closest_approach(a->second, b->second, now, 2.0, 3.0).has_value();
+  EXPECT_GT(want, 0u);
+  EXPECT_EQ(lines(r.out).size(), want + 1);
+}
+
+TEST_F(FleetCli, WindowOverAnIntervalMatchesBruteForce) {
+  const auto rows = make_rows(300, 31, 0, 100, 1000, 3);
+  const std::string f = write("fleet.csv", csv_of(rows));
+  std::mt19937_64 rng(32);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int q = 0; q < 10; ++q) {
+    const double x = 1000 * u(rng), y = 1000 * u(rng), w = 200 * u(rng);
+    const double t1 = 100 * u(rng), t2 = t1 + 40 * u(rng);
+    const Box2 box{{x, y}, {x + w, y + w}};
+    const CliRun r =
+        run_loci("fleet query " + shell_quote(f) + " -q -f csv --bbox " + num(x) + "," + num(y) +
+                 "," + num(x + w) + "," + num(y + w) + " --during " + num(t1) + "," + num(t2));
+    ASSERT_EQ(r.status, 0) << r.err;
+    // Each id's trajectory over [t1, t2]: report k holds from its time to the next report's.
+    std::map<Id, std::vector<Motion2>> by_id;
+    for (const Row& row : rows)
+      by_id[row.id].push_back(row.m);
+    std::vector<Id> want;
+    for (auto& [id, ms] : by_id) {
+      std::sort(ms.begin(), ms.end(), [](auto& a, auto& b) { return a.t < b.t; });
+      bool hit = false;
+      for (std::size_t k = 0; k < ms.size() && !hit; ++k) {
+        const double lo = std::max(t1, ms[k].t);
+        const double hi = k + 1 < ms.size() ? std::min(t2, ms[k + 1].t) : t2;
+        hit = lo <= hi && !meets(ms[k], MovingWindow<2>::during(box, lo, hi)).empty();
+      }
+      if (hit) want.push_back(id);
+    }
+    const auto got = csv_rows(r.out);
+    ASSERT_FALSE(got.empty());
+    EXPECT_EQ(lines(r.out)[0], "id,t,x,y");
+    std::vector<Id> ids;
+    for (std::size_t i = 1; i < got.size(); ++i) {
+      ids.push_back(std::stoull(got[i][0]));
+      const double t = std::stod(got[i][1]);
+      EXPECT_TRUE(t >= t1 && t <= t2);
+    }
+    EXPECT_EQ(ids, want);
+  }
+}
+
+TEST_F(FleetCli, NearestMatchesBruteForce) {
+  const auto rows = make_rows(300, 41, 0, 100, 1000, 3);
+  const std::string f = write("fleet.csv", csv_of(rows));
+  for (double t : {latest(rows), 60.0}) {
+    const CliRun r = run_loci("fleet query " + shell_quote(f) +
+                              " -q --nearest 500,400 -k 7 -f csv --at " + num(t));
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::vector<double> want;
+    for (const auto& [id, m] : brute_in_force(rows, t)) {
+      const Point2 p = position(m, t);
+      want.push_back(std::hypot(p[0] - 500, p[1] - 400));
+    }
+    std::sort(want.begin(), want.end());
+    const auto got = csv_rows(r.out);
+    ASSERT_EQ(got.size(), 8u);
+    EXPECT_EQ(lines(r.out)[0], "id,distance,t,x,y");
+    for (std::size_t i = 1; i < got.size(); ++i)
+      EXPECT_NEAR(std::stod(got[i][1]), want[i - 1], 1e-9 * (1 + want[i - 1]));
+  }
+}
+
+TEST_F(FleetCli, ConflictsMatchAllPairsAtTheLatestTimeAndBefore) {
+  const auto rows = make_rows(300, 51, 0, 100, 1000, 3);
+  const std::string f = write("fleet.csv", csv_of(rows));
+  for (const double at : {latest(rows), 40.0}) {
+    const bool given = at != latest(rows);
+    const CliRun r = run_loci("fleet conflicts " + shell_quote(f) + " --within 15 --horizon 30" +
+                              (given ? " --at 40" : ""));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("loci: read "), std::string::npos) << r.err;
+    const auto got = csv_rows(r.out);
+    ASSERT_FALSE(got.empty());
+    EXPECT_EQ(lines(r.out)[0].rfind("id_a,id_b,tcpa,dcpa,t_enter,t_exit", 0), 0u);
+    const auto fleet = brute_in_force(rows, at);
+    std::vector<std::vector<std::string>> want;
+    for (auto a = fleet.begin(); a != fleet.end(); ++a)
+      for (auto b = std::next(a); b != fleet.end(); ++b)
+        if (const auto ap = closest_approach(a->second, b->second, at, 30.0, 15.0))
+          want.push_back({std::to_string(a->first), std::to_string(b->first),
+                          std::to_string(ap->tcpa), std::to_string(ap->dcpa)});
+    ASSERT_GT(want.size(), 3u);
+    ASSERT_EQ(got.size(), want.size() + 1);
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      const auto& g = got[i + 1];
+      EXPECT_EQ(g[0], want[i][0]);
+      EXPECT_EQ(g[1], want[i][1]);
+      EXPECT_EQ(std::to_string(std::stod(g[2])), want[i][2]);
+      EXPECT_EQ(std::to_string(std::stod(g[3])), want[i][3]);
+      EXPECT_LE(std::stod(g[4]), std::stod(g[2]));
+      EXPECT_GE(std::stod(g[5]), std::stod(g[2]));
+    }
+  }
+}
+
+TEST_F(FleetCli, ConflictsAsGeoJsonForAMap) {
+  const auto rows = make_rows(200, 61, 0, 100, 1000, 3);
+  const std::string f = write("fleet.csv", csv_of(rows));
+  const std::string out = path("cpa.geojson");
+  const CliRun csv = run_loci("fleet conflicts " + shell_quote(f) + " --within 20 --horizon 30 -q");
+  const CliRun r = run_loci("fleet conflicts " + shell_quote(f) +
+                            " --within 20 --horizon 30 -q -f geojson -o " + shell_quote(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const OgrFeatureSet s = read_with_ogr(out);
+  EXPECT_EQ(s.fids.size() + 1, lines(csv.out).size());
+  for (const auto& g : s.geoms)
+    EXPECT_EQ(wkbFlatten(g->getGeometryType()), wkbLineString);
+}
+
+TEST_F(FleetCli, AisConflictsAndLonLatWindowsMatchBruteForce) {
+  const std::string f = path("ais.csv");
+  ASSERT_EQ(run_loci("fleet generate --count 250 --seed 5 --format ais --distribution lanes "
+                     "--along " +
+                     shell_quote(kCoast) + " -q -o " + shell_quote(f))
+                .status,
+            0);
+  const io::FleetData d = io::read_fleet_file(f);
+  const double now = d.latest();
+  const auto fleet = io::in_force(d.reports, now);
+  const CliRun r = run_loci("fleet conflicts " + shell_quote(f) + " --within 1000 --horizon 1200");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("loci: read 750 AIS reports of 250 vessels; skipped none"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("metres"), std::string::npos) << r.err;
+  std::set<std::pair<Id, Id>> want;
+  for (std::size_t i = 0; i < fleet.size(); ++i)
+    for (std::size_t j = i + 1; j < fleet.size(); ++j)
+      if (closest_approach(fleet[i].m, fleet[j].m, now, 1200.0, 1000.0))
+        want.insert({fleet[i].id, fleet[j].id});
+  const auto got = csv_rows(r.out);
+  ASSERT_GT(want.size(), 0u);
+  ASSERT_EQ(got.size(), want.size() + 1);
+  EXPECT_EQ(got[0][6], "dcpa_nm");
+  std::set<std::pair<Id, Id>> pairs;
+  for (std::size_t i = 1; i < got.size(); ++i) {
+    pairs.insert({std::stoull(got[i][0]), std::stoull(got[i][1])});
+    EXPECT_NEAR(std::stod(got[i][6]), std::stod(got[i][3]) / 1852, 1e-4);
+    EXPECT_EQ(got[i][7].size(), 20u);  // 2023-01-01T00:10:00Z
+  }
+  EXPECT_EQ(pairs, want);
+
+  // Lon/lat windows at now and ten minutes before.
+  for (const double t : {now, now - 600}) {
+    const auto at_t = io::in_force(d.reports, t);
+    for (const Box2& box : {Box2{{10, 55}, {11.5, 56.5}}, Box2{{8, 54.5}, {13, 58}},
+                            Box2{{12, 55.5}, {12.8, 56.2}}}) {
+      const CliRun q = run_loci("fleet query " + shell_quote(f) + " -q --at " + num(t) +
+                                " --bbox " + num(box.min[0]) + "," + num(box.min[1]) + "," +
+                                num(box.max[0]) + "," + num(box.max[1]));
+      ASSERT_EQ(q.status, 0) << q.err;
+      std::vector<Id> expect;
+      for (const io::FleetReport& rep : at_t) {
+        const Point2 ll = d.frame->to_lonlat(position(rep.m, t));
+        if (intersects(box, Box2::of_point(ll))) expect.push_back(rep.id);
+      }
+      EXPECT_EQ(ids_of(q.out), expect);
+    }
+  }
+}
+
+TEST_F(FleetCli, AisSampleSentinelsSummarisedOnStderr) {
+  const CliRun r =
+      run_loci("fleet query " + shell_quote(kData + "/ais-sentinels.csv") + " --bbox 9,54,11,56");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("loci: read 6 AIS reports of 4 vessels; skipped 12 (1 duplicate, 1 LAT "
+                       "not available"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(ids_of(r.out), (std::vector<Id>{219000001, 219000003, 219000008, 219000016}));
+}
+
+TEST_F(FleetCli, CommittedSampleHasConflicts) {
+  const CliRun r =
+      run_loci("fleet conflicts " + shell_quote(kSample) + " --within 926 --horizon 1200 -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_GT(lines(r.out).size(), 5u);
+}
+
+TEST_F(FleetCli, GenerateIsDeterministicAndStaysInTheBox) {
+  const std::string a = path("a.csv"), b = path("b.csv");
+  for (const std::string& out : {a, b})
+    ASSERT_EQ(run_loci("fleet generate --count 50 --seed 9 --distribution clustered --bbox "
+                       "0,0,500,500 -q -o " +
+                       shell_quote(out))
+                  .status,
+              0);
+  EXPECT_EQ(read_text(a), read_text(b));
+  const io::FleetData d = io::read_fleet_file(a);
+  EXPECT_EQ(d.objects(), 50u);
+  for (const auto& r : io::in_force(d.reports, d.latest()))
+    EXPECT_TRUE(intersects(Box2{{0, 0}, {500, 500}}, Box2::of_point(r.m.p)));
+  const CliRun s = run_loci("fleet simulate " + shell_quote(a) +
+                            " --ticks 5 --within 10 --horizon 30 --update-fraction 0.1 -q");
+  ASSERT_EQ(s.status, 0) << s.err;
+  const auto rows = lines(s.out);
+  ASSERT_EQ(rows.size(), 6u);
+  EXPECT_EQ(rows[0], "tick,t,updates,update_ms,conflict_ms,pairs");
+  EXPECT_EQ(rows[1].rfind("1,", 0), 0u);
+  EXPECT_EQ(csv_rows(s.out)[1][2], "5");
+}
+
+TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
+  const std::string good = write("good.csv", "id,t,x,y\n1,0,0,0\n2,0,5,5\n");
+  const std::string nan = write("nan.csv", "id,t,x,y\n1,0,0,0\n2,0,nan,5\n");
+  const std::string empty = write("empty.csv", "");
+  const std::string q = " --bbox 0,0,1,1";
+  expect_one_line_error(run_loci("fleet query " + shell_quote(nan) + q), "line 3: x is NaN");
+  expect_one_line_error(run_loci("fleet query " + shell_quote(empty) + q), "empty file");
+  expect_one_line_error(run_loci("fleet query " + shell_quote(path("none.csv")) + q),
+                        "no such file");
+  expect_one_line_error(run_loci("fleet query " + shell_quote(dir_.string()) + q),
+                        "is a directory");
+  const std::string g = "fleet conflicts " + shell_quote(good);
+  expect_one_line_error(run_loci(g + " --within -1 --horizon 5"), "--within");
+  expect_one_line_error(run_loci(g + " --within x --horizon 5"), "--within");
+  expect_one_line_error(run_loci(g + " --within 1"), "--horizon");
+  expect_one_line_error(run_loci(g + " --within 1 --horizon 5 --at soon"), "--at");
+  expect_one_line_error(run_loci(g + " --within 1 --horizon 5 -f ids"), "--format");
+  expect_one_line_error(run_loci(g + " --within 1 --horizon 5 --bogus"), "unknown option");
+  expect_one_line_error(run_loci("fleet query " + shell_quote(good) + " --bbox 1,2,3"), "--bbox");
+  expect_one_line_error(run_loci("fleet query " + shell_quote(good)), "--bbox");
+  expect_one_line_error(run_loci("fleet query " + shell_quote(good) + q + " --during 5,1"),
+                        "--during");
+  expect_one_line_error(run_loci("fleet query " + shell_quote(good) + " --nearest 0,0 -k 0"), "-k");
+  expect_one_line_error(
+      run_loci("fleet query " + shell_quote(good) + " --nearest 0,0 --during 0,1"), "--nearest");
+  expect_one_line_error(run_loci("fleet teleport " + shell_quote(good)), "unknown command");
+  expect_one_line_error(run_loci("fleet generate --count 0 -o " + shell_quote(path("g.csv"))),
+                        "--count");
+  expect_one_line_error(
+      run_loci("fleet generate --count 5 --distribution lanes -o " + shell_quote(path("g.csv"))),
+      "--along");
+  expect_one_line_error(
+      run_loci("fleet query " + shell_quote(kData + "/ais-sentinels.csv") + " --bbox 0,0,200,1"),
+      "lon/lat");
+  EXPECT_FALSE(fs::exists(path("g.csv")));
+}
+
+TEST_F(FleetCli, FailuresLeaveNothingWritten) {
+  const std::string good = write("good.csv", "id,t,x,y,vx,vy\n1,0,0,0,1,0\n2,0,5,0,-1,0\n");
+  const std::string nan = write("nan.csv", "id,t,x,y\n1,0,0,inf\n");
+  // An output in a directory that does not exist, or under a regular file.
+  write("plain", "x");
+  for (const std::string& out : {path("missing/out.csv"), path("plain/out.csv")}) {
+    expect_one_line_error(run_loci("fleet conflicts " + shell_quote(good) +
+                                   " --within 10 --horizon 10 -o " + shell_quote(out)));
+    expect_one_line_error(run_loci("fleet generate --count 3 -o " + shell_quote(out)));
+  }
+  // A failing run leaves an existing output as it was.
+  const std::string kept = write("kept.csv", "old\n");
+  expect_one_line_error(run_loci("fleet conflicts " + shell_quote(nan) +
+                                 " --within 10 --horizon 10 -o " + shell_quote(kept)));
+  EXPECT_EQ(read_text(kept), "old\n");
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+    ++files;
+  }
+  EXPECT_EQ(files, 4u);  // good.csv, nan.csv, plain, kept.csv
+  // And a good run writes the whole answer.
+  const CliRun ok = run_loci("fleet conflicts " + shell_quote(good) +
+                             " --within 10 --horizon 10 -q -o " + shell_quote(kept));
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  EXPECT_EQ(lines(read_text(kept)).size(), 2u);
+}
+
+}  // namespace
