@@ -17,8 +17,7 @@
 // the positions cannot lose a pair that touches the D-circle.
 //
 // More slices mean smaller boxes (fewer candidates) but one more sort per slice; slices = 0
-// picks the count from the motion: about one slice per D of the mean distance moved over the
-// horizon, at most 16.
+// picks the count from a cost model of the two (auto_slices), at most 16.
 //
 // ConflictMonitor keeps the answer of a stream: after a batch of new reports it recomputes
 // only the pairs that involve the objects that reported, and repeats the full computation
@@ -31,11 +30,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
 #include "loci/geom/motion.hpp"
 #include "loci/index/broadphase/sweep_prune.hpp"
+#include "loci/index/detail/hilbert.hpp"
+#include "loci/index/detail/radix_sort.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci {
@@ -70,19 +72,38 @@ Box<D> grown_sweep(const Motion<D>& m, double t0, double t1, double grow) {
   return box;
 }
 
+// The slice count that minimizes a cost model of the broad phase: each slice sorts every
+// object (about 100 ns each), and each candidate pair costs about 5 ns; candidates are
+// estimated from the density of the fleet and the grown boxes' mean extents per axis,
+// D + (mean distance moved along the axis) / slices.
 template <int D>
 std::size_t auto_slices(std::span<const Motion<D>> objects, double within, double horizon) {
-  if (objects.empty() || horizon <= 0) return 1;
-  double speed = 0;
+  if (objects.size() < 2 || horizon <= 0) return 1;
+  Box<D> extent = Box<D>::empty();
+  double moved[D] = {};
   for (const Motion<D>& m : objects) {
-    double s = 0;
+    extent.expand(m.p);
     for (int i = 0; i < D; ++i)
-      s += m.v[i] * m.v[i];
-    speed += std::sqrt(s);
+      moved[i] += std::abs(m.v[i]) * horizon;
   }
-  const double moved = speed / double(objects.size()) * horizon;
-  const double want = moved / std::max(within, 1e-300);
-  return std::size_t(std::clamp(std::floor(want), 1.0, 16.0));
+  const double n = double(objects.size());
+  double volume = 1;
+  for (int i = 0; i < D; ++i) {
+    moved[i] /= n;
+    volume *= std::max(extent.extent(i) + moved[i], within + 1e-300);
+  }
+  const double density = n / volume;
+  std::size_t best = 1;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (std::size_t s = 1; s <= 16; ++s) {
+    double overlap = 1;
+    for (int i = 0; i < D; ++i)
+      overlap *= 2 * (within + moved[i] / double(s));
+    const double candidates = 0.5 * n * std::min(n, density * overlap);
+    const double cost = 100 * n * double(s) + 5 * candidates;
+    if (cost < best_cost) best_cost = cost, best = s;
+  }
+  return best;
 }
 
 }  // namespace detail
@@ -96,42 +117,119 @@ inline void check_conflict_query(double within, double now, double horizon) {
   if (!std::isfinite(now)) throw InvalidArgument("conflict time is NaN or infinite");
 }
 
+// The broad phase and buffers of conflict searches, kept between calls so that a search
+// repeated every tick reuses its memory (and the broad phase its proxies).
+template <int D>
+class ConflictFinder {
+ public:
+  template <ConflictVisitor F>
+  QueryStats find(std::span<const Motion<D>> objects, double within, double now, double horizon,
+                  F&& visit, std::size_t slices = 0) {
+    check_conflict_query(within, now, horizon);
+    if (slices == 0) slices = detail::auto_slices(objects, within, horizon);
+    QueryStats st;
+    if (objects.size() < 2) return st;
+    if (objects.size() >= kNone) throw InvalidArgument("find_conflicts: too many objects");
+    prepare(objects, now, horizon);
+    const std::size_t n = objects.size();
+    // Pairs whose closest approach computed from the positions at `now` is clearly beyond D
+    // (by more than rounding can explain) are dropped before the exact test, which alone
+    // decides the rest.
+    const double reach = within * (1 + 1e-9) + 1e-9 * scale_;
+    const double reach2 = reach * reach;
+    auto clearly_apart = [&](std::uint32_t a, std::uint32_t b) {
+      double dw = 0, ww = 0, dd = 0;
+      Point<D> d{}, w{};
+      for (int k = 0; k < D; ++k) {
+        d[k] = at_now_[b][k] - at_now_[a][k];
+        w[k] = motion_[b].v[k] - motion_[a].v[k];
+        dw += d[k] * w[k];
+        ww += w[k] * w[k];
+      }
+      const double u = std::min(std::max(-dw / std::max(ww, 1e-300), 0.0), horizon);
+      for (int k = 0; k < D; ++k) {
+        const double c = d[k] + w[k] * u;
+        dd += c * c;
+      }
+      return dd > reach2;
+    };
+    const double step = horizon / double(slices);
+    for (std::size_t s = 0; s < slices; ++s) {
+      const double t0 = now + step * double(s);
+      const double t1 = s + 1 == slices ? now + horizon : now + step * double(s + 1);
+      for (std::uint32_t k = 0; k < n; ++k) {
+        const Box<D> b = detail::grown_sweep(objects[order_[k]], t0, t1, 0.5 * within);
+        if (k < held_)
+          broad_.move(k, b);
+        else
+          broad_.add(k, b);
+      }
+      for (std::size_t k = n; k < held_; ++k)
+        broad_.remove(k);
+      held_ = n;
+      bool go = true;
+      const QueryStats bs = broad_.pairs([&](Id a, Id b) {
+        ++st.entries_tested;
+        if (clearly_apart(std::uint32_t(a), std::uint32_t(b))) return true;
+        std::uint32_t i = order_[a], j = order_[b];
+        if (j < i) std::swap(i, j), std::swap(a, b);
+        // The same reports as objects[i] and objects[j], copied in proxy order.
+        const auto ap = closest_approach(motion_[a], motion_[b], now, horizon, within);
+        if (!ap) return true;
+        // Reported from the slice holding the entry time only.
+        const bool first = s == 0 || ap->t_enter > t0;
+        const bool last = s + 1 == slices || ap->t_enter <= t1;
+        if (!first || !last) return true;
+        ++st.results;
+        return go = visit(i, j, *ap);
+      });
+      st.nodes_visited += bs.nodes_visited;
+      if (!go) break;
+    }
+    return st;
+  }
+
+ private:
+  // Numbers the objects in Hilbert order of their positions at mid-horizon, so that the pairs
+  // the broad phase reports (neighbours in space) read neighbouring memory.
+  void prepare(std::span<const Motion<D>> objects, double now, double horizon) {
+    const std::size_t n = objects.size();
+    at_now_.resize(n);
+    motion_.resize(n);
+    Box<D> extent = Box<D>::empty();
+    for (const Motion<D>& m : objects)
+      extent.expand(position(m, now + 0.5 * horizon));
+    const detail::HilbertGrid<D> grid(extent);
+    keyed_.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i)
+      keyed_[i] = {grid.key(position(objects[i], now + 0.5 * horizon)), i};
+    detail::radix_sort(keyed_, D * detail::hilbert_bits<D>());
+    order_.resize(n);
+    scale_ = 0;
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t i = keyed_[k].index;
+      order_[k] = i;
+      at_now_[k] = position(objects[i], now);
+      motion_[k] = objects[i];
+      for (int a = 0; a < D; ++a)
+        scale_ = std::max(scale_, std::abs(at_now_[k][a]) + std::abs(motion_[k].v[a]) * horizon);
+    }
+  }
+
+  SweepPrune<D> broad_;
+  std::size_t held_ = 0;  // proxies 0 .. held_ - 1 are in broad_
+  std::vector<detail::KeyedIndex> keyed_;
+  std::vector<std::uint32_t> order_;  // input index by proxy number
+  std::vector<Point<D>> at_now_;      // positions at `now` by proxy number
+  std::vector<Motion<D>> motion_;     // the reports by proxy number
+  double scale_ = 0;                  // largest coordinate magnitude reached
+};
+
 template <int D, ConflictVisitor F>
 QueryStats find_conflicts(std::span<const Motion<D>> objects, double within, double now,
                           double horizon, F&& visit, std::size_t slices = 0) {
-  check_conflict_query(within, now, horizon);
-  if (slices == 0) slices = detail::auto_slices(objects, within, horizon);
-  QueryStats st;
-  if (objects.size() < 2) return st;
-  SweepPrune<D> broad;
-  const double step = horizon / double(slices);
-  for (std::size_t s = 0; s < slices; ++s) {
-    const double t0 = now + step * double(s);
-    const double t1 = s + 1 == slices ? now + horizon : now + step * double(s + 1);
-    for (std::uint32_t i = 0; i < objects.size(); ++i) {
-      const Box<D> b = detail::grown_sweep(objects[i], t0, t1, 0.5 * within);
-      if (s == 0)
-        broad.add(i, b);
-      else
-        broad.move(i, b);
-    }
-    bool go = true;
-    const QueryStats bs = broad.pairs([&](Id a, Id b) {
-      ++st.entries_tested;
-      const auto i = std::uint32_t(a), j = std::uint32_t(b);
-      const auto ap = closest_approach(objects[i], objects[j], now, horizon, within);
-      if (!ap) return true;
-      // Reported from the slice holding the entry time only.
-      const bool first = s == 0 || ap->t_enter > t0;
-      const bool last = s + 1 == slices || ap->t_enter <= t1;
-      if (!first || !last) return true;
-      ++st.results;
-      return go = visit(i, j, *ap);
-    });
-    st.nodes_visited += bs.nodes_visited;
-    if (!go) break;
-  }
-  return st;
+  ConflictFinder<D> finder;
+  return finder.find(objects, within, now, horizon, visit, slices);
 }
 
 // The conflicts among objects named by ids (ids[i] names objects[i]), sorted by (a, b).

@@ -137,6 +137,20 @@ class TprTree {
     thread_local std::vector<std::uint32_t> stack;
     stack.clear();
     stack.push_back(root_);
+    // A timeslice compares each entry's box at the query time with the window: no divisions.
+    const bool slice = w.t1 == w.t2 && w.from == w.to;
+    const double r = w.t1 - epoch_;
+    Box<D> grown = w.from;
+    const double tol = tolerance(r);
+    for (int i = 0; i < D; ++i)
+      grown.min[i] -= tol, grown.max[i] += tol;
+    auto meets = [&](const Box_& b) {
+      if (!slice) return detail::tpbr_meets(b, epoch_, w);
+      bool in = true;
+      for (int i = 0; i < D; ++i)
+        in &= (b.lo_at(i, r) <= grown.max[i]) & (b.hi_at(i, r) >= grown.min[i]);
+      return in;
+    };
     while (!stack.empty()) {
       const Node& n = nodes_[stack.back()];
       stack.pop_back();
@@ -144,6 +158,7 @@ class TprTree {
       st.entries_tested += n.count;
       if (n.level == 0) {
         for (int e = 0; e < n.count; ++e) {
+          if (!meets(n.box[e])) continue;
           const std::uint32_t s = n.child[e];
           if (!inside(obj_motion_[s], w)) continue;
           ++st.results;
@@ -151,7 +166,7 @@ class TprTree {
         }
       } else {
         for (int e = 0; e < n.count; ++e)
-          if (detail::tpbr_meets(n.box[e], epoch_, w)) stack.push_back(n.child[e]);
+          if (meets(n.box[e])) stack.push_back(n.child[e]);
       }
     }
     return st;
@@ -235,6 +250,11 @@ class TprTree {
   using Box_ = detail::Tpbr<D>;
 
   double rel_clock() const { return clock_ - epoch_; }
+  // The rounding allowance of box tests at relative time r: a bound rounded a few times at
+  // magnitudes up to mag_ + vmag_ (|r| + |clock|) is off by far less (tpbr.hpp).
+  double tolerance(double r) const {
+    return 1e-12 * (4 * mag_ + 4 * vmag_ * (std::abs(r) + std::abs(rel_clock()))) + 1e-300;
+  }
   double cost(const Box_& b) const {
     return detail::swept_cost(b, rel_clock(), params_.horizon, params_.query_extent);
   }
@@ -286,8 +306,13 @@ class TprTree {
       r.level = 0;
       r.count = 0;
     }
+    const Box_ b = Box_::of(m, epoch_);
+    for (int i = 0; i < D; ++i) {
+      mag_ = std::max(mag_, std::abs(b.lo[i]));
+      vmag_ = std::max(vmag_, std::abs(b.vlo[i]));
+    }
     std::uint32_t reinserted = 0;
-    insert_entry(Box_::of(m, epoch_), s, 0, reinserted);
+    insert_entry(b, s, 0, reinserted);
   }
 
   // Choose_Path: the node of `level` whose taking `b` raises the summed cost of the path to
@@ -619,6 +644,8 @@ class TprTree {
   double epoch_ = 0;
   double clock_ = -std::numeric_limits<double>::infinity();
   std::size_t max_choose_nodes_ = 0;
+  double mag_ = 0;   // largest |coordinate| of an object's entry at the epoch
+  double vmag_ = 0;  // largest |velocity| component
 };
 
 static_assert(MovingIndex<TprTree<2>>);
