@@ -34,10 +34,21 @@ std::vector<double> brute_nearest(const Objects& objs, const Point2& q, double s
   return d;
 }
 
+// The TPR*-tree with every update an erasure and an insertion, as in the paper.
+struct TprEraseInsert : TprTree<2, 8> {
+  TprEraseInsert() : TprTree<2, 8>(params()) {}
+  static TprParams<2> params() {
+    TprParams<2> p;
+    p.in_place_updates = false;
+    p.query_extent = {50, 50};
+    return p;
+  }
+};
+
 template <class T>
 class MovingIndexTest : public ::testing::Test {};
 
-using Structures = ::testing::Types<MovingScan<2>, TprTree<2>, TprTree<2, 6>>;
+using Structures = ::testing::Types<MovingScan<2>, TprTree<2>, TprTree<2, 6>, TprEraseInsert>;
 TYPED_TEST_SUITE(MovingIndexTest, Structures);
 
 MovingWindow<2> random_window(std::mt19937_64& rng, double now, int kind) {
@@ -112,11 +123,13 @@ TYPED_TEST(MovingIndexTest, UpdatesErasuresAndTicks) {
         EXPECT_EQ(index.erase(id), objs.erase(id) == 1);
         continue;
       }
-      // A new report: the object where it is now (plus noise), a new velocity.
+      // A new report: the object where it is now (plus noise), a new velocity, or (every
+      // other report) nearly the old one, which the TPR*-tree writes in place.
       Motion2 m{now, {jitter(rng) + 500, jitter(rng) + 500}, {v(rng), v(rng)}};
       if (auto it = objs.find(id); it != objs.end()) {
         const Point2 p = position(it->second, now);
-        m.p = {p[0] + jitter(rng), p[1] + jitter(rng)};
+        m.p = {p[0] + jitter(rng) / 100, p[1] + jitter(rng) / 100};
+        if (u % 2) m.v = {it->second.v[0] * 0.99, it->second.v[1] * 0.99};
       }
       index.update(id, m);
       objs[id] = m;
