@@ -16,7 +16,9 @@
 
 namespace loci::io {
 
-// The moving index the fleet commands use.
+// The moving index the fleet commands use; any MovingIndex fits (TprTree<2> passes the same
+// tests). A command answers one query from a fleet it has just read, and for one query a scan
+// (O(n)) costs less than building a tree (O(n log n)) and querying it.
 using FleetIndex = MovingScan<2>;
 
 namespace {

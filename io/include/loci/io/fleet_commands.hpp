@@ -21,7 +21,7 @@
 // candidate is refined exactly against the polygon: its position at T inside it (--at), or
 // its path from T1 to T2 meeting it (--during).
 //
-// The moving index behind the queries is FleetIndex, one alias below.
+// The moving index behind the queries is FleetIndex, one alias in fleet_commands.cpp.
 #pragma once
 
 #include <cstdio>
