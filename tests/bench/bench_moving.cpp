@@ -116,12 +116,10 @@ struct Report {
   Motion2 m;
 };
 
-template <class Index>
-struct Contender {
-  const char* name;
-  Index index;
+// Per-tick medians of one contender.
+struct Timing {
   std::vector<double> update_s, query_s;
-  std::size_t hits = 0;
+  std::size_t nodes = 0;
 };
 
 void run_objects(const Options& o) {
@@ -132,41 +130,58 @@ void run_objects(const Options& o) {
   std::vector<Motion2> state(o.objects);
   for (auto& m : state)
     m = {0, {pos(rng), pos(rng)}, {vel(rng), vel(rng)}};
+  std::vector<Id> ids(o.objects);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    ids[i] = i;
 
   loci::TprParams<2> params;
   params.horizon = horizon;
   params.query_extent = {qside, qside};
-  Contender<loci::TprTree<2>> tpr{"loci TPR*-tree", loci::TprTree<2>(params), {}, {}};
-  Contender<loci::MovingScan<2>> scan{"loci vectorized scan", {}, {}, {}};
+  loci::TprParams<2> paper = params;
+  paper.in_place_updates = false;
+  loci::TprTree<2> tpr(paper), inplace(params), packed(params);
+  loci::MovingScan<2> scan;
+  Timing t_tpr, t_inplace, t_packed, t_scan, t_sidx;
   std::unique_ptr<SidxTpr> sidx;
-  std::vector<double> sidx_update_s, sidx_query_s;
   std::size_t sidx_wrong = 0, sidx_missing = 0, sidx_extra = 0, sidx_failed_deletes = 0;
 
-  auto t0 = Clock::now();
-  for (std::size_t i = 0; i < state.size(); ++i)
-    tpr.index.insert(i, state[i]);
-  const double tpr_build = seconds_since(t0);
-  t0 = Clock::now();
-  for (std::size_t i = 0; i < state.size(); ++i)
-    scan.index.insert(i, state[i]);
-  const double scan_build = seconds_since(t0);
+  auto timed = [](auto&& f) {
+    const auto t0 = Clock::now();
+    f();
+    return seconds_since(t0);
+  };
+  const double tpr_build = timed([&] {
+    for (std::size_t i = 0; i < state.size(); ++i)
+      tpr.insert(i, state[i]);
+  });
+  timed([&] {
+    for (std::size_t i = 0; i < state.size(); ++i)
+      inplace.insert(i, state[i]);
+  });
+  const double packed_build = timed([&] { packed.build(ids, state); });
+  const double scan_build = timed([&] {
+    for (std::size_t i = 0; i < state.size(); ++i)
+      scan.insert(i, state[i]);
+  });
   double sidx_build = 0;
   if (o.peer) {
     sidx = std::make_unique<SidxTpr>(horizon);
-    t0 = Clock::now();
-    for (std::size_t i = 0; i < state.size(); ++i)
-      sidx->insert(i, state[i]);
-    sidx_build = seconds_since(t0);
+    sidx_build = timed([&] {
+      for (std::size_t i = 0; i < state.size(); ++i)
+        sidx->insert(i, state[i]);
+    });
   }
-  std::printf("objects: %zu points, %d ticks, %zu updates and %d windows (100 x 100) per tick\n",
-              o.objects, o.ticks, o.objects / 60, o.queries);
-  std::printf("  insert all: TPR*-tree %.3f s (height %d), scan %.3f s", tpr_build,
-              tpr.index.height(), scan_build);
-  if (o.peer) std::printf(", libspatialindex TPR %.3f s", sidx_build);
+  std::printf(
+      "objects: %zu points in 1000 x 1000, %d ticks, %zu updates (new velocity) and %d windows "
+      "(100 x 100, t in [now, now + 60]) per tick\n",
+      o.objects, o.ticks, o.objects / 60, o.queries);
+  std::printf("  load: TPR*-tree inserted %.3f s (height %d), packed %.3f s, scan %.3f s",
+              tpr_build, tpr.height(), packed_build, scan_build);
+  if (o.peer) std::printf(", libspatialindex TPR-tree %.3f s", sidx_build);
   std::printf("\n");
 
   std::uniform_int_distribution<std::size_t> pick(0, o.objects - 1);
-  std::size_t tpr_nodes = 0, total_hits = 0, total_queries = 0;
+  std::size_t total_hits = 0, total_queries = 0;
   for (int tick = 1; tick <= o.ticks; ++tick) {
     const double now = tick;
     std::vector<Report> batch;
@@ -177,66 +192,76 @@ void run_objects(const Options& o) {
         p[a] = std::clamp(p[a], 0.0, side);
       batch.push_back({id, {now, p, {vel(rng), vel(rng)}}});
     }
-    t0 = Clock::now();
-    for (const Report& r : batch)
-      tpr.index.update(r.id, r.m);
-    tpr.update_s.push_back(seconds_since(t0));
-    t0 = Clock::now();
-    for (const Report& r : batch)
-      scan.index.update(r.id, r.m);
-    scan.update_s.push_back(seconds_since(t0));
-    if (sidx) {
-      t0 = Clock::now();
-      for (const Report& r : batch) {
-        if (!sidx->erase(r.id, state[r.id], now)) ++sidx_failed_deletes;
-        sidx->insert(r.id, r.m);
-      }
-      sidx_update_s.push_back(seconds_since(t0));
-    }
-    for (const Report& r : batch)
-      state[r.id] = r.m;
+    t_tpr.update_s.push_back(timed([&] {
+      for (const Report& r : batch)
+        tpr.update(r.id, r.m);
+    }));
+    t_inplace.update_s.push_back(timed([&] {
+      for (const Report& r : batch)
+        inplace.update(r.id, r.m);
+    }));
+    t_scan.update_s.push_back(timed([&] {
+      for (const Report& r : batch)
+        scan.update(r.id, r.m);
+    }));
+    if (sidx)
+      t_sidx.update_s.push_back(timed([&] {
+        for (const Report& r : batch) {
+          if (!sidx->erase(r.id, state[r.id], now)) ++sidx_failed_deletes;
+          sidx->insert(r.id, r.m);
+        }
+      }));
+    // Rebuild per tick: the reports go into flat arrays, then the tree is packed again.
+    t_packed.update_s.push_back(timed([&] {
+      for (const Report& r : batch)
+        state[r.id] = r.m;
+      packed.build(ids, state);
+    }));
 
     std::vector<MovingWindow<2>> windows;
     for (int q = 0; q < o.queries; ++q) {
       const double x = corner(rng), y = corner(rng);
       windows.push_back(MovingWindow<2>::at({{x, y}, {x + qside, y + qside}}, now + ahead(rng)));
     }
-    std::vector<std::vector<Id>> truth;
-    t0 = Clock::now();
-    for (const auto& w : windows) {
-      auto ids = scan.index.query(w);
-      truth.push_back(std::move(ids));
-    }
-    scan.query_s.push_back(seconds_since(t0));
-    for (auto& ids : truth) {
-      std::sort(ids.begin(), ids.end());
-      total_hits += ids.size();
+    std::vector<std::vector<Id>> truth(windows.size());
+    t_scan.query_s.push_back(timed([&] {
+      for (std::size_t q = 0; q < windows.size(); ++q)
+        truth[q] = scan.query(windows[q]);
+    }));
+    for (auto& v : truth) {
+      std::sort(v.begin(), v.end());
+      total_hits += v.size();
     }
     total_queries += windows.size();
-    std::vector<std::vector<Id>> got(windows.size());
-    t0 = Clock::now();
-    for (std::size_t q = 0; q < windows.size(); ++q) {
-      const auto st = tpr.index.query(windows[q], [&](Id id, const Motion2&) {
-        got[q].push_back(id);
-        return true;
-      });
-      tpr_nodes += st.nodes_visited;
-    }
-    tpr.query_s.push_back(seconds_since(t0));
-    for (std::size_t q = 0; q < windows.size(); ++q) {
-      std::sort(got[q].begin(), got[q].end());
-      if (got[q] != truth[q]) {
-        std::printf("  MISMATCH: TPR*-tree answer differs from the scan (tick %d, query %zu)\n",
-                    tick, q);
-        std::exit(1);
+    auto check = [&](const char* name, auto& index, Timing& t) {
+      std::vector<std::vector<Id>> got(windows.size());
+      t.query_s.push_back(timed([&] {
+        for (std::size_t q = 0; q < windows.size(); ++q)
+          t.nodes += index
+                         .query(windows[q],
+                                [&](Id id, const Motion2&) {
+                                  got[q].push_back(id);
+                                  return true;
+                                })
+                         .nodes_visited;
+      }));
+      for (std::size_t q = 0; q < windows.size(); ++q) {
+        std::sort(got[q].begin(), got[q].end());
+        if (got[q] != truth[q]) {
+          std::printf("  MISMATCH: %s differs from the scan (tick %d, query %zu)\n", name, tick, q);
+          std::exit(1);
+        }
       }
-    }
+    };
+    check("TPR*-tree", tpr, t_tpr);
+    check("TPR*-tree in place", inplace, t_inplace);
+    check("packed", packed, t_packed);
     if (sidx) {
-      t0 = Clock::now();
-      std::vector<std::vector<Id>> answers;
-      for (const auto& w : windows)
-        answers.push_back(sidx->query(w.from, w.t1));
-      sidx_query_s.push_back(seconds_since(t0));
+      std::vector<std::vector<Id>> answers(windows.size());
+      t_sidx.query_s.push_back(timed([&] {
+        for (std::size_t q = 0; q < windows.size(); ++q)
+          answers[q] = sidx->query(windows[q].from, windows[q].t1);
+      }));
       for (std::size_t q = 0; q < windows.size(); ++q) {
         if (answers[q] == truth[q]) continue;
         ++sidx_wrong;
@@ -251,31 +276,43 @@ void run_objects(const Options& o) {
       }
     }
   }
-  tpr.index.validate();
-  const double per_tick_updates = double(o.objects / 60);
-  const double hits_per_query = double(total_hits) / double(total_queries);
-  auto row = [&](const char* name, const std::vector<double>& up, const std::vector<double>& qs) {
-    const double ups = per_tick_updates / median(up), qps = o.queries / median(qs);
-    std::printf("  %-28s %12.0f updates/s %10.0f queries/s %8.1f ns/hit\n", name, ups, qps,
-                1e9 / qps / std::max(1.0, hits_per_query));
-    return std::pair{ups, qps};
+  tpr.validate();
+  inplace.validate();
+  packed.validate();
+  const double per_tick = double(o.objects / 60);
+  const double hits = double(total_hits) / double(total_queries);
+  std::printf("  medians per tick; %.1f hits per window on average\n", hits);
+  std::printf("  %-40s %12s %10s %8s %8s\n", "", "updates/s", "queries/s", "ns/hit", "nodes/q");
+  struct Rates {
+    double ups, qps;
   };
-  std::printf("  medians per tick; %.1f hits per window on average\n", hits_per_query);
-  const auto [tu, tq] = row(tpr.name, tpr.update_s, tpr.query_s);
-  const auto [su, sq] = row(scan.name, scan.update_s, scan.query_s);
+  auto row = [&](const char* name, const Timing& t) {
+    const Rates r{per_tick / median(t.update_s), o.queries / median(t.query_s)};
+    std::printf("  %-40s %12.0f %10.0f %8.1f %8.1f\n", name, r.ups, r.qps,
+                1e9 / r.qps / std::max(1.0, hits), double(t.nodes) / double(total_queries));
+    return r;
+  };
+  const Rates tp = row("loci TPR*-tree (erase + insert)", t_tpr);
+  const Rates ip = row("loci TPR*-tree (in-place updates)", t_inplace);
+  const Rates pk = row("loci packed TPR-tree, rebuilt each tick", t_packed);
+  const Rates sc = row("loci vectorized scan", t_scan);
   std::printf(
-      "  TPR*-tree: %.1f nodes visited per window, Choose_Path explored at most %zu nodes\n",
-      double(tpr_nodes) / double(total_queries), tpr.index.max_choose_path_nodes());
-  std::printf("  TPR*-tree vs scan: queries %.2fx\n", tq / sq);
-  (void)su;
+      "  TPR*-tree: Choose_Path explored at most %zu nodes; rebuild of %zu objects: %.1f ms\n",
+      tpr.max_choose_path_nodes(), o.objects, median(t_packed.update_s) * 1e3);
+  std::printf("  queries vs the scan: TPR*-tree %.2fx, in place %.2fx, packed %.2fx\n",
+              tp.qps / sc.qps, ip.qps / sc.qps, pk.qps / sc.qps);
   if (sidx) {
-    const auto [pu, pq] = row("libspatialindex TPR-tree", sidx_update_s, sidx_query_s);
-    std::printf("  TPR*-tree vs libspatialindex: updates %.0fx, queries %.1fx\n", tu / pu, tq / pq);
+    const Rates sx = row("libspatialindex TPR-tree", t_sidx);
+    std::printf(
+        "  vs libspatialindex: updates %.0fx (TPR*), %.0fx (in place), %.0fx (packed), %.0fx "
+        "(scan); queries %.1fx (TPR*), %.1fx (in place), %.1fx (packed), %.1fx (scan)\n",
+        tp.ups / sx.ups, ip.ups / sx.ups, pk.ups / sx.ups, sc.ups / sx.ups, tp.qps / sx.qps,
+        ip.qps / sx.qps, pk.qps / sx.qps, sc.qps / sx.qps);
     std::printf(
         "  libspatialindex: %zu of %zu windows answered differently from brute force (%zu ids "
         "missing, %zu extra); %zu of %zu deletes failed\n",
         sidx_wrong, total_queries, sidx_missing, sidx_extra, sidx_failed_deletes,
-        std::size_t(per_tick_updates) * o.ticks);
+        std::size_t(per_tick) * o.ticks);
   }
 }
 

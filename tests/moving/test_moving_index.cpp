@@ -178,3 +178,58 @@ TYPED_TEST(MovingIndexTest, VisitorStopsEarly) {
 
 }  // namespace
 }  // namespace loci
+
+namespace loci {
+namespace {
+
+TEST(TprTreeBuild, PackedTreeAnswersLikeInsertedOne) {
+  for (test::Fleet f : test::kAllFleets) {
+    for (std::size_t n : {0, 1, 7, 25, 2000}) {
+      const auto fleet = test::make_fleet(f, n, 8);
+      std::vector<Id> ids(n);
+      Objects objs;
+      for (std::size_t i = 0; i < n; ++i) {
+        ids[i] = 5 * i + 1;
+        objs[ids[i]] = fleet[i];
+      }
+      TprTree<2> tree;
+      tree.build(ids, fleet);
+      tree.validate();
+      ASSERT_EQ(tree.size(), n);
+      check_queries(tree, objs, test::fleet_epoch(f), n, test::name(f) + " built");
+      // It stays a valid dynamic tree.
+      std::mt19937_64 rng(n);
+      std::uniform_real_distribution<double> v(-3, 3);
+      for (std::size_t u = 0; u < n / 3; ++u) {
+        const Id id = ids[rng() % n];
+        const Motion2 m{test::fleet_epoch(f) + 1,
+                        position(objs[id], test::fleet_epoch(f) + 1),
+                        {v(rng), v(rng)}};
+        tree.update(id, m);
+        objs[id] = m;
+        if (u % 4 == 0) {
+          EXPECT_TRUE(tree.erase(id));
+          objs.erase(id);
+        }
+      }
+      tree.validate();
+      check_queries(tree, objs, test::fleet_epoch(f) + 1, n + 1, test::name(f) + " after");
+    }
+  }
+}
+
+TEST(TprTreeBuild, RefusesBadInput) {
+  TprTree<2> tree;
+  const std::vector<Motion2> two{{0, {0, 0}, {1, 1}}, {0, {1, 1}, {0, 0}}};
+  const std::vector<Id> same{4, 4}, one{4};
+  EXPECT_THROW(tree.build(same, two), InvalidArgument);
+  EXPECT_THROW(tree.build(one, two), InvalidArgument);
+  const std::vector<Motion2> bad{{0, {0, 0}, {1, 1}}, {0, {std::nan(""), 1}, {0, 0}}};
+  const std::vector<Id> ok{1, 2};
+  EXPECT_THROW(tree.build(ok, bad), InvalidGeometry);
+  EXPECT_TRUE(tree.empty());
+  tree.validate();
+}
+
+}  // namespace
+}  // namespace loci

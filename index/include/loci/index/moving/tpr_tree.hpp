@@ -56,12 +56,14 @@
 #include <cstdint>
 #include <limits>
 #include <queue>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "loci/index/broadphase/detail/proxy_table.hpp"
 #include "loci/index/detail/best_first.hpp"
 #include "loci/index/detail/node_pool.hpp"
+#include "loci/index/detail/str_partition.hpp"
 #include "loci/index/moving/detail/tpbr.hpp"
 #include "loci/index/moving/moving_index.hpp"
 
@@ -118,6 +120,99 @@ class TprTree {
   }
 
   void clear() { *this = TprTree(params_); }
+
+  // Replaces the contents with objects[i] named ids[i], packed bottom-up instead of inserted
+  // one by one (the rebuild-per-tick strategy of main-memory moving-object indexing): the
+  // objects are tiled into leaves of 3/4 capacity by position and velocity (below), and each
+  // level is packed from consecutive nodes of the one below, in tiling order. The
+  // tree's epoch and clock become the latest report time. Throws InvalidArgument for
+  // duplicate ids or lengths that differ, InvalidGeometry for a bad report.
+  void build(std::span<const Id> ids, std::span<const Motion<D>> objects) {
+    if (ids.size() != objects.size())
+      throw InvalidArgument(std::string(kName) + ": ids and reports differ in length");
+    if (objects.size() + 1 >= kNone)
+      throw InvalidArgument(std::string(kName) + ": too many objects");
+    TprTree fresh(params_);
+    if (objects.empty()) return void(*this = std::move(fresh));
+    double latest = -std::numeric_limits<double>::infinity();
+    for (const Motion<D>& m : objects) {
+      check_motion(m);
+      latest = std::max(latest, m.t);
+    }
+    fresh.epoch_ = fresh.clock_ = latest;
+    // Leaves are tiles of the 2 D-dimensional space of positions at mid-horizon and
+    // velocities scaled by half the horizon (how far a velocity difference spreads a node
+    // by then), cut by Sort-Tile-Recursive.
+    const double mid = latest + 0.5 * params_.horizon;
+    const double spread = std::max(0.5 * params_.horizon, 1e-9);
+    struct Keyed {
+      double key[2 * D];
+      std::uint32_t index;
+    };
+    std::vector<Keyed> keyed(objects.size());
+    for (std::uint32_t i = 0; i < objects.size(); ++i) {
+      const Point<D> p = position(objects[i], mid);
+      for (int a = 0; a < D; ++a) {
+        keyed[i].key[a] = p[a];
+        keyed[i].key[D + a] = objects[i].v[a] * spread;
+      }
+      keyed[i].index = i;
+    }
+    constexpr std::size_t kFill = std::max<std::size_t>(kMinFill, M * 3 / 4);
+    {
+      const std::size_t leaves = (objects.size() + kFill - 1) / kFill;
+      std::vector<std::size_t> groups(leaves + 1);
+      for (std::size_t g = 0; g <= leaves; ++g)
+        groups[g] = objects.size() * g / leaves;
+      detail::str_tile<2 * D>(keyed.data(), std::span<const std::size_t>(groups),
+                              [](const Keyed& k, int axis) { return k.key[axis]; });
+    }
+    const std::size_t n = objects.size();
+    fresh.obj_id_.resize(n);
+    fresh.obj_motion_.resize(n);
+    fresh.obj_leaf_.resize(n);
+    std::vector<Item> level(n);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t i = keyed[k].index;
+      if (fresh.map_.find(ids[i]) != kNone)
+        throw InvalidArgument(std::string(kName) + ": id " + std::to_string(ids[i]) +
+                              " is given twice");
+      fresh.map_.insert(ids[i], k, k + 1);
+      fresh.obj_id_[k] = ids[i];
+      fresh.obj_motion_[k] = objects[i];
+      const Box_ b = Box_::of(objects[i], fresh.epoch_);
+      for (int a = 0; a < D; ++a) {
+        fresh.mag_ = std::max(fresh.mag_, std::abs(b.lo[a]));
+        fresh.vmag_ = std::max(fresh.vmag_, std::abs(b.vlo[a]));
+      }
+      level[k] = {b, k, objects[i], ids[i]};
+    }
+    fresh.count_ = n;
+    // Pack each level into nodes of nearly equal counts, about 3/4 full.
+    for (int height = 0;; ++height) {
+      const std::size_t groups = (level.size() + kFill - 1) / kFill;
+      std::vector<Item> up(groups);
+      for (std::size_t g = 0; g < groups; ++g) {
+        const std::size_t from = level.size() * g / groups, to = level.size() * (g + 1) / groups;
+        const std::uint32_t node = fresh.nodes_.allocate(kName);
+        Node& nd = fresh.nodes_[node];
+        nd.parent = kNone;
+        nd.level = std::uint8_t(height);
+        nd.count = 0;
+        for (std::size_t e = from; e < to; ++e) {
+          put(nd, nd.count, level[e]);
+          fresh.adopt(node, nd.count++);
+        }
+        up[g] = {fresh.bound(nd), node, {}, 0};
+      }
+      if (groups == 1) {
+        fresh.root_ = up[0].child;
+        break;
+      }
+      level.swap(up);
+    }
+    *this = std::move(fresh);
+  }
 
   bool contains(Id id) const { return map_.find(id) != kNone; }
   std::size_t size() const { return count_; }
