@@ -298,6 +298,16 @@ Point2 LocalFrame::to_local(double lon, double lat) const {
   return {x, y};
 }
 
+void LocalFrame::to_local(std::span<double> x, std::span<double> y) const {
+  if (x.size() != y.size()) throw InvalidArgument("LocalFrame::to_local: spans differ in length");
+  std::vector<int> ok(x.size());
+  const bool all = impl_->forward->Transform(x.size(), x.data(), y.data(), nullptr, ok.data());
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (!all && (!ok[i] || !std::isfinite(x[i]) || !std::isfinite(y[i])))
+      throw Error("cannot project point " + std::to_string(i + 1) + " of " +
+                  std::to_string(x.size()));
+}
+
 Point2 LocalFrame::to_lonlat(const Point2& xy) const {
   double x = xy[0], y = xy[1];
   if (!impl_->inverse->Transform(1, &x, &y) || !std::isfinite(x) || !std::isfinite(y))
@@ -305,21 +315,38 @@ Point2 LocalFrame::to_lonlat(const Point2& xy) const {
   return {x, y};
 }
 
-Point2 LocalFrame::north(double lon, double lat) const {
-  // A step of 1e-5 degrees (about a metre) north, or south at the pole.
-  const double step = lat > 89.9 ? -1e-5 : 1e-5;
-  const Point2 a = to_local(lon, lat), b = to_local(lon, lat + step);
-  const double dx = (b[0] - a[0]) * (step > 0 ? 1 : -1), dy = (b[1] - a[1]) * (step > 0 ? 1 : -1);
+namespace {
+
+// North is found by a step of 1e-5 degrees (about a metre) north, or south near the pole.
+double north_step(double lat) {
+  return lat > 89.9 ? -1e-5 : 1e-5;
+}
+
+// The unit vector from a towards b, reversed for a step south.
+Point2 unit_north(const Point2& a, const Point2& b, double step) {
+  const double sign = step > 0 ? 1 : -1;
+  const double dx = (b[0] - a[0]) * sign, dy = (b[1] - a[1]) * sign;
   const double len = std::hypot(dx, dy);
   return {dx / len, dy / len};
 }
 
-Point2 LocalFrame::velocity(double lon, double lat, double speed, double course) const {
-  const Point2 n = north(lon, lat);
+// A speed along a course (degrees from true north) given the frame's north there.
+Point2 along_course(const Point2& n, double speed, double course) {
   const Point2 e{n[1], -n[0]};  // north turned a quarter clockwise
   const double c = course * std::numbers::pi / 180;
   const double s = std::sin(c), k = std::cos(c);
   return {speed * (s * e[0] + k * n[0]), speed * (s * e[1] + k * n[1])};
+}
+
+}  // namespace
+
+Point2 LocalFrame::north(double lon, double lat) const {
+  const double step = north_step(lat);
+  return unit_north(to_local(lon, lat), to_local(lon, lat + step), step);
+}
+
+Point2 LocalFrame::velocity(double lon, double lat, double speed, double course) const {
+  return along_course(north(lon, lat), speed, course);
 }
 
 std::pair<double, double> LocalFrame::course(const Point2& xy, const Point2& v) const {
@@ -570,15 +597,39 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
   }
   const double lon0 = std::atan2(sy, sx) * 180 / std::numbers::pi;
   out.frame.emplace(lon0, slat / double(rows.size()));
-  out.reports.reserve(rows.size());
-  for (Row& r : rows) {
-    const Raw& w = raw[std::size_t(r.r.m.p[0])];
-    try {
-      r.r.m.p = out.frame->to_local(w.lon, w.lat);
-      r.r.m.v = out.frame->velocity(w.lon, w.lat, w.sog * kKnot, w.cog);
-    } catch (const Error& e) {
-      throw Error(source + ": line " + std::to_string(r.line) + ": " + e.what());
+  // Positions, and points a step north of them for the direction of north, projected as two
+  // arrays.
+  const std::size_t n = rows.size();
+  std::vector<double> x(n), y(n), nx(n), ny(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Raw& w = raw[std::size_t(rows[i].r.m.p[0])];
+    x[i] = nx[i] = w.lon;
+    y[i] = w.lat;
+    ny[i] = w.lat + north_step(w.lat);
+  }
+  try {
+    out.frame->to_local(x, y);
+    out.frame->to_local(nx, ny);
+  } catch (const Error&) {
+    // Find the row that fails, to name its line.
+    for (const Row& r : rows) {
+      const Raw& w = raw[std::size_t(r.r.m.p[0])];
+      try {
+        out.frame->to_local(w.lon, w.lat);
+        out.frame->to_local(w.lon, w.lat + north_step(w.lat));
+      } catch (const Error& e) {
+        throw Error(source + ": line " + std::to_string(r.line) + ": " + e.what());
+      }
     }
+    throw;
+  }
+  out.reports.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Row& r = rows[i];
+    const Raw& w = raw[std::size_t(r.r.m.p[0])];
+    r.r.m.p = {x[i], y[i]};
+    r.r.m.v =
+        along_course(unit_north(r.r.m.p, {nx[i], ny[i]}, north_step(w.lat)), w.sog * kKnot, w.cog);
     out.reports.push_back(r.r);
   }
   return out;
@@ -604,10 +655,11 @@ FleetData read_fleet_file(const std::string& path) {
   if (!S_ISREG(st.st_mode)) throw Error(path + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot read the file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) throw Error(path + ": cannot read the file");
-  return read_fleet(s.str(), path);
+  std::string text(std::size_t(st.st_size), '\0');
+  in.read(text.data(), std::streamsize(text.size()));
+  if (in.bad() || std::size_t(in.gcount()) != text.size())
+    throw Error(path + ": cannot read the file (it changed while being read?)");
+  return read_fleet(text, path);
 }
 
 std::vector<FleetReport> in_force(std::span<const FleetReport> sorted, double t) {

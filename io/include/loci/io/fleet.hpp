@@ -106,6 +106,9 @@ class LocalFrame {
   // Throws Error when a point cannot be transformed.
   Point2 to_local(double lon, double lat) const;
   Point2 to_lonlat(const Point2& xy) const;
+  // Many points at once, in place: lon/lat in, frame coordinates out (PROJ is much faster on
+  // arrays than point by point). Throws Error naming the position of a point that fails.
+  void to_local(std::span<double> lon_x, std::span<double> lat_y) const;
 
   // The unit vector of true north in the frame at (lon, lat).
   Point2 north(double lon, double lat) const;
