@@ -339,6 +339,70 @@ TEST_F(FleetCli, AisConflictsAndLonLatWindowsMatchBruteForce) {
   }
 }
 
+TEST_F(FleetCli, AisWindowOverAnIntervalHoldsEveryTimeSampledAndNothingOutside) {
+  const std::string f = path("ais.csv");
+  ASSERT_EQ(run_loci("fleet generate --count 250 --seed 7 --format ais --distribution lanes "
+                     "--along " +
+                     shell_quote(kCoast) + " -q -o " + shell_quote(f))
+                .status,
+            0);
+  const io::FleetData d = io::read_fleet_file(f);
+  const double t2 = d.latest(), t1 = t2 - 600;
+  ASSERT_EQ(t2, 1672531200);  // 2023-01-01T00:00:00, so t1 is the date given below
+  const Box2 box{{10, 55}, {11.5, 56.5}};
+  const CliRun r = run_loci("fleet query " + shell_quote(f) + " -q -f csv --bbox 10,55,11.5,56.5" +
+                            " --during 2022-12-31T23:50:00," + num(t2));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = csv_rows(r.out);
+  ASSERT_GT(rows.size(), 5u);
+  EXPECT_EQ(lines(r.out)[0], "id,t,time_utc,lon,lat");
+  std::set<Id> got;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const Id id = std::stoull(rows[i][0]);
+    got.insert(id);
+    const double t = std::stod(rows[i][1]), lon = std::stod(rows[i][3]),
+                 lat = std::stod(rows[i][4]);
+    EXPECT_TRUE(t >= t1 && t <= t2) << t;
+    // Where the report in force then puts it, inside the window (to rounding at an edge).
+    const auto at = io::in_force(d.reports, t);
+    const auto it = std::find_if(at.begin(), at.end(), [&](auto& x) { return x.id == id; });
+    ASSERT_NE(it, at.end());
+    const Point2 ll = d.frame->to_lonlat(position(it->m, t));
+    EXPECT_NEAR(ll[0], lon, 1e-7);
+    EXPECT_NEAR(ll[1], lat, 1e-7);
+    EXPECT_TRUE(lon >= 10 - 1e-6 && lon <= 11.5 + 1e-6 && lat >= 55 - 1e-6 && lat <= 56.5 + 1e-6);
+  }
+  // Every object inside at a sampled time of the interval is in the answer.
+  for (double t = t1; t <= t2; t += 15)
+    for (const io::FleetReport& rep : io::in_force(d.reports, t))
+      if (intersects(box, Box2::of_point(d.frame->to_lonlat(position(rep.m, t)))))
+        EXPECT_TRUE(got.count(rep.id)) << rep.id << " at " << t;
+}
+
+TEST_F(FleetCli, QueryAsGeoJsonAndAHeaderOnlyFleet) {
+  const auto rows = make_rows(100, 71, 0, 100, 1000, 3);
+  const std::string f = write("fleet.csv", csv_of(rows));
+  const std::string out = path("hits.geojson");
+  const CliRun ids = run_loci("fleet query " + shell_quote(f) + " -q --bbox 0,0,600,600");
+  const CliRun r = run_loci("fleet query " + shell_quote(f) +
+                            " -q --bbox 0,0,600,600 -f geojson -o " + shell_quote(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const OgrFeatureSet s = read_with_ogr(out);
+  EXPECT_EQ(s.fids.size(), lines(ids.out).size());
+  EXPECT_GT(s.fids.size(), 10u);
+  for (const auto& g : s.geoms)
+    EXPECT_EQ(wkbFlatten(g->getGeometryType()), wkbPoint);
+  // A fleet with a header and no reports answers nothing, and says so.
+  const std::string none = write("none.csv", "id,t,x,y\n");
+  const CliRun q = run_loci("fleet query " + shell_quote(none) + " --bbox 0,0,1,1");
+  EXPECT_EQ(q.status, 0) << q.err;
+  EXPECT_EQ(q.out, "");
+  EXPECT_NE(q.err.find("read 0 reports of 0 objects"), std::string::npos) << q.err;
+  const CliRun c = run_loci("fleet conflicts " + shell_quote(none) + " --within 1 --horizon 1 -q");
+  EXPECT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(lines(c.out).size(), 1u);
+}
+
 TEST_F(FleetCli, AisSampleSentinelsSummarisedOnStderr) {
   const CliRun r =
       run_loci("fleet query " + shell_quote(kData + "/ais-sentinels.csv") + " --bbox 9,54,11,56");
