@@ -444,6 +444,19 @@ TEST_F(FleetCli, GenerateIsDeterministicAndStaysInTheBox) {
   EXPECT_EQ(csv_rows(s.out)[1][2], "5");
 }
 
+TEST_F(FleetCli, HelpDocumentsEverySubcommand) {
+  const CliRun top = run_loci("--help"), fleet = run_loci("fleet --help");
+  EXPECT_EQ(fleet.status, 0);
+  for (const char* c : {"query", "conflicts", "generate", "simulate"}) {
+    EXPECT_NE(top.out.find(std::string("  fleet ") + c), std::string::npos) << c;
+    EXPECT_NE(fleet.out.find(std::string("  ") + c), std::string::npos) << c;
+    const CliRun h = run_loci(std::string("fleet ") + c + " --help");
+    EXPECT_EQ(h.status, 0);
+    EXPECT_NE(h.out.find("examples:"), std::string::npos) << c;
+  }
+  EXPECT_NE(run_loci("fleet conflicts --help").out.find("metres for AIS"), std::string::npos);
+}
+
 TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   const std::string good = write("good.csv", "id,t,x,y\n1,0,0,0\n2,0,5,5\n");
   const std::string nan = write("nan.csv", "id,t,x,y\n1,0,0,0\n2,0,nan,5\n");
