@@ -530,7 +530,8 @@ const std::vector<Command>& commands() {
          "for AIS)"},
         {"--format", "-f", "csv|ais", "planar id,t,x,y,vx,vy (default) or MarineCadastre AIS"},
         {"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX",
-         "area (default 0,0,10000,10000; AIS 8,54.5,13,58 in lon/lat)"},
+         "area (default 0,0,10000,10000, or the --along layer's extent; AIS 8,54.5,13,58 in "
+         "lon/lat)"},
         {"--speed", nullptr, "MIN,MAX", "speed range (default 1,10 per time unit; AIS 5,20 knots)"},
         {"--time", nullptr, "T0", "time of the last reports (default 0; AIS 2023-01-01T00:00:00)"},
         {"--reports", nullptr, "R", "reports per object (default 3)"},

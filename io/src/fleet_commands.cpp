@@ -433,7 +433,16 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
     throw InvalidArgument("the interval between reports must be > 0");
   if (o.distribution == Dist::lanes && o.along.empty())
     throw InvalidArgument("--distribution lanes needs --along LAYER");
-  const Box2 bbox = o.bbox.value_or(ais ? Box2{{8, 54.5}, {13, 58}} : Box2{{0, 0}, {1e4, 1e4}});
+  Box2 bbox = o.bbox.value_or(ais ? Box2{{8, 54.5}, {13, 58}} : Box2{{0, 0}, {1e4, 1e4}});
+  if (!ais && !o.bbox && o.distribution == Dist::lanes) {
+    // Planar lanes along a layer: by default, the layer's extent and a margin for the offsets.
+    auto ol = detail::open_layer(o.along, "");
+    OGREnvelope e;
+    if (ol.layer->GetExtent(&e, TRUE) != OGRERR_NONE)
+      throw Error(o.along + ": has no extent to lay lanes in");
+    const double margin = 0.05 * std::max(e.MaxX - e.MinX, e.MaxY - e.MinY);
+    bbox = {{e.MinX - margin, e.MinY - margin}, {e.MaxX + margin, e.MaxY + margin}};
+  }
   if (ais) {
     check_lonlat(bbox.min, "--bbox");
     check_lonlat(bbox.max, "--bbox");

@@ -75,7 +75,8 @@ struct FleetGenerateOptions {
   enum class Distribution { uniform, clustered, lanes } distribution = Distribution::uniform;
   std::string along;  // lanes: the line layer (lon/lat for AIS, its own units for CSV)
   FleetFormat format = FleetFormat::planar;
-  std::optional<Box2> bbox;  // default 0,0,10000,10000 (planar), 8,54.5,13,58 (AIS)
+  // Default: 0,0,10000,10000 (planar; lanes: the layer's extent), 8,54.5,13,58 (AIS).
+  std::optional<Box2> bbox;
   std::optional<std::pair<double, double>> speed;  // default 1,10 per time unit; AIS 5,20 knots
   std::optional<double> time;  // the last reports' time; default 0, AIS 2023-01-01T00:00:00
   std::size_t reports = 3;     // reports per object
