@@ -2,6 +2,8 @@
 // fixed-seed fleets with the degenerate cases, for several slicings of the horizon.
 #include <gtest/gtest.h>
 
+#include <random>
+#include <unordered_map>
 #include <vector>
 
 #include "loci/index/moving/conflicts.hpp"
@@ -91,6 +93,56 @@ TEST(Conflicts, VisitorStops) {
   find_conflicts<2>(fleet, 1, 0, 10,
                     [&](std::uint32_t, std::uint32_t, const Approach&) { return ++seen < 4; });
   EXPECT_EQ(seen, 4);
+}
+
+}  // namespace
+}  // namespace loci
+
+namespace loci {
+namespace {
+
+// A stream of reports: the monitor's answer after each batch equals a computation from
+// scratch over the reports in force, through incremental refreshes and full ones.
+TEST(ConflictMonitor, MatchesComputationFromScratch) {
+  for (test::Fleet f : {test::Fleet::uniform, test::Fleet::clustered, test::Fleet::head_on,
+                        test::Fleet::identical, test::Fleet::epoch}) {
+    auto fleet = test::make_fleet(f, 700, 23);
+    const double t0 = test::fleet_epoch(f);
+    ConflictMonitor<2> monitor(12, 30, 5);
+    std::unordered_map<Id, Motion2> state;
+    for (std::size_t i = 0; i < fleet.size(); ++i) {
+      monitor.report(i * 3, fleet[i]);
+      state[i * 3] = fleet[i];
+    }
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> v(-3, 3), u(0, 1);
+    for (int tick = 0; tick <= 14; ++tick) {
+      const double now = t0 + tick;
+      if (tick > 0)
+        for (int k = 0; k < 25; ++k) {
+          const Id id = (rng() % 760) * 3;  // some new ids, most known
+          if (k % 9 == 0) {
+            EXPECT_EQ(monitor.remove(id), state.erase(id) == 1);
+            continue;
+          }
+          Motion2 m{now, {u(rng) * 1000, u(rng) * 1000}, {v(rng), v(rng)}};
+          if (auto it = state.find(id); it != state.end()) m.p = position(it->second, now);
+          monitor.report(id, m);
+          state[id] = m;
+        }
+      monitor.refresh(now);
+      std::vector<Id> ids;
+      std::vector<Motion2> objs;
+      for (const auto& [id, m] : state)
+        ids.push_back(id), objs.push_back(m);
+      const auto want = find_conflicts<2>(ids, objs, 12, now, 30);
+      const auto got = monitor.conflicts();
+      expect_same(got, want, test::name(f) + " tick " + std::to_string(tick));
+    }
+    EXPECT_EQ(monitor.size(), state.size());
+    EXPECT_GE(monitor.full_computations(), 3u);  // slack 5: a full computation every 6 ticks
+    EXPECT_GE(monitor.incremental_refreshes(), 10u);
+  }
 }
 
 }  // namespace

@@ -35,9 +35,12 @@
 #include <vector>
 
 #include "loci/geom/motion.hpp"
+#include "loci/index/broadphase/detail/proxy_table.hpp"
+#include "loci/index/broadphase/dynamic_aabb_tree.hpp"
 #include "loci/index/broadphase/sweep_prune.hpp"
 #include "loci/index/detail/hilbert.hpp"
 #include "loci/index/detail/radix_sort.hpp"
+#include "loci/index/packed_rtree.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci {
@@ -251,5 +254,220 @@ std::vector<Conflict> find_conflicts(std::span<const Id> ids, std::span<const Mo
   });
   return out;
 }
+
+// ConflictMonitor<D>: the conflicts of a fleet kept up to date as reports stream in.
+//
+// It computes ahead: at a full computation at time b it keeps every pair within D during
+// [b, b + H + slack] (find_conflicts), and the grown swept boxes of that span in a packed
+// R-tree (packed_rtree.hpp). After a batch of reports, refresh(now) with now <= b + slack
+// drops the kept pairs of the objects that reported and looks for their new pairs with one
+// query each: the pairs of the others cannot have changed, since their reports did not and
+// [now, now + H] lies inside the span already searched. Objects that reported since b have
+// stale boxes in the packed tree, which queries skip; their current boxes are in a small
+// dynamic AABB tree (broadphase/dynamic_aabb_tree.hpp) that queries look at too. Once now passes
+// b + slack, refresh computes everything again from now. conflicts(visit) then reports, from
+// the kept pairs, those within D during [now, now + H], with the same closest approach as
+// find_conflicts at now (each kept pair is tested again at now, so answers are identical to a
+// computation from scratch).
+//
+// Cost: a full computation as find_conflicts over the longer span; an incremental refresh
+// O(reported x (log n + candidates)); conflicts() O(kept pairs). Objects are named by the
+// caller's ids. Thread-safety: one thread at a time.
+template <int D>
+class ConflictMonitor {
+ public:
+  ConflictMonitor(double within, double horizon, double slack)
+      : within_(within), horizon_(horizon), slack_(slack) {
+    check_conflict_query(within, 0, horizon);
+    if (!std::isfinite(slack) || slack < 0)
+      throw InvalidArgument("conflict monitor slack must be a finite number >= 0");
+  }
+
+  // A new report for id (added when new); the latest given replaces the earlier.
+  void report(Id id, const Motion<D>& m) {
+    check_motion(m);
+    std::uint32_t s = slots_.find(id);
+    if (s == kNone) {
+      if (!free_.empty()) {
+        s = free_.back();
+        free_.pop_back();
+      } else {
+        s = std::uint32_t(ids_.size());
+        ids_.push_back(0);
+        motion_.emplace_back();
+        alive_.push_back(0);
+        dirty_.push_back(0);
+        adj_.emplace_back();
+      }
+      ids_[s] = id;
+      alive_[s] = 1;
+      slots_.insert(id, s, ++count_);
+    }
+    motion_[s] = m;
+    mark(s);
+  }
+
+  bool remove(Id id) {
+    const std::uint32_t s = slots_.find(id);
+    if (s == kNone) return false;
+    slots_.erase(id);
+    alive_[s] = 0;
+    --count_;
+    mark(s);
+    return true;
+  }
+
+  std::size_t size() const { return count_; }
+  // Full computations and incremental refreshes done so far.
+  std::size_t full_computations() const { return full_; }
+  std::size_t incremental_refreshes() const { return incremental_; }
+
+  // Brings the kept pairs up to time now.
+  QueryStats refresh(double now) {
+    if (!std::isfinite(now)) throw InvalidArgument("conflict time is NaN or infinite");
+    now_ = now;
+    if (!computed_ || now < base_ || now > base_ + slack_) return recompute(now);
+    ++incremental_;
+    QueryStats st;
+    const double t1 = base_ + horizon_ + slack_;
+    dirty_seen_.resize(ids_.size(), 0);
+    for (std::uint32_t s : dirty_list_)
+      if (alive_[s]) widen(motion_[s], t1 - base_);
+    // Drop every kept pair of the objects that reported.
+    for (std::uint32_t s : dirty_list_) {
+      for (std::uint32_t t : adj_[s])
+        std::erase(adj_[t], s);
+      adj_[s].clear();
+    }
+    moved_.resize(ids_.size(), 0);
+    for (std::uint32_t s : dirty_list_) {
+      dirty_[s] = 0;
+      moved_[s] = 1;
+      if (!alive_[s]) {
+        recent_.remove(s);
+        free_.push_back(s);
+        continue;
+      }
+      const Box<D> b = detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_);
+      if (recent_.contains(s))
+        recent_.move(s, b);
+      else
+        recent_.add(s, b);
+    }
+    for (std::uint32_t s : dirty_list_) {
+      if (!alive_[s]) continue;
+      const Box<D> b = detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_);
+      auto candidate = [&](Id other, const Box<D>&) {
+        const auto t = std::uint32_t(other);
+        // A pair of two reporting objects is taken from the first of them looked at.
+        if (t == s || dirty_seen_[t]) return true;
+        if (closest_approach(motion_[s], motion_[t], base_, t1 - base_, keep_)) link(s, t);
+        return true;
+      };
+      st += packed_.query(b, [&](Id other, const Box<D>& ob) {
+        // Boxes of objects that reported since the base are stale here.
+        return moved_[other] ? true : candidate(other, ob);
+      });
+      st += recent_.query(b, candidate);
+      dirty_seen_[s] = 1;
+    }
+    for (std::uint32_t s : dirty_list_)
+      dirty_seen_[s] = 0;
+    dirty_list_.clear();
+    return st;
+  }
+
+  // The conflicts during [now, now + H] (now as given to the last refresh), by ids, a < b.
+  template <class F>
+  void conflicts(F&& visit) const {
+    for (std::uint32_t s = 0; s < adj_.size(); ++s)
+      for (std::uint32_t t : adj_[s]) {
+        if (t < s) continue;
+        const bool sa = ids_[s] < ids_[t];
+        const Motion<D>& a = sa ? motion_[s] : motion_[t];
+        const Motion<D>& b = sa ? motion_[t] : motion_[s];
+        if (auto ap = closest_approach(a, b, now_, horizon_, within_))
+          if (!visit(sa ? ids_[s] : ids_[t], sa ? ids_[t] : ids_[s], *ap)) return;
+      }
+  }
+  std::vector<Conflict> conflicts() const {
+    std::vector<Conflict> out;
+    conflicts([&](Id a, Id b, const Approach& ap) { return out.push_back({a, b, ap}), true; });
+    std::sort(out.begin(), out.end(), [](const Conflict& x, const Conflict& y) {
+      return x.a != y.a ? x.a < y.a : x.b < y.b;
+    });
+    return out;
+  }
+
+ private:
+  void mark(std::uint32_t s) {
+    if (!dirty_[s]) {
+      dirty_[s] = 1;
+      dirty_list_.push_back(s);
+    }
+  }
+  // Kept pairs are those within keep_, a hair more than D (relative to the magnitudes seen),
+  // so that a pair within D at a later `now` is never lost to rounding at the base time.
+  void widen(const Motion<D>& m, double span) {
+    const Point<D> p = position(m, base_);
+    for (int a = 0; a < D; ++a)
+      scale_ = std::max(scale_, std::abs(p[a]) + std::abs(m.v[a]) * span);
+    keep_ = within_ * (1 + 1e-9) + 1e-9 * scale_;
+  }
+  void link(std::uint32_t s, std::uint32_t t) {
+    adj_[s].push_back(t);
+    adj_[t].push_back(s);
+  }
+
+  QueryStats recompute(double now) {
+    ++full_;
+    computed_ = true;
+    base_ = now;
+    const double span = horizon_ + slack_;
+    for (std::uint32_t s : dirty_list_) {
+      dirty_[s] = 0;
+      if (!alive_[s]) free_.push_back(s);
+    }
+    dirty_list_.clear();
+    dirty_seen_.assign(ids_.size(), 0);
+    std::vector<std::uint32_t> live;
+    std::vector<Motion<D>> dense;
+    recent_.clear();
+    moved_.assign(ids_.size(), 0);
+    scale_ = 0;
+    for (std::uint32_t s = 0; s < ids_.size(); ++s) {
+      adj_[s].clear();
+      if (!alive_[s]) continue;
+      live.push_back(s);
+      dense.push_back(motion_[s]);
+      widen(motion_[s], span);
+    }
+    // The packed tree names entries by their index in `boxes`: one per slot, free slots empty.
+    std::vector<Box<D>> boxes(ids_.size(), Box<D>::empty());
+    for (std::uint32_t s : live)
+      boxes[s] = detail::grown_sweep(motion_[s], now, now + span, 0.5 * keep_);
+    packed_ = PackedRTree<D>::build(boxes);
+    return finder_.find(std::span<const Motion<D>>(dense), keep_, now, span,
+                        [&](std::uint32_t i, std::uint32_t j, const Approach&) {
+                          link(live[i], live[j]);
+                          return true;
+                        });
+  }
+
+  double within_, horizon_, slack_;
+  double base_ = 0, now_ = 0, scale_ = 0, keep_ = 0;
+  bool computed_ = false;
+  std::size_t full_ = 0, incremental_ = 0;
+  std::vector<Id> ids_;
+  std::vector<Motion<D>> motion_;
+  std::vector<std::uint8_t> alive_, dirty_, dirty_seen_, moved_;
+  std::vector<std::uint32_t> dirty_list_, free_;
+  std::vector<std::vector<std::uint32_t>> adj_;  // kept pairs, both ways
+  detail::IdMap slots_;
+  std::size_t count_ = 0;
+  PackedRTree<D> packed_;      // grown swept boxes at the base, by slot
+  DynamicAabbTree<D> recent_;  // the same for objects that reported since the base
+  ConflictFinder<D> finder_;
+};
 
 }  // namespace loci
