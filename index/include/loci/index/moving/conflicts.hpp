@@ -364,8 +364,9 @@ class ConflictMonitor {
         if (closest_approach(motion_[s], motion_[t], base_, t1 - base_, keep_)) link(s, t);
         return true;
       };
-      st += packed_.query(b, [&](Id other, const Box<D>& ob) {
+      st += packed_.query(b, [&](Id k, const Box<D>& ob) {
         // Boxes of objects that reported since the base are stale here.
+        const std::uint32_t other = packed_slot_[k];
         return moved_[other] ? true : candidate(other, ob);
       });
       st += recent_.query(b, candidate);
@@ -442,11 +443,13 @@ class ConflictMonitor {
       dense.push_back(motion_[s]);
       widen(motion_[s], span);
     }
-    // The packed tree names entries by their index in `boxes`: one per slot, free slots empty.
-    std::vector<Box<D>> boxes(ids_.size(), Box<D>::empty());
+    // The packed tree names entries by their index in `boxes`, packed_slot_ maps it back.
+    std::vector<Box<D>> boxes;
+    boxes.reserve(live.size());
     for (std::uint32_t s : live)
-      boxes[s] = detail::grown_sweep(motion_[s], now, now + span, 0.5 * keep_);
+      boxes.push_back(detail::grown_sweep(motion_[s], now, now + span, 0.5 * keep_));
     packed_ = PackedRTree<D>::build(boxes);
+    packed_slot_ = live;
     return finder_.find(std::span<const Motion<D>>(dense), keep_, now, span,
                         [&](std::uint32_t i, std::uint32_t j, const Approach&) {
                           link(live[i], live[j]);
@@ -465,8 +468,9 @@ class ConflictMonitor {
   std::vector<std::vector<std::uint32_t>> adj_;  // kept pairs, both ways
   detail::IdMap slots_;
   std::size_t count_ = 0;
-  PackedRTree<D> packed_;      // grown swept boxes at the base, by slot
-  DynamicAabbTree<D> recent_;  // the same for objects that reported since the base
+  PackedRTree<D> packed_;                   // grown swept boxes at the base
+  std::vector<std::uint32_t> packed_slot_;  // slot of each entry of packed_
+  DynamicAabbTree<D> recent_;               // the same for objects that reported since the base
   ConflictFinder<D> finder_;
 };
 
