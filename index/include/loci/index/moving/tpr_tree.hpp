@@ -247,27 +247,31 @@ class TprTree {
     const double tol = tolerance(r);
     for (int i = 0; i < D; ++i)
       grown.min[i] -= tol, grown.max[i] += tol;
-    auto meets = [&](const Box_& b) {
-      if (!slice) return detail::tpbr_meets(b, epoch_, w);
-      bool in = true;
-      for (int i = 0; i < D; ++i)
-        in &= (b.lo_at(i, r) <= grown.max[i]) & (b.hi_at(i, r) >= grown.min[i]);
-      return in;
-    };
     while (!stack.empty()) {
       const Node& n = nodes_[stack.back()];
       stack.pop_back();
       ++st.nodes_visited;
       st.entries_tested += n.count;
+      bool in[kSlots];
       if (n.level == 0) {
+        if (slice)
+          positions_inside(n, w.from, w.t1, in);
+        else
+          for (int e = 0; e < n.count; ++e)
+            in[e] = inside(n.motion[e], w);
         for (int e = 0; e < n.count; ++e) {
-          if (!inside(n.motion[e], w)) continue;
+          if (!in[e]) continue;
           ++st.results;
           if (!visit(n.id[e], n.motion[e])) return st;
         }
       } else {
+        if (slice)
+          boxes_meet(n, grown, r, in);
+        else
+          for (int e = 0; e < n.count; ++e)
+            in[e] = detail::tpbr_meets(n.box[e], epoch_, w);
         for (int e = 0; e < n.count; ++e)
-          if (meets(n.box[e])) stack.push_back(n.child[e]);
+          if (in[e]) stack.push_back(n.child[e]);
       }
     }
     return st;
@@ -340,15 +344,68 @@ class TprTree {
   }
 
  private:
+  using Box_ = detail::Tpbr<D>;
+  static constexpr int kSlots = M + 1;  // one spare entry while overflowing
+
+  // A node's entry boxes as structure-of-arrays, so that the tests of all entries of a node
+  // run as one vectorized loop; box[e] reads (and, on a mutable node, writes) one entry.
+  struct BoxArray {
+    double lo[D][kSlots], hi[D][kSlots], vlo[D][kSlots], vhi[D][kSlots];
+
+    Box_ get(int e) const {
+      Box_ b;
+      for (int i = 0; i < D; ++i)
+        b.lo[i] = lo[i][e], b.hi[i] = hi[i][e], b.vlo[i] = vlo[i][e], b.vhi[i] = vhi[i][e];
+      return b;
+    }
+    void set(int e, const Box_& b) {
+      for (int i = 0; i < D; ++i)
+        lo[i][e] = b.lo[i], hi[i][e] = b.hi[i], vlo[i][e] = b.vlo[i], vhi[i][e] = b.vhi[i];
+    }
+    struct Ref {
+      BoxArray& a;
+      int e;
+      operator Box_() const { return a.get(e); }
+      Ref& operator=(const Box_& b) {
+        a.set(e, b);
+        return *this;
+      }
+      void enclose(const Box_& b, double c) {
+        Box_ x = a.get(e);
+        x.enclose(b, c);
+        a.set(e, x);
+      }
+    };
+    Box_ operator[](int e) const { return get(e); }
+    Ref operator[](int e) { return {*this, e}; }
+  };
+  // The reports of a leaf's objects, likewise.
+  struct MotionArray {
+    double t[kSlots], p[D][kSlots], v[D][kSlots];
+
+    Motion<D> operator[](int e) const {
+      Motion<D> m;
+      m.t = t[e];
+      for (int i = 0; i < D; ++i)
+        m.p[i] = p[i][e], m.v[i] = v[i][e];
+      return m;
+    }
+    void set(int e, const Motion<D>& m) {
+      t[e] = m.t;
+      for (int i = 0; i < D; ++i)
+        p[i][e] = m.p[i], v[i][e] = m.v[i];
+    }
+  };
+
   struct Node {
     std::uint32_t parent = kNone;  // also the free-list link
     std::uint8_t level = 0;        // 0: leaf (children are object slots)
     std::uint8_t count = 0;
-    detail::Tpbr<D> box[M + 1];  // one spare entry while overflowing
-    std::uint32_t child[M + 1];
+    BoxArray box;
+    std::uint32_t child[kSlots];
     // Leaves also keep each object's report and id, so that queries read no other memory.
-    Motion<D> motion[M + 1];
-    Id id[M + 1];
+    MotionArray motion;
+    Id id[kSlots];
   };
   // An entry on its way from one node to another.
   struct Item {
@@ -359,19 +416,80 @@ class TprTree {
   };
   static Item take(const Node& n, int e) { return {n.box[e], n.child[e], n.motion[e], n.id[e]}; }
   static void put(Node& n, int e, const Item& it) {
-    n.box[e] = it.box;
+    n.box.set(e, it.box);
     n.child[e] = it.child;
-    n.motion[e] = it.motion;
+    n.motion.set(e, it.motion);
     n.id[e] = it.id;
   }
   using Pool = detail::NodePool<Node, &Node::parent>;
-  using Box_ = detail::Tpbr<D>;
 
   double rel_clock() const { return clock_ - epoch_; }
   // The rounding allowance of box tests at relative time r: a bound rounded a few times at
   // magnitudes up to mag_ + vmag_ (|r| + |clock|) is off by far less (tpbr.hpp).
   double tolerance(double r) const {
     return 1e-12 * (4 * mag_ + 4 * vmag_ * (std::abs(r) + std::abs(rel_clock()))) + 1e-300;
+  }
+
+  // Vectorized timeslice tests of all entries of a node. in[e]: the entry's box at relative
+  // time r meets `grown` (the window grown by the tolerance).
+  static void boxes_meet(const Node& n, const Box<D>& grown, double r, bool* in) {
+    const BoxArray& b = n.box;
+    for (int e = 0; e < n.count; ++e) {
+      bool ok = true;
+      for (int i = 0; i < D; ++i)
+        ok &= (b.lo[i][e] + b.vlo[i][e] * r <= grown.max[i]) &
+              (b.hi[i][e] + b.vhi[i][e] * r >= grown.min[i]);
+      in[e] = ok;
+    }
+  }
+  // in[e]: the object's position at time s lies in the window; the arithmetic of inside().
+  static void positions_inside(const Node& n, const Box<D>& w, double s, bool* in) {
+    const MotionArray& m = n.motion;
+    for (int e = 0; e < n.count; ++e) {
+      const double dt = s - m.t[e];
+      bool ok = true;
+      for (int i = 0; i < D; ++i) {
+        const double x = m.p[i][e] + m.v[i][e] * dt;
+        ok &= (x >= w.min[i]) & (x <= w.max[i]);
+      }
+      in[e] = ok;
+    }
+  }
+
+  // pen[e]: the rise of the TPR* cost of entry e's box when it takes b (0 when it holds b),
+  // for all entries of a node in one vectorized loop; the arithmetic of detail::swept_cost.
+  void enlargements(const Node& n, const Box_& b, double* pen) const {
+    const double c = rel_clock(), h = params_.horizon;
+    const BoxArray& a = n.box;
+    double bl[D], bh[D];
+    for (int i = 0; i < D; ++i)
+      bl[i] = b.lo_at(i, c), bh[i] = b.hi_at(i, c);
+    for (int e = 0; e < n.count; ++e) {
+      double e1[D], e2[D], sp[D], g1[D], g2[D], gs[D];
+      for (int i = 0; i < D; ++i) {
+        const double l = a.lo[i][e] + a.vlo[i][e] * c, u = a.hi[i][e] + a.vhi[i][e] * c;
+        const double vl = a.vlo[i][e], vh = a.vhi[i][e];
+        e1[i] = u - l + params_.query_extent[i];
+        e2[i] = e1[i] + (vh - vl) * h;
+        sp[i] = vl > 0 ? vh : vh < 0 ? -vl : vh - vl;
+        const double gl = std::min(l, bl[i]), gu = std::max(u, bh[i]);
+        const double gvl = std::min(vl, b.vlo[i]), gvh = std::max(vh, b.vhi[i]);
+        g1[i] = gu - gl + params_.query_extent[i];
+        g2[i] = g1[i] + (gvh - gvl) * h;
+        gs[i] = gvl > 0 ? gvh : gvh < 0 ? -gvl : gvh - gvl;
+      }
+      double before = 1, after = 1;
+      for (int i = 0; i < D; ++i)
+        before *= e1[i], after *= g1[i];
+      for (int i = 0; i < D; ++i) {
+        double up = 1, down = 1, gup = 1, gdown = 1;
+        for (int j = 0; j < D; ++j)
+          if (j != i) up *= e1[j], down *= e2[j], gup *= g1[j], gdown *= g2[j];
+        before += 0.5 * (up + down) * sp[i] * h;
+        after += 0.5 * (gup + gdown) * gs[i] * h;
+      }
+      pen[e] = std::max(0.0, after - before);
+    }
   }
   double cost(const Box_& b) const {
     return detail::swept_cost(b, rel_clock(), params_.horizon, params_.query_extent);
@@ -458,8 +576,10 @@ class TprTree {
       const Node& n = nodes_[top.node];
       ++explored;
       const bool last = n.level == level + 1;
+      double rise[kSlots];
+      enlargements(n, b, rise);
       for (int e = 0; e < n.count; ++e) {
-        const double pen = top.key + enlargement(n.box[e], b);
+        const double pen = top.key + rise[e];
         if (!(pen < minpen)) continue;
         if (last) {
           minpen = pen;
@@ -474,19 +594,6 @@ class TprTree {
     if (best == kNone)
       throw Error(std::string(kName) + ": no node of level " + std::to_string(level) + " found");
     return best;
-  }
-
-  // The rise of the cost of `box` when it takes `b` (0 when it holds b already).
-  double enlargement(const Box_& box, const Box_& b) const {
-    const double c = rel_clock();
-    bool holds = true;
-    for (int i = 0; i < D; ++i)
-      holds &= (box.vlo[i] <= b.vlo[i]) & (box.vhi[i] >= b.vhi[i]) &
-               (box.lo_at(i, c) <= b.lo_at(i, c)) & (box.hi_at(i, c) >= b.hi_at(i, c));
-    if (holds) return 0;
-    Box_ grown = box;
-    grown.enclose(b, c);
-    return std::max(0.0, cost(grown) - cost(box));
   }
 
   // Inserts the entry (b, child) into a node of `level`, handling overflow.
@@ -715,8 +822,7 @@ class TprTree {
         for (int i = 0; i < node.count; ++i)
           orphans.push_back({take(node, i), node.level});
         Node& parent = nodes_[p];
-        parent.box[e] = parent.box[parent.count - 1];
-        parent.child[e] = parent.child[parent.count - 1];
+        put(parent, e, take(parent, parent.count - 1));
         --parent.count;
         nodes_.release(x);
       } else {
