@@ -374,6 +374,8 @@ int run_fleet_simulate(const Args& a) {
     o.update_fraction = parse_nonnegative("--update-fraction", a.get("--update-fraction"));
   if (a.has("--tick")) o.tick = parse_nonnegative("--tick", a.get("--tick"));
   if (a.has("--seed")) o.seed = parse_count("--seed", a.get("--seed"), 0, std::size_t(-1) / 2);
+  if (a.has("--slack")) o.slack = parse_nonnegative("--slack", a.get("--slack"));
+  o.from_scratch = a.has("--from-scratch");
   o.out_path = a.get("--output");
   o.progress = progress_bar(a, "simulating");
   const FleetSimulateReport r = fleet_simulate(o, stdout);
@@ -545,7 +547,7 @@ const std::vector<Command>& commands() {
       {"fleet simulate",
        "loci fleet simulate FILE --ticks N --within D --horizon H [--update-fraction F] [--tick S]",
        "ticks of position updates and conflict checks, timed (CSV "
-       "tick,t,updates,update_ms,conflict_ms,pairs)",
+       "tick,t,updates,update_ms,conflict_ms,pairs,full)",
        {{"--ticks", nullptr, "N", "how many ticks"},
         {"--within", nullptr, "D", "conflict distance (metres for AIS input)"},
         {"--horizon", nullptr, "H", "conflict horizon (seconds for AIS input)"},
@@ -554,6 +556,10 @@ const std::vector<Command>& commands() {
          "1/60)"},
         {"--tick", nullptr, "S", "time between ticks (default 1)"},
         {"--seed", nullptr, "S", "random seed of the turns (default 1)"},
+        {"--slack", nullptr, "S",
+         "conflicts are kept up to date incrementally and recomputed in full once the clock "
+         "is S past the last full computation (default H/4)"},
+        {"--from-scratch", nullptr, nullptr, "compute the conflicts from scratch every tick"},
         {"--output", "-o", "OUT", "write the per-tick CSV to OUT instead of stdout"},
         kQuiet},
        "  loci fleet simulate ais.csv --ticks 600 --within 1852 --horizon 1800\n",

@@ -584,13 +584,17 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
   if (!(o.update_fraction >= 0 && o.update_fraction <= 1))
     throw InvalidArgument("--update-fraction must be in [0, 1]");
   if (!(o.tick > 0) || !std::isfinite(o.tick)) throw InvalidArgument("--tick must be > 0");
+  const double slack = o.slack.value_or(o.horizon / 4);
+  if (!(slack >= 0) || !std::isfinite(slack)) throw InvalidArgument("--slack must be >= 0");
   const Loaded l = load(o.path, std::nullopt);
   const auto start = in_force(l.data.reports, l.now);
   std::vector<Id> ids;
   std::vector<Motion2> motions;
+  ConflictMonitor<2> monitor(o.within, o.horizon, slack);
   for (const FleetReport& r : start) {
     ids.push_back(r.id);
     motions.push_back(r.m);
+    if (!o.from_scratch) monitor.report(r.id, r.m);
   }
   FleetIndex ix = index_of(start);
   FleetSimulateReport rep;
@@ -599,19 +603,20 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> turn(0, 0.05);
   const std::size_t per_tick =
-      ids.empty() ? 0
-                  : std::max<std::size_t>(
-                        1, std::size_t(std::llround(o.update_fraction * double(ids.size()))));
+      ids.empty() || o.update_fraction == 0
+          ? 0
+          : std::max<std::size_t>(
+                1, std::size_t(std::llround(o.update_fraction * double(ids.size()))));
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
-  std::fprintf(f, "tick,t,updates,update_ms,conflict_ms,pairs\n");
+  std::fprintf(f, "tick,t,updates,update_ms,conflict_ms,pairs,full\n");
   ProgressTicker ticker(o.progress, double(o.ticks));
   std::size_t next = 0;  // round robin: each tick the next per_tick objects report
   double total_update = 0, total_conflict = 0, total_pairs = 0;
   for (std::size_t tick = 1; tick <= o.ticks; ++tick) {
     const double t = l.now + o.tick * double(tick);
     const auto t0 = std::chrono::steady_clock::now();
-    for (std::size_t u = 0; u < per_tick && o.update_fraction > 0; ++u, ++next) {
+    for (std::size_t u = 0; u < per_tick; ++u, ++next) {
       const std::size_t i = next % ids.size();
       Motion2 m = motions[i];
       const Point2 p = position(m, t);
@@ -619,16 +624,26 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
       m = {t, p, {m.v[0] * c - m.v[1] * s, m.v[0] * s + m.v[1] * c}};
       motions[i] = m;
       ix.update(ids[i], m);
+      if (!o.from_scratch) monitor.report(ids[i], m);
     }
     const double update_ms = 1e3 * seconds_since(t0);
     const auto t1 = std::chrono::steady_clock::now();
-    const std::vector<Conflict> found = find_conflicts<2>(ids, motions, o.within, t, o.horizon);
+    std::size_t pairs = 0;
+    bool full = true;
+    if (o.from_scratch) {
+      pairs = find_conflicts<2>(ids, motions, o.within, t, o.horizon).size();
+    } else {
+      const std::size_t before = monitor.full_computations();
+      monitor.refresh(t);
+      monitor.conflicts([&](Id, Id, const Approach&) { return ++pairs, true; });
+      full = monitor.full_computations() != before;
+    }
     const double conflict_ms = 1e3 * seconds_since(t1);
-    std::fprintf(f, "%zu,%s,%zu,%.3f,%.3f,%zu\n", tick, num(t).c_str(),
-                 o.update_fraction > 0 ? per_tick : 0, update_ms, conflict_ms, found.size());
+    std::fprintf(f, "%zu,%s,%zu,%.3f,%.3f,%zu,%d\n", tick, num(t).c_str(), per_tick, update_ms,
+                 conflict_ms, pairs, int(full));
     total_update += update_ms;
     total_conflict += conflict_ms;
-    total_pairs += double(found.size());
+    total_pairs += double(pairs);
     ticker.tick(double(tick));
   }
   out.commit();

@@ -434,14 +434,26 @@ TEST_F(FleetCli, GenerateIsDeterministicAndStaysInTheBox) {
   EXPECT_EQ(d.objects(), 50u);
   for (const auto& r : io::in_force(d.reports, d.latest()))
     EXPECT_TRUE(intersects(Box2{{0, 0}, {500, 500}}, Box2::of_point(r.m.p)));
-  const CliRun s = run_loci("fleet simulate " + shell_quote(a) +
-                            " --ticks 5 --within 10 --horizon 30 --update-fraction 0.1 -q");
+  // Kept incrementally or computed from scratch, each tick finds the same number of pairs.
+  const std::string sim = "fleet simulate " + shell_quote(a) +
+                          " --ticks 40 --within 30 --horizon 30 --update-fraction 0.1 -q";
+  const CliRun s = run_loci(sim), scratch = run_loci(sim + " --from-scratch");
   ASSERT_EQ(s.status, 0) << s.err;
-  const auto rows = lines(s.out);
-  ASSERT_EQ(rows.size(), 6u);
-  EXPECT_EQ(rows[0], "tick,t,updates,update_ms,conflict_ms,pairs");
-  EXPECT_EQ(rows[1].rfind("1,", 0), 0u);
-  EXPECT_EQ(csv_rows(s.out)[1][2], "5");
+  ASSERT_EQ(scratch.status, 0) << scratch.err;
+  const auto rows = csv_rows(s.out), want = csv_rows(scratch.out);
+  ASSERT_EQ(rows.size(), 41u);
+  ASSERT_EQ(want.size(), 41u);
+  EXPECT_EQ(lines(s.out)[0], "tick,t,updates,update_ms,conflict_ms,pairs,full");
+  std::size_t full = 0, pairs = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i][0], std::to_string(i));
+    EXPECT_EQ(rows[i][2], "5");
+    EXPECT_EQ(rows[i][5], want[i][5]) << "tick " << i;
+    full += rows[i][6] == "1";
+    pairs += std::stoull(rows[i][5]);
+  }
+  EXPECT_GT(pairs, 0u);
+  EXPECT_LT(full, 40u);  // some ticks were incremental
 }
 
 TEST_F(FleetCli, HelpDocumentsEverySubcommand) {
