@@ -622,27 +622,30 @@ class TprTree {
   }
 
   // Sort key k of entry b: k / D picks lo at now, hi at now, vlo, vhi; k % D the axis.
-  double key(const Box_& b, int k) const {
+  // Sort key k of entry e: k / D picks lo at the clock, hi at the clock, vlo, vhi; k % D the
+  // axis.
+  double key(const Node& node, int e, int k) const {
     const int axis = k % D, what = k / D;
+    const BoxArray& a = node.box;
     switch (what) {
       case 0:
-        return b.lo_at(axis, rel_clock());
+        return a.lo[axis][e] + a.vlo[axis][e] * rel_clock();
       case 1:
-        return b.hi_at(axis, rel_clock());
+        return a.hi[axis][e] + a.vhi[axis][e] * rel_clock();
       case 2:
-        return b.vlo[axis];
+        return a.vlo[axis][e];
       default:
-        return b.vhi[axis];
+        return a.vhi[axis][e];
     }
   }
 
   void order_by(const Node& node, int k, bool descending, std::uint8_t* order) const {
-    for (int e = 0; e < node.count; ++e)
+    double keys[kSlots];
+    for (int e = 0; e < node.count; ++e) {
       order[e] = std::uint8_t(e);
-    std::sort(order, order + node.count, [&](int a, int b) {
-      const double ka = key(node.box[a], k), kb = key(node.box[b], k);
-      return descending ? ka > kb : ka < kb;
-    });
+      keys[e] = descending ? -key(node, e, k) : key(node, e, k);
+    }
+    std::sort(order, order + node.count, [&](int x, int y) { return keys[x] < keys[y]; });
   }
 
   Box_ union_of(const Node& node, const std::uint8_t* order, int from, int to) const {
