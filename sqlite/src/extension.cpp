@@ -7,7 +7,7 @@
 // include/loci/sqlite/loci_sqlite.h).
 #include <memory>
 
-#include "rtree_table.hpp"
+#include "shadow_table.hpp"
 
 SQLITE_EXTENSION_INIT1
 
@@ -15,12 +15,13 @@ namespace loci::sqlite {
 
 namespace {
 
-// loci_check('t'): 'ok' or what is wrong with t's index.
+// loci_check('t'): 'ok' or what is wrong with t's index (loci_rtree) or reports (loci_fleet).
 void check_function(sqlite3_context* ctx, int, sqlite3_value** argv) {
   try {
     auto& registry = *registry_of(sqlite3_user_data(ctx));
     const char* name = reinterpret_cast<const char*>(sqlite3_value_text(argv[0]));
-    RTreeTable& t = table_named(sqlite3_context_db_handle(ctx), registry, name, "loci_check");
+    ShadowTable& t =
+        table_named<ShadowTable>(sqlite3_context_db_handle(ctx), registry, name, "loci_check");
     const std::string verdict = t.check();
     sqlite3_result_text(ctx, verdict.c_str(), int(verdict.size()), SQLITE_TRANSIENT);
   } catch (const SqlError& e) {

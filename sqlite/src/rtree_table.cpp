@@ -2,7 +2,6 @@
 // [, +aux ...]), SQLite rtree's argument shape with exact double coordinates.
 #include "rtree_table.hpp"
 
-#include <strings.h>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -20,35 +19,11 @@ const char* const kShadowSuffixes[] = {"node", "delta", "dead", "meta", "aux"};
 // A coordinate from SQL: integers and real numbers, and text that reads as one; anything
 // else is an error naming the column.
 double coordinate(sqlite3_value* v, const char* column, const RTreeTable& t) {
-  int type = sqlite3_value_type(v);
-  if (type == SQLITE_TEXT) type = sqlite3_value_numeric_type(v);
-  const auto fail = [&](const char* what) {
-    return SqlError{SQLITE_CONSTRAINT,
-                    format_sql("loci_rtree %s: %s is %s", t.name.c_str(), column, what)};
-  };
-  if (type == SQLITE_NULL) throw fail("NULL");
-  if (type != SQLITE_INTEGER && type != SQLITE_FLOAT) throw fail("not a number");
-  const double x = sqlite3_value_double(v);
-  if (!std::isfinite(x)) throw fail("not finite");
+  double x = 0;
+  if (const char* problem = read_number(v, x))
+    throw SqlError{SQLITE_CONSTRAINT,
+                   format_sql("loci_rtree %s: %s is %s", t.name.c_str(), column, problem)};
   return x;
-}
-
-// A row id from SQL: an integer, or a real number or text holding one.
-bool row_id(sqlite3_value* v, RowId& id) {
-  int type = sqlite3_value_type(v);
-  if (type == SQLITE_TEXT) type = sqlite3_value_numeric_type(v);
-  if (type == SQLITE_INTEGER) {
-    id = sqlite3_value_int64(v);
-    return true;
-  }
-  if (type == SQLITE_FLOAT) {
-    const double d = sqlite3_value_double(v);
-    if (d >= -9223372036854775808.0 && d < 9223372036854775808.0 && d == std::floor(d)) {
-      id = RowId(d);
-      return true;
-    }
-  }
-  return false;
 }
 
 // The largest double <= i and the smallest double >= i.
@@ -152,17 +127,9 @@ RTreeTable& table_of(sqlite3_vtab* v) {
 int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_vtab** out,
             char** err, bool create) {
   auto table = std::make_unique<RTreeTable>();
-  std::memset(static_cast<sqlite3_vtab*>(table.get()), 0, sizeof(sqlite3_vtab));
   try {
-    const int columns = argc - 3;
     std::vector<std::string> names, aux_names;
-    for (int i = 3; i < argc; ++i) {
-      std::string a = argv[i];
-      while (!a.empty() && (a.front() == ' ' || a.front() == '\t'))
-        a.erase(0, 1);
-      while (!a.empty() && (a.back() == ' ' || a.back() == '\t'))
-        a.pop_back();
-      if (a.empty()) throw SqlError{SQLITE_ERROR, "loci_rtree: an empty column name"};
+    for (std::string& a : column_arguments(argc, argv, "loci_rtree")) {
       if (a[0] == '+') {
         if (names.size() < 1 + kCoordinates)
           throw SqlError{SQLITE_ERROR,
@@ -171,7 +138,7 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
         aux_names.push_back(a.substr(1));
       } else {
         if (!aux_names.empty()) throw SqlError{SQLITE_ERROR, "loci_rtree: +aux columns come last"};
-        names.push_back(a);
+        names.push_back(std::move(a));
       }
     }
     if (names.size() != 1 + kCoordinates)
@@ -179,12 +146,10 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
                      format_sql("loci_rtree: expected (id, minx, maxx, miny, maxy [, +aux ...]), "
                                 "got %d column%s before the +aux ones (2-dimensional boxes only)",
                                 int(names.size()), names.size() == 1 ? "" : "s")};
-    (void)columns;
+    table->aux_count = int(aux_names.size());
     table->db = db;
     table->schema = argv[1];
     table->name = argv[2];
-    table->aux_count = int(aux_names.size());
-    table->registry = registry_of(aux);
 
     // Typed like the values they hold, so SQL's comparison rules are those of REAL columns.
     std::string decl = "CREATE TABLE x(";
@@ -198,7 +163,7 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
     sqlite3_vtab_config(db, SQLITE_VTAB_CONSTRAINT_SUPPORT, 1);
 
     if (create) {
-      const RTreeTable& t = *table;
+      RTreeTable& t = *table;
       exec(db, format_sql("CREATE TABLE %s(n INTEGER PRIMARY KEY, data BLOB);"
                           "CREATE TABLE %s(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, "
                           "miny REAL, maxy REAL);"
@@ -216,7 +181,7 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
       }
     }
     table->prepare_statements();
-    table->registry->tables.push_back(table.get());
+    table->attach(db, argv[1], argv[2], registry_of(aux));
     *out = table.release();
     return SQLITE_OK;
   } catch (const SqlError& e) {
@@ -240,23 +205,13 @@ int x_connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3
 }
 
 int x_disconnect(sqlite3_vtab* v) {
-  RTreeTable* t = &table_of(v);
-  auto& tables = t->registry->tables;
-  std::erase(tables, t);
-  delete t;
+  delete &table_of(v);
   return SQLITE_OK;
 }
 
 int x_destroy(sqlite3_vtab* v) {
   RTreeTable& t = table_of(v);
-  const int rc = guarded(v, [&] {
-    std::string sql;
-    for (const char* s : kShadowSuffixes)
-      sql += "DROP TABLE IF EXISTS " + t.shadow(s) + ";";
-    t.finalize_statements();  // they hold the shadow tables open
-    exec(t.db, sql);
-    return SQLITE_OK;
-  });
+  const int rc = guarded(v, [&] { return t.drop_shadows(), SQLITE_OK; });
   if (rc != SQLITE_OK) return rc;
   return x_disconnect(v);
 }
@@ -466,14 +421,8 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
 
 // ---- Transactions -------------------------------------------------------------------------
 
-int x_begin(sqlite3_vtab*) {
-  return SQLITE_OK;
-}
 int x_sync(sqlite3_vtab* v) {
   return guarded(v, [&] { return table_of(v).flush(true), SQLITE_OK; });
-}
-int x_commit(sqlite3_vtab*) {
-  return SQLITE_OK;
 }
 int x_rollback(sqlite3_vtab* v) {
   table_of(v).forget();
@@ -481,9 +430,6 @@ int x_rollback(sqlite3_vtab* v) {
 }
 int x_savepoint(sqlite3_vtab* v, int) {
   return guarded(v, [&] { return table_of(v).flush(false), SQLITE_OK; });
-}
-int x_release(sqlite3_vtab*, int) {
-  return SQLITE_OK;
 }
 int x_rollback_to(sqlite3_vtab* v, int) {
   table_of(v).forget();
@@ -494,15 +440,7 @@ int x_rename(sqlite3_vtab* v, const char* new_name) {
   RTreeTable& t = table_of(v);
   return guarded(v, [&] {
     t.flush(false);
-    std::string sql;
-    for (const char* s : kShadowSuffixes) {
-      if (std::strcmp(s, "aux") == 0 && !t.aux_count) continue;
-      sql += format_sql("ALTER TABLE %s RENAME TO \"%w_%s\";", t.shadow(s).c_str(), new_name, s);
-    }
-    t.finalize_statements();  // statements on the old names go before the tables move
-    exec(t.db, sql);
-    t.name = new_name;
-    t.prepare_statements();
+    t.rename_shadows(new_name);
     return SQLITE_OK;
   });
 }
@@ -529,13 +467,13 @@ sqlite3_module rtree_module() {
   m.xColumn = x_column;
   m.xRowid = x_rowid;
   m.xUpdate = x_update;
-  m.xBegin = x_begin;
+  m.xBegin = no_op_transaction;
   m.xSync = x_sync;
-  m.xCommit = x_commit;
+  m.xCommit = no_op_transaction;
   m.xRollback = x_rollback;
   m.xRename = x_rename;
   m.xSavepoint = x_savepoint;
-  m.xRelease = x_release;
+  m.xRelease = no_op_savepoint;
   m.xRollbackTo = x_rollback_to;
   m.xShadowName = x_shadow_name;
   return m;
@@ -547,8 +485,10 @@ const sqlite3_module kRTreeModule = rtree_module();
 
 // ---- RTreeTable ---------------------------------------------------------------------------
 
-std::string RTreeTable::shadow(const char* suffix) const {
-  return format_sql("\"%w\".\"%w_%s\"", schema.c_str(), name.c_str(), suffix);
+std::vector<const char*> RTreeTable::shadow_suffixes() const {
+  std::vector<const char*> out(std::begin(kShadowSuffixes), std::end(kShadowSuffixes));
+  if (!aux_count) out.pop_back();
+  return out;
 }
 
 void RTreeTable::finalize_statements() {
@@ -562,8 +502,7 @@ void RTreeTable::prepare_statements() {
   const auto sql = [&](const char* fmt, const char* suffix) {
     return format_sql(fmt, shadow(suffix).c_str());
   };
-  get_generation.prepare(db, sql("SELECT v FROM %s WHERE k = 'generation'", "meta"));
-  set_generation.prepare(db, sql("UPDATE %s SET v = ?1 WHERE k = 'generation'", "meta"));
+  prepare_generation();
   read_node.prepare(db, sql("SELECT n, data FROM %s ORDER BY n", "node"));
   write_node.prepare(db, sql("INSERT INTO %s(n, data) VALUES(?1, ?2)", "node"));
   clear_node.prepare(db, sql("DELETE FROM %s", "node"));
@@ -657,22 +596,8 @@ RTreeIndex RTreeTable::load_stored() {
   return RTreeIndex::load(h, read, std::move(delta), std::move(dead));
 }
 
-sqlite3_int64 RTreeTable::stored_generation() {
-  const ResetOnExit reset{get_generation};
-  return get_generation.step() ? sqlite3_column_int64(get_generation.get(), 0) : -1;
-}
-
 RTreeIndex& RTreeTable::current() {
-  if (index && !index->has_touched()) {
-    unsigned v = 0;
-    const bool known =
-        sqlite3_file_control(db, schema.c_str(), SQLITE_FCNTL_DATA_VERSION, &v) == SQLITE_OK;
-    if (!(known && data_version_known && v == data_version)) {
-      if (stored_generation() != generation) index.reset();
-      data_version = v;
-      data_version_known = known;
-    }
-  }
+  if (index && !index->has_touched() && changed_elsewhere()) index.reset();
   if (!index) {
     const sqlite3_int64 g = stored_generation();
     try {
@@ -685,12 +610,6 @@ RTreeIndex& RTreeTable::current() {
     generation = g;
   }
   return *index;
-}
-
-void RTreeTable::bump_generation() {
-  set_generation.bind(1, sqlite3_int64(generation + 1));
-  set_generation.run();
-  ++generation;
 }
 
 void RTreeTable::write_base() {
@@ -776,40 +695,6 @@ std::string RTreeTable::check() {
   } catch (const std::exception& e) {
     return e.what();
   }
-}
-
-RTreeTable* Registry::find(std::string_view name) const {
-  RTreeTable* found = nullptr;
-  for (RTreeTable* t : tables) {
-    const std::string qualified = t->schema + "." + t->name;
-    const auto same = [&](const std::string& s) {
-      return s.size() == name.size() && strncasecmp(s.data(), name.data(), s.size()) == 0;
-    };
-    if (same(qualified)) return t;
-    if (same(t->name) && (!found || t->schema == "main")) found = t;
-  }
-  return found;
-}
-
-RTreeTable& table_named(sqlite3* db, const Registry& registry, const char* name,
-                        const char* function) {
-  if (!name) throw SqlError{SQLITE_ERROR, format_sql("%s: the table name is NULL", function)};
-  if (RTreeTable* t = registry.find(name)) return *t;
-  // Not connected on this connection yet: naming it in a statement connects it.
-  sqlite3_stmt* s = nullptr;
-  const std::string dot = name;
-  std::string sql;
-  if (const auto p = dot.find('.'); p != std::string::npos && !registry.find(dot.substr(p + 1)))
-    sql = format_sql("SELECT 1 FROM \"%w\".\"%w\" LIMIT 0", dot.substr(0, p).c_str(),
-                     dot.substr(p + 1).c_str());
-  else
-    sql = format_sql("SELECT 1 FROM \"%w\" LIMIT 0", name);
-  const int rc = sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr);
-  sqlite3_finalize(s);
-  if (rc != SQLITE_OK)
-    throw SqlError{SQLITE_ERROR, format_sql("%s: no such table: %s", function, name)};
-  if (RTreeTable* t = registry.find(name)) return *t;
-  throw SqlError{SQLITE_ERROR, format_sql("%s: %s is not a loci_rtree table", function, name)};
 }
 
 int register_rtree(sqlite3* db, const std::shared_ptr<Registry>& registry) {

@@ -4,6 +4,8 @@
 
 #include <sqlite3ext.h>
 
+#include <cmath>
+#include <cstdint>
 #include <exception>
 #include <new>
 #include <string>
@@ -125,6 +127,35 @@ std::string format_sql(const char* fmt, Args... args) {
   std::string out = s;
   sqlite3_free(s);
   return out;
+}
+
+// A number from SQL: an integer, a real, or text that reads as one. Sets `out` and returns
+// null, or returns what is wrong with the value ("NULL", "not a number", "not finite").
+inline const char* read_number(sqlite3_value* v, double& out) {
+  int type = sqlite3_value_type(v);
+  if (type == SQLITE_TEXT) type = sqlite3_value_numeric_type(v);
+  if (type == SQLITE_NULL) return "NULL";
+  if (type != SQLITE_INTEGER && type != SQLITE_FLOAT) return "not a number";
+  out = sqlite3_value_double(v);
+  return std::isfinite(out) ? nullptr : "not finite";
+}
+
+// A row id from SQL: an integer, or a real number or text holding one.
+inline bool row_id(sqlite3_value* v, std::int64_t& id) {
+  int type = sqlite3_value_type(v);
+  if (type == SQLITE_TEXT) type = sqlite3_value_numeric_type(v);
+  if (type == SQLITE_INTEGER) {
+    id = sqlite3_value_int64(v);
+    return true;
+  }
+  if (type == SQLITE_FLOAT) {
+    const double d = sqlite3_value_double(v);
+    if (d >= -9223372036854775808.0 && d < 9223372036854775808.0 && d == std::floor(d)) {
+      id = std::int64_t(d);
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace loci::sqlite

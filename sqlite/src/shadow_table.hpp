@@ -1,0 +1,126 @@
+// ShadowTable: what every loci virtual table that keeps its rows in shadow tables shares (the
+// loci_rtree and loci_fleet modules), and the registry through which the functions that name
+// a table by its name ('t' in loci_nearest('t', ...)) find it.
+//
+// Shadow tables are ordinary tables named after the virtual table (`t_node`, `t_report`, ...),
+// so SQLite's journal makes them follow BEGIN / ROLLBACK / SAVEPOINT / ROLLBACK TO and survive
+// a killed process. Each table also holds what it read from them in memory; that copy must be
+// dropped after a rollback (the module's xRollback and xRollbackTo do) and when another
+// connection committed a change. The second is noticed in two steps: the file's data version
+// (SQLITE_FCNTL_DATA_VERSION, one call without I/O) tells that something in the file changed;
+// then 'generation' in %_meta, which every transaction that wrote the table has bumped before
+// committing, tells whether it was this table.
+//
+// A table is on its connection's registry from xConnect / xCreate to xDisconnect / xDestroy.
+// Thread-safety: as SQLite's connection, one thread at a time.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sqlite_api.hpp"
+
+namespace loci::sqlite {
+
+struct Registry;
+
+struct ShadowTable : sqlite3_vtab {
+  // The name functions use in "%s is not a ... table" (the module's name).
+  static constexpr const char* kModule = "loci_rtree or loci_fleet";
+
+  ShadowTable();
+  ShadowTable(const ShadowTable&) = delete;
+  ShadowTable& operator=(const ShadowTable&) = delete;
+  virtual ~ShadowTable();  // leaves the registry
+
+  sqlite3* db = nullptr;
+  std::string schema;
+  std::string name;
+  std::shared_ptr<Registry> registry;
+
+  sqlite3_int64 generation = -1;  // the stored 'generation' the in-memory copy was read at
+  unsigned data_version = 0;      // the file's data version when `generation` was last checked
+  bool data_version_known = false;
+  Statement get_generation, set_generation;
+
+  // "ok", or what is wrong with the stored or in-memory rows.
+  virtual std::string check() = 0;
+  // The suffixes of the shadow tables this table has ("node", "report", ...).
+  virtual std::vector<const char*> shadow_suffixes() const = 0;
+  // Prepares or finalizes every statement on the shadow tables (they keep them open).
+  virtual void prepare_statements() = 0;
+  virtual void finalize_statements() = 0;
+
+  // Joins `registry` as `name` in `schema`.
+  void attach(sqlite3* connection, const char* schema_name, const char* table_name,
+              std::shared_ptr<Registry> on);
+  // "schema"."name_suffix", quoted for SQL.
+  std::string shadow(const char* suffix) const;
+  // Prepares get_generation and set_generation on %_meta(k, v).
+  void prepare_generation();
+  sqlite3_int64 stored_generation();  // 'generation' in %_meta, -1 when missing
+  void bump_generation();             // 'generation' + 1, stored and remembered
+  // Whether another connection committed a change to this table since `generation` was read.
+  bool changed_elsewhere();
+  void forget_version() { data_version_known = false; }
+
+  // DROP TABLE of every shadow table (xDestroy), ALTER TABLE ... RENAME of each (xRename).
+  void drop_shadows();
+  void rename_shadows(const char* new_name);
+};
+
+// The loci tables connected on one database connection.
+struct Registry {
+  std::vector<ShadowTable*> tables;
+  // The table called `name` (case-insensitive; "schema.name" also works); null when absent.
+  ShadowTable* find(std::string_view name) const;
+};
+
+// The table `name`, connecting it if this connection has not yet; null when it exists but is
+// not a loci table. Throws SqlError naming `function` when there is no such table.
+ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* name,
+                             const char* function);
+
+// The table `name` of module T (RTreeTable, FleetTable, or ShadowTable for any); throws
+// SqlError naming `function` when there is none.
+template <class T>
+T& table_named(sqlite3* db, const Registry& registry, const char* name, const char* function) {
+  if (auto* typed = dynamic_cast<T*>(connected_table(db, registry, name, function))) return *typed;
+  throw SqlError{SQLITE_ERROR, format_sql("%s: %s is not a %s table", function, name, T::kModule)};
+}
+
+// The column arguments of CREATE VIRTUAL TABLE (argv[3..]), with blanks around them removed;
+// throws SqlError naming `module` for an empty one.
+std::vector<std::string> column_arguments(int argc, const char* const* argv, const char* module);
+
+// The registry as SQLite carries it (a module's or a function's client data): a heap copy of
+// the shared pointer, freed by free_registry_handle when SQLite drops the module or function.
+inline void* new_registry_handle(const std::shared_ptr<Registry>& r) {
+  return new std::shared_ptr<Registry>(r);
+}
+inline const std::shared_ptr<Registry>& registry_of(void* handle) {
+  return *static_cast<std::shared_ptr<Registry>*>(handle);
+}
+inline void free_registry_handle(void* handle) {
+  delete static_cast<std::shared_ptr<Registry>*>(handle);
+}
+
+// Transaction slots with nothing to do, for the modules' tables.
+inline int no_op_transaction(sqlite3_vtab*) {
+  return SQLITE_OK;
+}
+inline int no_op_savepoint(sqlite3_vtab*, int) {
+  return SQLITE_OK;
+}
+
+// The modules and functions of the extension, each registered on a connection.
+int register_rtree(sqlite3* db, const std::shared_ptr<Registry>& registry);
+int register_fleet(sqlite3* db, const std::shared_ptr<Registry>& registry);
+int register_nearest(sqlite3* db, const std::shared_ptr<Registry>& registry);
+int register_fleet_functions(sqlite3* db, const std::shared_ptr<Registry>& registry);
+
+}  // namespace loci::sqlite
