@@ -39,6 +39,8 @@ int register_all(sqlite3* db, char** err) {
     auto registry = std::make_shared<Registry>();
     int rc = register_rtree(db, registry);
     if (rc == SQLITE_OK) rc = register_nearest(db, registry);
+    if (rc == SQLITE_OK) rc = register_fleet(db, registry);
+    if (rc == SQLITE_OK) rc = register_fleet_functions(db, registry);
     if (rc == SQLITE_OK)
       rc = sqlite3_create_function_v2(db, "loci_check", 1, SQLITE_UTF8 | SQLITE_DIRECTONLY,
                                       new_registry_handle(registry), check_function, nullptr,

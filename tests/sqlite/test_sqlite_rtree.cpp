@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <map>
 #include <random>
 #include <set>
@@ -21,11 +20,11 @@
 #include "loci/io/layer_reader.hpp"
 #endif
 
-namespace fs = std::filesystem;
 using loci::Box;
 using loci::test::Db;
 using loci::test::real;
 using loci::test::Row;
+using loci::test::TempDir;
 
 namespace {
 
@@ -314,19 +313,6 @@ TEST(SqliteRtreeSql, RandomWritesFollowRollbackAndSavepoints) {
   EXPECT_EQ(all(db, "t"), all(db, "m"));
   EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
 }
-
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/loci-sqlite-XXXXXX";
-    path_ = ::mkdtemp(tmpl);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
 
 TEST(SqliteRtreeSql, SurvivesCloseAndReopen) {
   TempDir dir;
