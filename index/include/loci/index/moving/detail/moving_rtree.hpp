@@ -1,0 +1,881 @@
+// MovingRTree<D, M, Policy>: the machinery the TPR*-tree (tpr_tree.hpp) and the STAR-tree
+// (star_tree.hpp) share, an R-tree over moving points with time-parameterized bounds.
+//
+// Layout. Nodes live in detail::NodePool with up to M entries stored inline as
+// structure-of-arrays (each entry's bounds relative to the tree's epoch, its child, and in
+// leaves the object's report and id, so that queries read no other memory); parent links serve
+// condensing. Objects are in flat arrays by slot (id, report, leaf) and ids map to slots through
+// detail::IdMap, so an update finds its leaf at once.
+//
+// What the structures share: Choose_Path (best-first search for the path of least total cost
+// rise), Pick_Worst reinsertion and splits over the 4 D sort orders, deletion with condensing
+// and tightening, in-place updates, packing (build), and exact queries (vectorized timeslice
+// tests; windows over an interval and moving windows by linear constraints; nearest-n
+// best-first). What they do not share comes from the Policy: the name, the parameters, the
+// cost of a box (Policy::horizon and Policy::extent feed detail::swept_cost: the TPR* swept
+// area, or with both zero the area at the clock) and, for the STAR-tree, local regrouping.
+//
+// Time. Bounds are kept relative to the tree's epoch (the time of its first report), so that
+// epoch-second timestamps lose no precision. A node's bounds are tightened at the tree's
+// clock, the latest report time it has been given, and hold from then on; queries at or after
+// the clock prune with them. A query reaching back before the clock is answered exactly by
+// looking at every object (the bounds do not hold backwards).
+//
+// Thread-safety: const members may run concurrently with each other.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <queue>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "loci/index/broadphase/detail/proxy_table.hpp"
+#include "loci/index/detail/best_first.hpp"
+#include "loci/index/detail/node_pool.hpp"
+#include "loci/index/detail/str_partition.hpp"
+#include "loci/index/moving/detail/tpbr.hpp"
+#include "loci/index/moving/moving_index.hpp"
+
+namespace loci {
+
+namespace detail {
+
+template <int D, int M, class Policy>
+class MovingRTree {
+  static_assert(M >= 4 && M <= 63, "node entries are tracked in 64-bit masks");
+
+ public:
+  static constexpr int dimension = D;
+  static constexpr const char* kName = Policy::kName;
+  using Params = typename Policy::Params;
+  static constexpr int kMinFill = std::max(2, M * 2 / 5);
+
+  explicit MovingRTree(const Params& params = {}) : params_(params) { Policy::check(params); }
+
+  const Params& params() const { return params_; }
+
+  void insert(Id id, const Motion<D>& m) {
+    check_motion(m);
+    if (map_.find(id) != kNone)
+      throw InvalidArgument(std::string(kName) + ": id " + std::to_string(id) + " is already held");
+    add(id, m);
+  }
+
+  void update(Id id, const Motion<D>& m) {
+    check_motion(m);
+    const std::uint32_t s = map_.find(id);
+    if (s != kNone && params_.in_place_updates && update_in_place(s, m)) return;
+    if (s != kNone) remove_slot(s);
+    add(id, m);
+  }
+
+  bool erase(Id id) {
+    const std::uint32_t s = map_.find(id);
+    if (s == kNone) return false;
+    remove_slot(s);
+    return true;
+  }
+
+  void clear() { *this = MovingRTree(params_); }
+
+  // Replaces the contents with objects[i] named ids[i], packed bottom-up instead of inserted
+  // one by one (the rebuild-per-tick strategy of main-memory moving-object indexing): the
+  // objects are tiled into leaves of 3/4 capacity by position and velocity (below), and each
+  // level is packed from consecutive nodes of the one below, in tiling order. The
+  // tree's epoch and clock become the latest report time. Throws InvalidArgument for
+  // duplicate ids or lengths that differ, InvalidGeometry for a bad report.
+  void build(std::span<const Id> ids, std::span<const Motion<D>> objects) {
+    if (ids.size() != objects.size())
+      throw InvalidArgument(std::string(kName) + ": ids and reports differ in length");
+    if (objects.size() + 1 >= kNone)
+      throw InvalidArgument(std::string(kName) + ": too many objects");
+    MovingRTree fresh(params_);
+    if (objects.empty()) return void(*this = std::move(fresh));
+    double latest = -std::numeric_limits<double>::infinity();
+    for (const Motion<D>& m : objects) {
+      check_motion(m);
+      latest = std::max(latest, m.t);
+    }
+    fresh.epoch_ = fresh.clock_ = latest;
+    // Leaves are tiles of the 2 D-dimensional space of positions at mid-horizon and
+    // velocities scaled by half the horizon (how far a velocity difference spreads a node
+    // by then), cut by Sort-Tile-Recursive.
+    const double mid = latest + 0.5 * Policy::lookahead(params_);
+    const double spread = std::max(0.5 * Policy::lookahead(params_), 1e-9);
+    struct Keyed {
+      double key[2 * D];
+      std::uint32_t index;
+    };
+    std::vector<Keyed> keyed(objects.size());
+    for (std::uint32_t i = 0; i < objects.size(); ++i) {
+      const Point<D> p = position(objects[i], mid);
+      for (int a = 0; a < D; ++a) {
+        keyed[i].key[a] = p[a];
+        keyed[i].key[D + a] = objects[i].v[a] * spread;
+      }
+      keyed[i].index = i;
+    }
+    constexpr std::size_t kFill = std::max<std::size_t>(kMinFill, M * 3 / 4);
+    {
+      const std::size_t leaves = (objects.size() + kFill - 1) / kFill;
+      std::vector<std::size_t> groups(leaves + 1);
+      for (std::size_t g = 0; g <= leaves; ++g)
+        groups[g] = objects.size() * g / leaves;
+      detail::str_tile<2 * D>(keyed.data(), std::span<const std::size_t>(groups),
+                              [](const Keyed& k, int axis) { return k.key[axis]; });
+    }
+    const std::size_t n = objects.size();
+    fresh.obj_id_.resize(n);
+    fresh.obj_motion_.resize(n);
+    fresh.obj_leaf_.resize(n);
+    std::vector<Item> level(n);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t i = keyed[k].index;
+      if (fresh.map_.find(ids[i]) != kNone)
+        throw InvalidArgument(std::string(kName) + ": id " + std::to_string(ids[i]) +
+                              " is given twice");
+      fresh.map_.insert(ids[i], k, k + 1);
+      fresh.obj_id_[k] = ids[i];
+      fresh.obj_motion_[k] = objects[i];
+      const Box_ b = Box_::of(objects[i], fresh.epoch_);
+      for (int a = 0; a < D; ++a) {
+        fresh.mag_ = std::max(fresh.mag_, std::abs(b.lo[a]));
+        fresh.vmag_ = std::max(fresh.vmag_, std::abs(b.vlo[a]));
+      }
+      level[k] = {b, k, objects[i], ids[i]};
+    }
+    fresh.count_ = n;
+    // Pack each level into nodes of nearly equal counts, about 3/4 full.
+    for (int height = 0;; ++height) {
+      const std::size_t groups = (level.size() + kFill - 1) / kFill;
+      std::vector<Item> up(groups);
+      for (std::size_t g = 0; g < groups; ++g) {
+        const std::size_t from = level.size() * g / groups, to = level.size() * (g + 1) / groups;
+        const std::uint32_t node = fresh.nodes_.allocate(kName);
+        Node& nd = fresh.nodes_[node];
+        nd.parent = kNone;
+        nd.level = std::uint8_t(height);
+        nd.count = 0;
+        for (std::size_t e = from; e < to; ++e) {
+          put(nd, nd.count, level[e]);
+          fresh.adopt(node, nd.count++);
+        }
+        up[g] = {fresh.bound(nd), node, {}, 0};
+      }
+      if (groups == 1) {
+        fresh.root_ = up[0].child;
+        break;
+      }
+      level.swap(up);
+    }
+    *this = std::move(fresh);
+  }
+
+  bool contains(Id id) const { return map_.find(id) != kNone; }
+  std::size_t size() const { return count_; }
+  bool empty() const { return count_ == 0; }
+  double clock() const { return clock_; }
+  int height() const { return root_ == kNone ? 0 : nodes_[root_].level + 1; }
+  std::size_t memory_bytes() const {
+    return nodes_.memory_bytes() + obj_motion_.capacity() * (sizeof(Motion<D>) + 12);
+  }
+  // Nodes examined by the most expensive Choose_Path so far (the price of TPR* insertions).
+  std::size_t max_choose_path_nodes() const { return max_choose_nodes_; }
+
+  Motion<D> at(Id id) const {
+    const std::uint32_t s = map_.find(id);
+    if (s == kNone) throw InvalidArgument(std::string(kName) + ": no object " + std::to_string(id));
+    return obj_motion_[s];
+  }
+
+  template <MotionVisitor<D> F>
+  QueryStats query(const MovingWindow<D>& w, F&& visit) const {
+    check_window(w);
+    QueryStats st;
+    if (root_ == kNone) return st;
+    if (w.t1 < clock_) return scan(w, visit);
+    thread_local std::vector<std::uint32_t> stack;
+    stack.clear();
+    stack.push_back(root_);
+    // A timeslice compares each entry's box at the query time with the window: no divisions.
+    const bool slice = w.t1 == w.t2 && w.from == w.to;
+    const double r = w.t1 - epoch_;
+    Box<D> grown = w.from;
+    const double tol = tolerance(r);
+    for (int i = 0; i < D; ++i)
+      grown.min[i] -= tol, grown.max[i] += tol;
+    while (!stack.empty()) {
+      const Node& n = nodes_[stack.back()];
+      stack.pop_back();
+      ++st.nodes_visited;
+      st.entries_tested += n.count;
+      bool in[kSlots];
+      if (n.level == 0) {
+        if (slice)
+          positions_inside(n, w.from, w.t1, in);
+        else
+          for (int e = 0; e < n.count; ++e)
+            in[e] = inside(n.motion[e], w);
+        for (int e = 0; e < n.count; ++e) {
+          if (!in[e]) continue;
+          ++st.results;
+          if (!visit(n.id[e], n.motion[e])) return st;
+        }
+      } else {
+        if (slice)
+          boxes_meet(n, grown, r, in);
+        else
+          for (int e = 0; e < n.count; ++e)
+            in[e] = detail::tpbr_meets(n.box[e], epoch_, w);
+        for (int e = 0; e < n.count; ++e)
+          if (in[e]) stack.push_back(n.child[e]);
+      }
+    }
+    return st;
+  }
+  std::vector<Id> query(const MovingWindow<D>& w) const {
+    return collect_ids([&](auto&& v) { return query(w, v); });
+  }
+
+  template <MotionNearestVisitor<D> F>
+  QueryStats nearest(const Point<D>& q, double s, std::size_t k, F&& visit) const {
+    check_point(q, "nearest point");
+    check_coordinate(s, "nearest time");
+    if (root_ == kNone || k == 0) return {};
+    const double r = s - epoch_;
+    const bool prune = s >= clock_;
+    auto expand = [&](std::uint64_t ref, detail::BestFirstSink& sink) -> std::size_t {
+      const Node& n = nodes_[std::uint32_t(ref)];
+      double d2[M + 1];
+      if (n.level == 0) {
+        for (int e = 0; e < n.count; ++e)
+          d2[e] = squared_distance(position(n.motion[e], s), q);
+        sink.push_entries(
+            d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); },
+            [&](int e) { return n.id[e]; });
+      } else {
+        for (int e = 0; e < n.count; ++e)
+          d2[e] = prune ? detail::tpbr_distance2(n.box[e], r, q) : 0.0;
+        sink.push_subtrees(d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); });
+      }
+      return n.count;
+    };
+    return detail::best_first(root_, k, expand, [&](Id id, std::uint64_t ref, double d) {
+      return visit(id, obj_motion_[std::uint32_t(ref)], d);
+    });
+  }
+  std::vector<Neighbor> nearest(const Point<D>& q, double s, std::size_t k) const {
+    std::vector<Neighbor> out;
+    nearest(q, s, k, [&](Id id, const Motion<D>&, double d) {
+      return out.push_back({id, d}), true;
+    });
+    return out;
+  }
+
+  template <MotionVisitor<D> F>
+  void for_each(F&& visit) const {
+    for (std::uint32_t s = 0; s < obj_id_.size(); ++s)
+      if (obj_leaf_[s] != kNone && !visit(obj_id_[s], obj_motion_[s])) return;
+  }
+
+  void validate() const {
+    const std::string who(kName);
+    std::size_t objects = 0;
+    if (root_ != kNone) {
+      if (nodes_[root_].parent != kNone) throw Error(who + ": the root has a parent");
+      std::vector<bool> seen(nodes_.size(), false);
+      validate_node(root_, seen, objects);
+      if (!nodes_.validate_free(seen)) throw Error(who + ": a node is both in use and free");
+      for (std::uint32_t n = 0; n < nodes_.size(); ++n)
+        if (!seen[n]) throw Error(who + ": node " + std::to_string(n) + " is lost");
+    }
+    if (objects != count_) throw Error(who + ": the leaves hold a different number of objects");
+    std::size_t live = 0;
+    for (std::uint32_t s = 0; s < obj_id_.size(); ++s) {
+      if (obj_leaf_[s] == kNone) continue;
+      ++live;
+      if (map_.find(obj_id_[s]) != s)
+        throw Error(who + ": id " + std::to_string(obj_id_[s]) + " does not map to its slot");
+    }
+    if (live != count_) throw Error(who + ": object table and count disagree");
+  }
+
+ private:
+  using Box_ = detail::Tpbr<D>;
+  static constexpr int kSlots = M + 1;  // one spare entry while overflowing
+
+  // A node's entry boxes as structure-of-arrays, so that the tests of all entries of a node
+  // run as one vectorized loop; box[e] reads (and, on a mutable node, writes) one entry.
+  struct BoxArray {
+    double lo[D][kSlots], hi[D][kSlots], vlo[D][kSlots], vhi[D][kSlots];
+
+    Box_ get(int e) const {
+      Box_ b;
+      for (int i = 0; i < D; ++i)
+        b.lo[i] = lo[i][e], b.hi[i] = hi[i][e], b.vlo[i] = vlo[i][e], b.vhi[i] = vhi[i][e];
+      return b;
+    }
+    void set(int e, const Box_& b) {
+      for (int i = 0; i < D; ++i)
+        lo[i][e] = b.lo[i], hi[i][e] = b.hi[i], vlo[i][e] = b.vlo[i], vhi[i][e] = b.vhi[i];
+    }
+    struct Ref {
+      BoxArray& a;
+      int e;
+      operator Box_() const { return a.get(e); }
+      Ref& operator=(const Box_& b) {
+        a.set(e, b);
+        return *this;
+      }
+      void enclose(const Box_& b, double c) {
+        Box_ x = a.get(e);
+        x.enclose(b, c);
+        a.set(e, x);
+      }
+    };
+    Box_ operator[](int e) const { return get(e); }
+    Ref operator[](int e) { return {*this, e}; }
+  };
+  // The reports of a leaf's objects, likewise.
+  struct MotionArray {
+    double t[kSlots], p[D][kSlots], v[D][kSlots];
+
+    Motion<D> operator[](int e) const {
+      Motion<D> m;
+      m.t = t[e];
+      for (int i = 0; i < D; ++i)
+        m.p[i] = p[i][e], m.v[i] = v[i][e];
+      return m;
+    }
+    void set(int e, const Motion<D>& m) {
+      t[e] = m.t;
+      for (int i = 0; i < D; ++i)
+        p[i][e] = m.p[i], v[i][e] = m.v[i];
+    }
+  };
+
+  struct Node {
+    std::uint32_t parent = kNone;  // also the free-list link
+    std::uint8_t level = 0;        // 0: leaf (children are object slots)
+    std::uint8_t count = 0;
+    BoxArray box;
+    std::uint32_t child[kSlots];
+    // Leaves also keep each object's report and id, so that queries read no other memory.
+    MotionArray motion;
+    Id id[kSlots];
+  };
+  // An entry on its way from one node to another.
+  struct Item {
+    detail::Tpbr<D> box;
+    std::uint32_t child;
+    Motion<D> motion;
+    Id id;
+  };
+  static Item take(const Node& n, int e) { return {n.box[e], n.child[e], n.motion[e], n.id[e]}; }
+  static void put(Node& n, int e, const Item& it) {
+    n.box.set(e, it.box);
+    n.child[e] = it.child;
+    n.motion.set(e, it.motion);
+    n.id[e] = it.id;
+  }
+  using Pool = detail::NodePool<Node, &Node::parent>;
+
+  double rel_clock() const { return clock_ - epoch_; }
+  // The rounding allowance of box tests at relative time r: a bound rounded a few times at
+  // magnitudes up to mag_ + vmag_ (|r| + |clock|) is off by far less (tpbr.hpp).
+  double tolerance(double r) const {
+    return 1e-12 * (4 * mag_ + 4 * vmag_ * (std::abs(r) + std::abs(rel_clock()))) + 1e-300;
+  }
+
+  // Vectorized timeslice tests of all entries of a node. in[e]: the entry's box at relative
+  // time r meets `grown` (the window grown by the tolerance).
+  static void boxes_meet(const Node& n, const Box<D>& grown, double r, bool* in) {
+    const BoxArray& b = n.box;
+    for (int e = 0; e < n.count; ++e) {
+      bool ok = true;
+      for (int i = 0; i < D; ++i)
+        ok &= (b.lo[i][e] + b.vlo[i][e] * r <= grown.max[i]) &
+              (b.hi[i][e] + b.vhi[i][e] * r >= grown.min[i]);
+      in[e] = ok;
+    }
+  }
+  // in[e]: the object's position at time s lies in the window; the arithmetic of inside().
+  static void positions_inside(const Node& n, const Box<D>& w, double s, bool* in) {
+    const MotionArray& m = n.motion;
+    for (int e = 0; e < n.count; ++e) {
+      const double dt = s - m.t[e];
+      bool ok = true;
+      for (int i = 0; i < D; ++i) {
+        const double x = m.p[i][e] + m.v[i][e] * dt;
+        ok &= (x >= w.min[i]) & (x <= w.max[i]);
+      }
+      in[e] = ok;
+    }
+  }
+
+  // pen[e]: the rise of the TPR* cost of entry e's box when it takes b (0 when it holds b),
+  // for all entries of a node in one vectorized loop; the arithmetic of detail::swept_cost.
+  void enlargements(const Node& n, const Box_& b, double* pen) const {
+    const double c = rel_clock(), h = Policy::horizon(params_);
+    const Point<D> extent = Policy::extent(params_);
+    const BoxArray& a = n.box;
+    double bl[D], bh[D];
+    for (int i = 0; i < D; ++i)
+      bl[i] = b.lo_at(i, c), bh[i] = b.hi_at(i, c);
+    for (int e = 0; e < n.count; ++e) {
+      double e1[D], e2[D], sp[D], g1[D], g2[D], gs[D];
+      for (int i = 0; i < D; ++i) {
+        const double l = a.lo[i][e] + a.vlo[i][e] * c, u = a.hi[i][e] + a.vhi[i][e] * c;
+        const double vl = a.vlo[i][e], vh = a.vhi[i][e];
+        e1[i] = u - l + extent[i];
+        e2[i] = e1[i] + (vh - vl) * h;
+        sp[i] = vl > 0 ? vh : vh < 0 ? -vl : vh - vl;
+        const double gl = std::min(l, bl[i]), gu = std::max(u, bh[i]);
+        const double gvl = std::min(vl, b.vlo[i]), gvh = std::max(vh, b.vhi[i]);
+        g1[i] = gu - gl + extent[i];
+        g2[i] = g1[i] + (gvh - gvl) * h;
+        gs[i] = gvl > 0 ? gvh : gvh < 0 ? -gvl : gvh - gvl;
+      }
+      double before = 1, after = 1;
+      for (int i = 0; i < D; ++i)
+        before *= e1[i], after *= g1[i];
+      for (int i = 0; i < D; ++i) {
+        double up = 1, down = 1, gup = 1, gdown = 1;
+        for (int j = 0; j < D; ++j)
+          if (j != i) up *= e1[j], down *= e2[j], gup *= g1[j], gdown *= g2[j];
+        before += 0.5 * (up + down) * sp[i] * h;
+        after += 0.5 * (gup + gdown) * gs[i] * h;
+      }
+      pen[e] = std::max(0.0, after - before);
+    }
+  }
+  double cost(const Box_& b) const {
+    return detail::swept_cost(b, rel_clock(), Policy::horizon(params_), Policy::extent(params_));
+  }
+  Box_ bound(const Node& n) const {
+    Box_ b = n.box[0];
+    for (int e = 1; e < n.count; ++e)
+      b.enclose(n.box[e], rel_clock());
+    return b;
+  }
+
+  // Where entry e of node n records its place: an object's leaf, a child node's parent.
+  void adopt(std::uint32_t n, int e) {
+    Node& node = nodes_[n];
+    if (node.level == 0)
+      obj_leaf_[node.child[e]] = n;
+    else
+      nodes_[node.child[e]].parent = n;
+  }
+  int slot_in_parent(std::uint32_t n) const {
+    const Node& p = nodes_[nodes_[n].parent];
+    for (int e = 0; e < p.count; ++e)
+      if (p.child[e] == n) return e;
+    throw Error(std::string(kName) + ": a node is missing from its parent");
+  }
+
+  void add(Id id, const Motion<D>& m) {
+    if (count_ == 0 && root_ == kNone) epoch_ = m.t;
+    clock_ = std::max(clock_, m.t);
+    std::uint32_t s;
+    if (!free_slots_.empty()) {
+      s = free_slots_.back();
+      free_slots_.pop_back();
+    } else {
+      if (obj_id_.size() + 1 >= kNone)
+        throw InvalidArgument(std::string(kName) + ": too many objects");
+      s = std::uint32_t(obj_id_.size());
+      obj_id_.push_back(0);
+      obj_motion_.push_back({});
+      obj_leaf_.push_back(kNone);
+    }
+    obj_id_[s] = id;
+    obj_motion_[s] = m;
+    map_.insert(id, s, count_ + 1);
+    ++count_;
+    if (root_ == kNone) {
+      root_ = nodes_.allocate(kName);
+      Node& r = nodes_[root_];
+      r.parent = kNone;
+      r.level = 0;
+      r.count = 0;
+    }
+    const Box_ b = Box_::of(m, epoch_);
+    for (int i = 0; i < D; ++i) {
+      mag_ = std::max(mag_, std::abs(b.lo[i]));
+      vmag_ = std::max(vmag_, std::abs(b.vlo[i]));
+    }
+    std::uint32_t reinserted = 0;
+    insert_entry({b, s, m, id}, 0, reinserted);
+  }
+
+  // Choose_Path: the node of `level` whose taking `b` raises the summed cost of the path to
+  // it least. Partial paths wait in a heap by their cost so far; the children of a node just
+  // above the target level are candidates, compared with the best found (minpen), and the
+  // search ends when no waiting path is cheaper than it.
+  std::uint32_t choose_path(const Box_& b, int level) {
+    if (nodes_[root_].level == level) return root_;
+    struct Waiting {
+      double key;
+      std::uint32_t node;
+      bool operator<(const Waiting& o) const { return key > o.key; }
+    };
+    thread_local std::vector<Waiting> heap;
+    heap.clear();
+    heap.push_back({0, root_});
+    std::size_t explored = 0;
+    double minpen = std::numeric_limits<double>::infinity();
+    std::uint32_t best = kNone;
+    while (!heap.empty()) {
+      std::pop_heap(heap.begin(), heap.end());
+      const Waiting top = heap.back();
+      heap.pop_back();
+      if (!(top.key < minpen)) break;
+      const Node& n = nodes_[top.node];
+      ++explored;
+      const bool last = n.level == level + 1;
+      double rise[kSlots];
+      enlargements(n, b, rise);
+      for (int e = 0; e < n.count; ++e) {
+        const double pen = top.key + rise[e];
+        if (!(pen < minpen)) continue;
+        if (last) {
+          minpen = pen;
+          best = n.child[e];
+        } else {
+          heap.push_back({pen, n.child[e]});
+          std::push_heap(heap.begin(), heap.end());
+        }
+      }
+    }
+    max_choose_nodes_ = std::max(max_choose_nodes_, explored);
+    if (best == kNone)
+      throw Error(std::string(kName) + ": no node of level " + std::to_string(level) + " found");
+    return best;
+  }
+
+  // Inserts the entry (b, child) into a node of `level`, handling overflow.
+  void insert_entry(const Item& it, int level, std::uint32_t& reinserted) {
+    const Box_& b = it.box;
+    const std::uint32_t n = choose_path(b, level);
+    Node& node = nodes_[n];
+    put(node, node.count, it);
+    ++node.count;
+    adopt(n, node.count - 1);
+    // Grow the path's bounds.
+    const double c = rel_clock();
+    for (std::uint32_t x = n; nodes_[x].parent != kNone; x = nodes_[x].parent)
+      nodes_[nodes_[x].parent].box[slot_in_parent(x)].enclose(b, c);
+    if (node.count > M) overflow(n, reinserted);
+  }
+
+  void overflow(std::uint32_t n, std::uint32_t& reinserted) {
+    const int level = nodes_[n].level;
+    if (n != root_ && !(reinserted & (1u << level))) {
+      reinserted |= 1u << level;
+      pick_worst(n, reinserted);
+    } else {
+      split(n, reinserted);
+    }
+  }
+
+  // Sort key k of entry b: k / D picks lo at now, hi at now, vlo, vhi; k % D the axis.
+  // Sort key k of entry e: k / D picks lo at the clock, hi at the clock, vlo, vhi; k % D the
+  // axis.
+  double key(const Node& node, int e, int k) const {
+    const int axis = k % D, what = k / D;
+    const BoxArray& a = node.box;
+    switch (what) {
+      case 0:
+        return a.lo[axis][e] + a.vlo[axis][e] * rel_clock();
+      case 1:
+        return a.hi[axis][e] + a.vhi[axis][e] * rel_clock();
+      case 2:
+        return a.vlo[axis][e];
+      default:
+        return a.vhi[axis][e];
+    }
+  }
+
+  void order_by(const Node& node, int k, bool descending, std::uint8_t* order) const {
+    double keys[kSlots];
+    for (int e = 0; e < node.count; ++e) {
+      order[e] = std::uint8_t(e);
+      keys[e] = descending ? -key(node, e, k) : key(node, e, k);
+    }
+    std::sort(order, order + node.count, [&](int x, int y) { return keys[x] < keys[y]; });
+  }
+
+  Box_ union_of(const Node& node, const std::uint8_t* order, int from, int to) const {
+    Box_ b = node.box[order[from]];
+    for (int e = from + 1; e < to; ++e)
+      b.enclose(node.box[order[e]], rel_clock());
+    return b;
+  }
+
+  // Pick_Worst: removes the entries whose absence shrinks the node's cost most and reinserts
+  // them.
+  void pick_worst(std::uint32_t n, std::uint32_t& reinserted) {
+    Node& node = nodes_[n];
+    const int total = node.count;
+    const int taken = std::max(1, int(0.3 * total));
+    std::uint8_t order[M + 1], best_order[M + 1];
+    double best_gain = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 4 * D; ++k)
+      for (bool descending : {true, false}) {
+        order_by(node, k, descending, order);
+        const double rest = cost(union_of(node, order, taken, total));
+        const double gain = -rest;
+        if (gain > best_gain) {
+          best_gain = gain;
+          std::copy(order, order + total, best_order);
+        }
+      }
+    // Take the chosen entries out, keep the rest in place.
+    Item out[M + 1];
+    bool leaving[M + 1] = {};
+    for (int e = 0; e < taken; ++e) {
+      leaving[best_order[e]] = true;
+      out[e] = take(node, best_order[e]);
+    }
+    int kept = 0;
+    for (int e = 0; e < total; ++e)
+      if (!leaving[e]) put(node, kept++, take(node, e));
+    node.count = std::uint8_t(kept);
+    const int level = node.level;
+    tighten_upwards(n);
+    for (int e = 0; e < taken; ++e)
+      insert_entry(out[e], level, reinserted);
+  }
+
+  // Recomputes the bounds of n and its ancestors from their entries at the clock.
+  void tighten_upwards(std::uint32_t n) {
+    for (std::uint32_t x = n; nodes_[x].parent != kNone; x = nodes_[x].parent)
+      nodes_[nodes_[x].parent].box[slot_in_parent(x)] = bound(nodes_[x]);
+  }
+
+  void split(std::uint32_t n, std::uint32_t& reinserted) {
+    Node& node = nodes_[n];
+    const int total = node.count;
+    std::uint8_t order[M + 1], best_order[M + 1];
+    int best_cut = 0;
+    double best = std::numeric_limits<double>::infinity();
+    Box_ prefix[M + 1], suffix[M + 1];
+    for (int k = 0; k < 4 * D; ++k) {
+      order_by(node, k, false, order);
+      prefix[0] = node.box[order[0]];
+      for (int e = 1; e < total; ++e)
+        (prefix[e] = prefix[e - 1]).enclose(node.box[order[e]], rel_clock());
+      suffix[total - 1] = node.box[order[total - 1]];
+      for (int e = total - 2; e >= 0; --e)
+        (suffix[e] = suffix[e + 1]).enclose(node.box[order[e]], rel_clock());
+      for (int cut = kMinFill; cut <= total - kMinFill; ++cut) {
+        const double c = cost(prefix[cut - 1]) + cost(suffix[cut]);
+        if (c < best) {
+          best = c;
+          best_cut = cut;
+          std::copy(order, order + total, best_order);
+        }
+      }
+    }
+    const std::uint32_t sib = nodes_.allocate(kName);
+    Node& a = nodes_[n];  // allocation may have moved the pool
+    Node& b = nodes_[sib];
+    b.level = a.level;
+    b.count = 0;
+    Item items[M + 1];
+    for (int e = 0; e < total; ++e)
+      items[e] = take(a, best_order[e]);
+    a.count = 0;
+    for (int e = 0; e < total; ++e) {
+      Node& to = e < best_cut ? a : b;
+      put(to, to.count++, items[e]);
+    }
+    for (int e = 0; e < b.count; ++e)
+      adopt(sib, e);
+    if (n == root_) {
+      const std::uint32_t r = nodes_.allocate(kName);
+      Node& root = nodes_[r];
+      root.parent = kNone;
+      root.level = std::uint8_t(nodes_[n].level + 1);
+      root.count = 2;
+      root.box[0] = bound(nodes_[n]);
+      root.child[0] = n;
+      root.box[1] = bound(nodes_[sib]);
+      root.child[1] = sib;
+      nodes_[n].parent = r;
+      nodes_[sib].parent = r;
+      root_ = r;
+      return;
+    }
+    const std::uint32_t p = nodes_[n].parent;
+    nodes_[p].box[slot_in_parent(n)] = bound(nodes_[n]);
+    Node& parent = nodes_[p];
+    parent.box[parent.count] = bound(nodes_[sib]);
+    parent.child[parent.count] = sib;
+    ++parent.count;
+    nodes_[sib].parent = p;
+    tighten_upwards(p);
+    if (parent.count > M) overflow(p, reinserted);
+  }
+
+  void remove_slot(std::uint32_t s) {
+    const std::uint32_t leaf = obj_leaf_[s];
+    Node& node = nodes_[leaf];
+    int e = 0;
+    while (node.child[e] != s)
+      ++e;
+    put(node, e, take(node, node.count - 1));
+    --node.count;
+    map_.erase(obj_id_[s]);
+    obj_leaf_[s] = kNone;
+    free_slots_.push_back(s);
+    --count_;
+    condense(leaf);
+  }
+
+  // Writes the new report over the old one when the leaf's bounds, as its parent records
+  // them, hold it from the clock on (compared without slack); the leaf's bounds are then
+  // recomputed, which can only shrink them. False when it does not fit.
+  bool update_in_place(std::uint32_t s, const Motion<D>& m) {
+    const std::uint32_t leaf = obj_leaf_[s];
+    const double clock = std::max(clock_, m.t), c = clock - epoch_;
+    const Box_ b = Box_::of(m, epoch_);
+    const bool root = nodes_[leaf].parent == kNone;
+    int slot = 0;
+    if (!root) {
+      slot = slot_in_parent(leaf);
+      const Box_& bound = nodes_[nodes_[leaf].parent].box[slot];
+      for (int i = 0; i < D; ++i)
+        if (bound.vlo[i] > b.vlo[i] || bound.vhi[i] < b.vhi[i] ||
+            bound.lo_at(i, c) > b.lo_at(i, c) || bound.hi_at(i, c) < b.hi_at(i, c))
+          return false;
+    }
+    clock_ = clock;
+    for (int i = 0; i < D; ++i) {
+      mag_ = std::max(mag_, std::abs(b.lo[i]));
+      vmag_ = std::max(vmag_, std::abs(b.vlo[i]));
+    }
+    Node& node = nodes_[leaf];
+    int e = 0;
+    while (node.child[e] != s)
+      ++e;
+    put(node, e, {b, s, m, node.id[e]});
+    obj_motion_[s] = m;
+    if (!root) nodes_[node.parent].box[slot] = bound(node);
+    return true;
+  }
+
+  // Dissolves underfull nodes from n up, tightens the rest of the path, reinserts orphans.
+  void condense(std::uint32_t n) {
+    struct Orphan {
+      Item item;
+      int level;
+    };
+    thread_local std::vector<Orphan> orphans;
+    orphans.clear();
+    std::uint32_t x = n;
+    while (x != root_) {
+      const std::uint32_t p = nodes_[x].parent;
+      Node& node = nodes_[x];
+      const int e = slot_in_parent(x);
+      if (node.count < kMinFill) {
+        for (int i = 0; i < node.count; ++i)
+          orphans.push_back({take(node, i), node.level});
+        Node& parent = nodes_[p];
+        put(parent, e, take(parent, parent.count - 1));
+        --parent.count;
+        nodes_.release(x);
+      } else {
+        nodes_[p].box[e] = bound(node);
+      }
+      x = p;
+    }
+    // Higher levels first, so that their subtrees find a level to go to.
+    std::sort(orphans.begin(), orphans.end(),
+              [](const Orphan& a, const Orphan& b) { return a.level > b.level; });
+    for (const Orphan& o : orphans) {
+      std::uint32_t reinserted = 0;
+      insert_entry(o.item, o.level, reinserted);
+    }
+    // A root with one child hands over to it; an empty leaf root goes.
+    while (nodes_[root_].level > 0 && nodes_[root_].count == 1) {
+      const std::uint32_t old = root_;
+      root_ = nodes_[old].child[0];
+      nodes_[root_].parent = kNone;
+      nodes_.release(old);
+    }
+    if (count_ == 0) {
+      nodes_.clear();
+      root_ = kNone;
+    }
+  }
+
+  template <class F>
+  QueryStats scan(const MovingWindow<D>& w, F& visit) const {
+    QueryStats st;
+    st.nodes_visited = 1;
+    for (std::uint32_t s = 0; s < obj_id_.size(); ++s) {
+      if (obj_leaf_[s] == kNone) continue;
+      ++st.entries_tested;
+      if (!inside(obj_motion_[s], w)) continue;
+      ++st.results;
+      if (!visit(obj_id_[s], obj_motion_[s])) break;
+    }
+    return st;
+  }
+
+  void validate_node(std::uint32_t n, std::vector<bool>& seen, std::size_t& objects) const {
+    const std::string who(kName);
+    if (seen[n]) throw Error(who + ": node " + std::to_string(n) + " is reachable twice");
+    seen[n] = true;
+    const Node& node = nodes_[n];
+    if (node.count > M) throw Error(who + ": node over capacity");
+    if (n != root_ && node.count < kMinFill) throw Error(who + ": node under the minimum fill");
+    if (n == root_ && node.level > 0 && node.count < 2) throw Error(who + ": root with one child");
+    const double c = rel_clock();
+    if (n != root_) {
+      const Box_& mine = nodes_[node.parent].box[slot_in_parent(n)];
+      for (int e = 0; e < node.count; ++e)
+        if (!mine.encloses(node.box[e], c))
+          throw Error(who + ": an entry of node " + std::to_string(n) + " escapes its bound");
+    }
+    for (int e = 0; e < node.count; ++e) {
+      if (node.level == 0) {
+        const std::uint32_t s = node.child[e];
+        if (s >= obj_id_.size() || obj_leaf_[s] != n)
+          throw Error(who + ": an object does not point back to its leaf");
+        if (!node.box[e].encloses(Box_::of(obj_motion_[s], epoch_), c))
+          throw Error(who + ": an object's entry does not hold its report");
+        ++objects;
+      } else {
+        const std::uint32_t ch = node.child[e];
+        if (nodes_[ch].parent != n) throw Error(who + ": a child does not point to its parent");
+        if (nodes_[ch].level + 1 != node.level) throw Error(who + ": levels are inconsistent");
+        validate_node(ch, seen, objects);
+      }
+    }
+  }
+
+  Params params_;
+  Pool nodes_;
+  std::uint32_t root_ = kNone;
+  std::vector<Id> obj_id_;
+  std::vector<Motion<D>> obj_motion_;
+  std::vector<std::uint32_t> obj_leaf_;  // kNone: a free slot
+  std::vector<std::uint32_t> free_slots_;
+  detail::IdMap map_;
+  std::size_t count_ = 0;
+  double epoch_ = 0;
+  double clock_ = -std::numeric_limits<double>::infinity();
+  std::size_t max_choose_nodes_ = 0;
+  double mag_ = 0;   // largest |coordinate| of an object's entry at the epoch
+  double vmag_ = 0;  // largest |velocity| component
+};
+
+}  // namespace detail
+}  // namespace loci
