@@ -7,7 +7,13 @@
 //            each query its own statement in autocommit, then all inside one read transaction
 //   nearest  10,000 nearest-10 queries: loci_nearest vs SpatiaLite's KNN (mod_spatialite; the
 //            VirtualKNN of Debian's SpatiaLite 5.0), distances compared
+//   fleet    100,000 reports (10,000 objects x 10, epoch-second times) inserted into a loci_fleet
+//            table in one transaction, and into a plain WITHOUT ROWID table of reports; windows
+//            of about 100 objects at a time after the latest report and at a time before it,
+//            through loci_fleet_window vs the same question as SQL over the plain table (the
+//            report in force per id, positions computed in the query); loci_conflicts
 // Medians of --repeat runs. Usage: bench_sqlite [--rows N] [--queries N] [--repeat N] [--no-knn]
+//                                               [--fleet-only | --no-fleet]
 #include <sqlite3.h>
 
 #include <algorithm>
@@ -21,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "loci/geom/motion.hpp"
 #include "loci/index/packed_rtree.hpp"
 #include "loci/io/layer_reader.hpp"
 
@@ -34,6 +41,8 @@ struct Options {
   std::size_t queries = 10000;
   int repeat = 3;
   bool knn = true;
+  bool boxes = true;
+  bool fleet = true;
 };
 
 [[noreturn]] void die(const std::string& what) {
@@ -126,6 +135,153 @@ double run_nearest(sqlite3* db, const std::string& sql, const std::vector<loci::
   return t;
 }
 
+// Runs each window at its time through `sql` (?1..?4 the window, ?5 the time), collecting the
+// ids; returns the seconds taken.
+double run_fleet_windows(sqlite3* db, const std::string& sql, const std::vector<Box2>& windows,
+                         const std::vector<double>& times,
+                         std::vector<std::vector<sqlite3_int64>>& out) {
+  sqlite3_stmt* s = prepare(db, sql);
+  out.assign(windows.size(), {});
+  const auto t0 = Clock::now();
+  for (std::size_t q = 0; q < windows.size(); ++q) {
+    sqlite3_bind_double(s, 1, windows[q].min[0]);
+    sqlite3_bind_double(s, 2, windows[q].min[1]);
+    sqlite3_bind_double(s, 3, windows[q].max[0]);
+    sqlite3_bind_double(s, 4, windows[q].max[1]);
+    sqlite3_bind_double(s, 5, times[q]);
+    while (sqlite3_step(s) == SQLITE_ROW)
+      out[q].push_back(sqlite3_column_int64(s, 0));
+    sqlite3_reset(s);
+    std::sort(out[q].begin(), out[q].end());
+  }
+  const double t = seconds(t0, Clock::now());
+  sqlite3_finalize(s);
+  return t;
+}
+
+void bench_fleet(const std::string& dir, const Options& o) {
+  constexpr std::size_t kObjects = 10000, kPer = 10;
+  constexpr double kT0 = 1.7e9, kSide = 100000;  // metres; 600 s of reports
+  std::mt19937_64 rng(43);
+  std::uniform_real_distribution<double> pos(0, kSide), vel(-12, 12), jitter(0, 60);
+  struct Report {
+    sqlite3_int64 id;
+    loci::Motion2 m;
+  };
+  std::vector<Report> reports;
+  for (std::size_t k = 0; k < kPer; ++k)  // in time order, as a feed delivers them
+    for (std::size_t i = 0; i < kObjects; ++i)
+      reports.push_back({sqlite3_int64(i + 1), loci::Motion2{kT0 + 60.0 * double(k) + jitter(rng),
+                                                             {{pos(rng), pos(rng)}},
+                                                             {{vel(rng), vel(rng)}}}});
+  double last = 0;
+  for (const Report& r : reports)
+    last = std::max(last, r.m.t);
+  sqlite3* db = open_db(dir + "/fleet.db");
+  load(db, LOCI_SQLITE_EXTENSION);
+  const auto fill = [&](const char* table) {
+    exec(db, "BEGIN");
+    sqlite3_stmt* s =
+        prepare(db, std::string("INSERT INTO ") + table + " VALUES(?, ?, ?, ?, ?, ?)");
+    for (const Report& r : reports) {
+      sqlite3_bind_int64(s, 1, r.id);
+      sqlite3_bind_double(s, 2, r.m.t);
+      sqlite3_bind_double(s, 3, r.m.p[0]);
+      sqlite3_bind_double(s, 4, r.m.p[1]);
+      sqlite3_bind_double(s, 5, r.m.v[0]);
+      sqlite3_bind_double(s, 6, r.m.v[1]);
+      if (sqlite3_step(s) != SQLITE_DONE) die(std::string("insert: ") + sqlite3_errmsg(db));
+      sqlite3_reset(s);
+    }
+    sqlite3_finalize(s);
+    exec(db, "COMMIT");
+  };
+  std::vector<double> insert_fleet, insert_plain;
+  for (int r = 0; r < o.repeat; ++r) {
+    exec(db, "DROP TABLE IF EXISTS f; DROP TABLE IF EXISTS p;");
+    exec(db, "CREATE VIRTUAL TABLE f USING loci_fleet(id, t, x, y, vx, vy)");
+    exec(db,
+         "CREATE TABLE p(id INTEGER, t REAL, x REAL, y REAL, vx REAL, vy REAL, PRIMARY KEY(id, "
+         "t)) WITHOUT ROWID");
+    auto t0 = Clock::now();
+    fill("f");
+    insert_fleet.push_back(seconds(t0, Clock::now()));
+    t0 = Clock::now();
+    fill("p");
+    insert_plain.push_back(seconds(t0, Clock::now()));
+  }
+  const double fi = median(insert_fleet), pi = median(insert_plain);
+  std::printf("\nfleet: %zu reports of %zu objects, epoch-second times over %.0f s\n",
+              reports.size(), kObjects, last - kT0);
+  std::printf(
+      "  insert, one transaction: loci_fleet %.3f s (%.0f reports/s), plain table %.3f s, "
+      "ratio %.2fx\n",
+      fi, double(reports.size()) / fi, pi, pi / fi);
+
+  // Windows of about 100 objects (10,000 in a square of side kSide: side kSide / 10).
+  const std::string loci_sql = "SELECT id FROM loci_fleet_window('f', ?1, ?2, ?3, ?4, ?5)";
+  const std::string plain_sql =
+      "SELECT id FROM (SELECT id, x + vx * (?5 - t) AS px, y + vy * (?5 - t) AS py FROM p a "
+      "WHERE t = (SELECT max(t) FROM p WHERE id = a.id AND t <= ?5)) WHERE px >= ?1 AND px <= ?3 "
+      "AND py >= ?2 AND py <= ?4";
+  std::uniform_real_distribution<double> corner(0, kSide * 0.9);
+  for (const auto& [label, at] :
+       {std::pair<const char*, double>{"after the latest report", last + 30},
+        {"before it (from the history)", last - 200}}) {
+    std::vector<Box2> windows(o.queries);
+    for (auto& w : windows) {
+      const double x = corner(rng), y = corner(rng);
+      w = {{{x, y}}, {{x + kSide / 10, y + kSide / 10}}};
+    }
+    const std::vector<double> times(windows.size(), at);
+    // The plain scan reads every report per query: a few suffice for its rate.
+    const std::size_t few = std::min<std::size_t>(windows.size(), 20);
+    const std::vector<Box2> some(windows.begin(), windows.begin() + std::ptrdiff_t(few));
+    const std::vector<double> some_times(times.begin(), times.begin() + std::ptrdiff_t(few));
+    std::vector<std::vector<sqlite3_int64>> got, plain;
+    std::vector<double> tl, tp;
+    const std::size_t loci_queries = at > last ? windows.size() : few;
+    const std::vector<Box2> mine(windows.begin(), windows.begin() + std::ptrdiff_t(loci_queries));
+    const std::vector<double> mine_times(times.begin(),
+                                         times.begin() + std::ptrdiff_t(loci_queries));
+    for (int r = 0; r < o.repeat; ++r) {
+      tl.push_back(run_fleet_windows(db, loci_sql, mine, mine_times, got) / double(mine.size()));
+      tp.push_back(run_fleet_windows(db, plain_sql, some, some_times, plain) / double(few));
+    }
+    std::size_t hits = 0, differ = 0;
+    for (std::size_t q = 0; q < few; ++q)
+      differ += got[q] != plain[q];
+    for (const auto& g : got)
+      hits += g.size();
+    const double ql = median(tl), qp = median(tp);
+    std::printf("  windows at a time %s, %.0f objects each on average:\n", label,
+                double(hits) / double(got.size()));
+    std::printf(
+        "    loci_fleet_window %9.0f queries/s (%zu queries)\n    plain SQL scan    %9.1f "
+        "queries/s (%zu queries)\n    ratio             %9.1fx   answers identical: %s\n",
+        1 / ql, mine.size(), 1 / qp, few, qp / ql,
+        differ == 0 ? "yes" : ("NO, " + std::to_string(differ) + " differ").c_str());
+  }
+
+  // Conflicts over the next 5 minutes within 200 m, and within 1 km.
+  for (const double d : {200.0, 1000.0}) {
+    std::vector<double> tc;
+    std::string pairs;
+    for (int r = 0; r < o.repeat; ++r) {
+      const auto t0 = Clock::now();
+      sqlite3_stmt* s =
+          prepare(db, "SELECT count(*) FROM loci_conflicts('f', " + std::to_string(d) + ", 300)");
+      if (sqlite3_step(s) != SQLITE_ROW) die(sqlite3_errmsg(db));
+      pairs = reinterpret_cast<const char*>(sqlite3_column_text(s, 0));
+      sqlite3_finalize(s);
+      tc.push_back(seconds(t0, Clock::now()));
+    }
+    std::printf("  loci_conflicts('f', %.0f, 300): %s pairs among %zu objects in %.3f s\n", d,
+                pairs.c_str(), kObjects, median(tc));
+  }
+  sqlite3_close(db);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -141,8 +297,22 @@ int main(int argc, char** argv) {
       o.repeat = int(std::max(1ull, next()));
     else if (a == "--no-knn")
       o.knn = false;
+    else if (a == "--fleet-only")
+      o.boxes = false;
+    else if (a == "--no-fleet")
+      o.fleet = false;
     else
-      die("usage: bench_sqlite [--rows N] [--queries N] [--repeat N] [--no-knn]");
+      die("usage: bench_sqlite [--rows N] [--queries N] [--repeat N] [--no-knn] "
+          "[--fleet-only | --no-fleet]");
+  }
+  if (!o.boxes) {
+    const std::string dir = std::filesystem::temp_directory_path() / "loci-bench-sqlite";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::printf("bench_sqlite: SQLite %s\n", sqlite3_libversion());
+    bench_fleet(dir, o);
+    std::filesystem::remove_all(dir);
+    return 0;
   }
 
   const std::string layer =
@@ -340,6 +510,7 @@ int main(int argc, char** argv) {
     }
     sqlite3_close(sp);
   }
+  if (o.fleet) bench_fleet(dir, o);
   std::filesystem::remove_all(dir);
   return 0;
 }
