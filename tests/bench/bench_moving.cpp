@@ -34,6 +34,7 @@
 
 #include "loci/index/moving/conflicts.hpp"
 #include "loci/index/moving/moving_scan.hpp"
+#include "loci/index/moving/star_tree.hpp"
 #include "loci/index/moving/tpr_tree.hpp"
 
 namespace {
@@ -141,7 +142,8 @@ void run_objects(const Options& o) {
   paper.in_place_updates = false;
   loci::TprTree<2> tpr(paper), inplace(params), packed(params);
   loci::MovingScan<2> scan;
-  Timing t_tpr, t_inplace, t_packed, t_scan, t_sidx;
+  loci::StarTree<2> star;
+  Timing t_tpr, t_inplace, t_packed, t_scan, t_sidx, t_star;
   std::unique_ptr<SidxTpr> sidx;
   std::size_t sidx_wrong = 0, sidx_missing = 0, sidx_extra = 0, sidx_failed_deletes = 0;
 
@@ -157,6 +159,10 @@ void run_objects(const Options& o) {
   timed([&] {
     for (std::size_t i = 0; i < state.size(); ++i)
       inplace.insert(i, state[i]);
+  });
+  const double star_build = timed([&] {
+    for (std::size_t i = 0; i < state.size(); ++i)
+      star.insert(i, state[i]);
   });
   const double packed_build = timed([&] { packed.build(ids, state); });
   const double scan_build = timed([&] {
@@ -175,8 +181,10 @@ void run_objects(const Options& o) {
       "objects: %zu points in 1000 x 1000, %d ticks, %zu updates (new velocity) and %d windows "
       "(100 x 100, t in [now, now + 60]) per tick\n",
       o.objects, o.ticks, o.objects / 60, o.queries);
-  std::printf("  load: TPR*-tree inserted %.3f s (height %d), packed %.3f s, scan %.3f s",
-              tpr_build, tpr.height(), packed_build, scan_build);
+  std::printf(
+      "  load: TPR*-tree inserted %.3f s (height %d), STAR-tree %.3f s, packed %.3f s, scan %.3f "
+      "s",
+      tpr_build, tpr.height(), star_build, packed_build, scan_build);
   if (o.peer) std::printf(", libspatialindex TPR-tree %.3f s", sidx_build);
   std::printf("\n");
 
@@ -199,6 +207,10 @@ void run_objects(const Options& o) {
     t_inplace.update_s.push_back(timed([&] {
       for (const Report& r : batch)
         inplace.update(r.id, r.m);
+    }));
+    t_star.update_s.push_back(timed([&] {
+      for (const Report& r : batch)
+        star.update(r.id, r.m);
     }));
     t_scan.update_s.push_back(timed([&] {
       for (const Report& r : batch)
@@ -256,6 +268,7 @@ void run_objects(const Options& o) {
     check("TPR*-tree", tpr, t_tpr);
     check("TPR*-tree in place", inplace, t_inplace);
     check("packed", packed, t_packed);
+    check("STAR-tree", star, t_star);
     if (sidx) {
       std::vector<std::vector<Id>> answers(windows.size());
       t_sidx.query_s.push_back(timed([&] {
@@ -279,6 +292,7 @@ void run_objects(const Options& o) {
   tpr.validate();
   inplace.validate();
   packed.validate();
+  star.validate();
   const double per_tick = double(o.objects / 60);
   const double hits = double(total_hits) / double(total_queries);
   std::printf("  medians per tick; %.1f hits per window on average\n", hits);
@@ -295,19 +309,23 @@ void run_objects(const Options& o) {
   const Rates tp = row("loci TPR*-tree (erase + insert)", t_tpr);
   const Rates ip = row("loci TPR*-tree (in-place updates)", t_inplace);
   const Rates pk = row("loci packed TPR-tree, rebuilt each tick", t_packed);
+  const Rates st = row("loci STAR-tree", t_star);
   const Rates sc = row("loci vectorized scan", t_scan);
   std::printf(
       "  TPR*-tree: Choose_Path explored at most %zu nodes; rebuild of %zu objects: %.1f ms\n",
       tpr.max_choose_path_nodes(), o.objects, median(t_packed.update_s) * 1e3);
-  std::printf("  queries vs the scan: TPR*-tree %.2fx, in place %.2fx, packed %.2fx\n",
-              tp.qps / sc.qps, ip.qps / sc.qps, pk.qps / sc.qps);
+  std::printf(
+      "  queries vs the scan: TPR*-tree %.2fx, in place %.2fx, packed %.2fx, STAR-tree %.2fx "
+      "(%zu regroupings)\n",
+      tp.qps / sc.qps, ip.qps / sc.qps, pk.qps / sc.qps, st.qps / sc.qps, star.regroups());
   if (sidx) {
     const Rates sx = row("libspatialindex TPR-tree", t_sidx);
     std::printf(
         "  vs libspatialindex: updates %.0fx (TPR*), %.0fx (in place), %.0fx (packed), %.0fx "
-        "(scan); queries %.1fx (TPR*), %.1fx (in place), %.1fx (packed), %.1fx (scan)\n",
-        tp.ups / sx.ups, ip.ups / sx.ups, pk.ups / sx.ups, sc.ups / sx.ups, tp.qps / sx.qps,
-        ip.qps / sx.qps, pk.qps / sx.qps, sc.qps / sx.qps);
+        "(STAR), %.0fx (scan); queries %.1fx (TPR*), %.1fx (in place), %.1fx (packed), %.1fx "
+        "(STAR), %.1fx (scan)\n",
+        tp.ups / sx.ups, ip.ups / sx.ups, pk.ups / sx.ups, st.ups / sx.ups, sc.ups / sx.ups,
+        tp.qps / sx.qps, ip.qps / sx.qps, pk.qps / sx.qps, st.qps / sx.qps, sc.qps / sx.qps);
     std::printf(
         "  libspatialindex: %zu of %zu windows answered differently from brute force (%zu ids "
         "missing, %zu extra); %zu of %zu deletes failed\n",

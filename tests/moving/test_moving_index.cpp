@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "loci/index/moving/moving_scan.hpp"
+#include "loci/index/moving/star_tree.hpp"
 #include "loci/index/moving/tpr_tree.hpp"
 #include "support/fleet_data.hpp"
 
@@ -48,7 +49,13 @@ struct TprEraseInsert : TprTree<2, 8> {
 template <class T>
 class MovingIndexTest : public ::testing::Test {};
 
-using Structures = ::testing::Types<MovingScan<2>, TprTree<2>, TprTree<2, 6>, TprEraseInsert>;
+// The STAR-tree regrouping eagerly, so that the tests see many regroupings.
+struct EagerStar : StarTree<2, 6> {
+  EagerStar() : StarTree<2, 6>(StarParams<2>{1.05, 30, true}) {}
+};
+
+using Structures = ::testing::Types<MovingScan<2>, TprTree<2>, TprTree<2, 6>, TprEraseInsert,
+                                    StarTree<2>, EagerStar>;
 TYPED_TEST_SUITE(MovingIndexTest, Structures);
 
 MovingWindow<2> random_window(std::mt19937_64& rng, double now, int kind) {
@@ -229,6 +236,37 @@ TEST(TprTreeBuild, RefusesBadInput) {
   EXPECT_THROW(tree.build(ok, bad), InvalidGeometry);
   EXPECT_TRUE(tree.empty());
   tree.validate();
+}
+
+}  // namespace
+}  // namespace loci
+
+namespace loci {
+namespace {
+
+// As objects drift apart, the STAR-tree regroups nodes and stays exact.
+TEST(StarTree, RegroupsAsNodesDeteriorate) {
+  const auto fleet = test::make_fleet(test::Fleet::uniform, 3000, 31);
+  StarTree<2, 8> tree(StarParams<2>{1.5, 30, false});
+  Objects objs;
+  for (std::size_t i = 0; i < fleet.size(); ++i) {
+    tree.insert(i, fleet[i]);
+    objs[i] = fleet[i];
+  }
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> v(-3, 3);
+  for (int tick = 1; tick <= 30; ++tick) {
+    for (int u = 0; u < 50; ++u) {
+      const Id id = rng() % fleet.size();
+      const Motion2 m{double(tick), position(objs[id], tick), {v(rng), v(rng)}};
+      tree.update(id, m);
+      objs[id] = m;
+    }
+  }
+  EXPECT_GT(tree.regroups(), 0u);
+  tree.validate();
+  check_queries(tree, objs, 30, 12, "star after drift");
+  EXPECT_THROW(StarTree<2>(StarParams<2>{1.0, 30, true}), InvalidArgument);
 }
 
 }  // namespace

@@ -67,6 +67,7 @@ struct TprStarPolicy {
   static double horizon(const Params& p) { return p.horizon; }
   static Point<D> extent(const Params& p) { return p.query_extent; }
   static double lookahead(const Params& p) { return p.horizon; }
+  static double ratio(const Params&) { return 0; }
   static void check(const Params& p) {
     if (!(p.horizon >= 0) || !std::isfinite(p.horizon))
       throw InvalidArgument("TprTree: the horizon must be a finite number >= 0");

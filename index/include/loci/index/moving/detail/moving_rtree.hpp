@@ -160,6 +160,7 @@ class MovingRTree {
         nd.parent = kNone;
         nd.level = std::uint8_t(height);
         nd.count = 0;
+        nd.grouped = 0;
         for (std::size_t e = from; e < to; ++e) {
           put(nd, nd.count, level[e]);
           fresh.adopt(node, nd.count++);
@@ -183,6 +184,8 @@ class MovingRTree {
   std::size_t memory_bytes() const {
     return nodes_.memory_bytes() + obj_motion_.capacity() * (sizeof(Motion<D>) + 12);
   }
+  // Local regroupings done so far (regrouping policies only).
+  std::size_t regroups() const { return regroups_; }
   // Nodes examined by the most expensive Choose_Path so far (the price of TPR* insertions).
   std::size_t max_choose_path_nodes() const { return max_choose_nodes_; }
 
@@ -362,6 +365,7 @@ class MovingRTree {
     std::uint32_t parent = kNone;  // also the free-list link
     std::uint8_t level = 0;        // 0: leaf (children are object slots)
     std::uint8_t count = 0;
+    double grouped = 0;  // area of the node's box when it was last grouped (regrouping policies)
     BoxArray box;
     std::uint32_t child[kSlots];
     // Leaves also keep each object's report and id, so that queries read no other memory.
@@ -503,6 +507,7 @@ class MovingRTree {
       r.parent = kNone;
       r.level = 0;
       r.count = 0;
+      r.grouped = 0;
     }
     const Box_ b = Box_::of(m, epoch_);
     for (int i = 0; i < D; ++i) {
@@ -511,6 +516,7 @@ class MovingRTree {
     }
     std::uint32_t reinserted = 0;
     insert_entry({b, s, m, id}, 0, reinserted);
+    if constexpr (Policy::kRegroups) maybe_regroup(obj_leaf_[s]);
   }
 
   // Choose_Path: the node of `level` whose taking `b` raises the summed cost of the path to
@@ -687,6 +693,8 @@ class MovingRTree {
     Node& b = nodes_[sib];
     b.level = a.level;
     b.count = 0;
+    b.grouped = 0;
+    a.grouped = 0;
     Item items[M + 1];
     for (int e = 0; e < total; ++e)
       items[e] = take(a, best_order[e]);
@@ -703,6 +711,7 @@ class MovingRTree {
       root.parent = kNone;
       root.level = std::uint8_t(nodes_[n].level + 1);
       root.count = 2;
+      root.grouped = 0;
       root.box[0] = bound(nodes_[n]);
       root.child[0] = n;
       root.box[1] = bound(nodes_[sib]);
@@ -767,7 +776,70 @@ class MovingRTree {
     put(node, e, {b, s, m, node.id[e]});
     obj_motion_[s] = m;
     if (!root) nodes_[node.parent].box[slot] = bound(node);
+    if constexpr (Policy::kRegroups) maybe_regroup(leaf);
     return true;
+  }
+
+  // The area of b at the clock.
+  double area_now(const Box_& b) const {
+    double a = 1;
+    for (int i = 0; i < D; ++i)
+      a *= b.hi_at(i, rel_clock()) - b.lo_at(i, rel_clock());
+    return a;
+  }
+
+  // Regrouping policies: walks from the leaf's parent to the root and regroups the first node
+  // whose box at the clock has grown past Policy::ratio times its area when it was last
+  // grouped (a node not yet measured is measured now).
+  void maybe_regroup(std::uint32_t leaf) {
+    for (std::uint32_t x = nodes_[leaf].parent; x != kNone; x = nodes_[x].parent) {
+      const double now = area_now(bound(nodes_[x]));
+      Node& node = nodes_[x];
+      if (!(node.grouped > 0)) {
+        node.grouped = now;
+        continue;
+      }
+      if (now > Policy::ratio(params_) * node.grouped) return regroup(x);
+    }
+  }
+
+  // Deals the entries of x's children out again among as many new children, tiled by
+  // Sort-Tile-Recursive on their centres at the clock, so that each child is tight now.
+  void regroup(std::uint32_t x) {
+    ++regroups_;
+    thread_local std::vector<Item> items;
+    items.clear();
+    const int k = nodes_[x].count;
+    const int level = nodes_[x].level - 1;
+    for (int e = 0; e < k; ++e) {
+      const std::uint32_t ch = nodes_[x].child[e];
+      for (int i = 0; i < nodes_[ch].count; ++i)
+        items.push_back(take(nodes_[ch], i));
+      nodes_.release(ch);
+    }
+    std::vector<std::size_t> groups(k + 1);
+    for (int g = 0; g <= k; ++g)
+      groups[g] = items.size() * g / k;
+    const double c = rel_clock();
+    detail::str_tile<D>(
+        items.data(), std::span<const std::size_t>(groups),
+        [c](const Item& it, int axis) { return it.box.lo_at(axis, c) + it.box.hi_at(axis, c); });
+    for (int g = 0; g < k; ++g) {
+      const std::uint32_t n = nodes_.allocate(kName);
+      Node& nd = nodes_[n];
+      nd.parent = x;
+      nd.level = std::uint8_t(level);
+      nd.count = 0;
+      for (std::size_t i = groups[g]; i < groups[g + 1]; ++i) {
+        put(nd, nd.count, items[i]);
+        adopt(n, nd.count++);
+      }
+      nd.grouped = area_now(bound(nd));
+      nodes_[x].box[g] = bound(nd);
+      nodes_[x].child[g] = n;
+    }
+    nodes_[x].grouped = area_now(bound(nodes_[x]));
+    tighten_upwards(x);
   }
 
   // Dissolves underfull nodes from n up, tightens the rest of the path, reinserts orphans.
@@ -873,6 +945,7 @@ class MovingRTree {
   double epoch_ = 0;
   double clock_ = -std::numeric_limits<double>::infinity();
   std::size_t max_choose_nodes_ = 0;
+  std::size_t regroups_ = 0;
   double mag_ = 0;   // largest |coordinate| of an object's entry at the epoch
   double vmag_ = 0;  // largest |velocity| component
 };
