@@ -93,14 +93,20 @@ class MovingRTree {
       throw InvalidArgument(std::string(kName) + ": ids and reports differ in length");
     if (objects.size() + 1 >= kNone)
       throw InvalidArgument(std::string(kName) + ": too many objects");
-    MovingRTree fresh(params_);
-    if (objects.empty()) return void(*this = std::move(fresh));
+    // Everything is checked before anything changes: bad input leaves the tree as it was.
     double latest = -std::numeric_limits<double>::infinity();
     for (const Motion<D>& m : objects) {
       check_motion(m);
       latest = std::max(latest, m.t);
     }
-    fresh.epoch_ = fresh.clock_ = latest;
+    const std::size_t n = objects.size();
+    detail::IdMap map;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (map.find(ids[i]) != kNone)
+        throw InvalidArgument(std::string(kName) + ": id " + std::to_string(ids[i]) +
+                              " is given twice");
+      map.insert(ids[i], i, i + 1);
+    }
     // Leaves are tiles of the 2 D-dimensional space of positions at mid-horizon and
     // velocities scaled by half the horizon (how far a velocity difference spreads a node
     // by then), cut by Sort-Tile-Recursive.
@@ -110,8 +116,8 @@ class MovingRTree {
       double key[2 * D];
       std::uint32_t index;
     };
-    std::vector<Keyed> keyed(objects.size());
-    for (std::uint32_t i = 0; i < objects.size(); ++i) {
+    std::vector<Keyed> keyed(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
       const Point<D> p = position(objects[i], mid);
       for (int a = 0; a < D; ++a) {
         keyed[i].key[a] = p[a];
@@ -120,60 +126,75 @@ class MovingRTree {
       keyed[i].index = i;
     }
     constexpr std::size_t kFill = std::max<std::size_t>(kMinFill, M * 3 / 4);
-    {
-      const std::size_t leaves = (objects.size() + kFill - 1) / kFill;
+    const std::size_t leaves = (n + kFill - 1) / kFill;
+    if (n > 0) {
       std::vector<std::size_t> groups(leaves + 1);
       for (std::size_t g = 0; g <= leaves; ++g)
-        groups[g] = objects.size() * g / leaves;
+        groups[g] = n * g / leaves;
       detail::str_tile<2 * D>(keyed.data(), std::span<const std::size_t>(groups),
                               [](const Keyed& k, int axis) { return k.key[axis]; });
     }
-    const std::size_t n = objects.size();
-    fresh.obj_id_.resize(n);
-    fresh.obj_motion_.resize(n);
-    fresh.obj_leaf_.resize(n);
-    std::vector<Item> level(n);
-    for (std::uint32_t k = 0; k < n; ++k) {
-      const std::uint32_t i = keyed[k].index;
-      if (fresh.map_.find(ids[i]) != kNone)
-        throw InvalidArgument(std::string(kName) + ": id " + std::to_string(ids[i]) +
-                              " is given twice");
-      fresh.map_.insert(ids[i], k, k + 1);
-      fresh.obj_id_[k] = ids[i];
-      fresh.obj_motion_[k] = objects[i];
-      const Box_ b = Box_::of(objects[i], fresh.epoch_);
-      for (int a = 0; a < D; ++a) {
-        fresh.mag_ = std::max(fresh.mag_, std::abs(b.lo[a]));
-        fresh.vmag_ = std::max(fresh.vmag_, std::abs(b.vlo[a]));
-      }
-      level[k] = {b, k, objects[i], ids[i]};
+    // The old contents go; their memory is reused (a tree rebuilt every tick touches no new
+    // pages). Object slots follow the tiling order, so a leaf's objects are neighbours.
+    nodes_.clear();
+    nodes_.reserve(leaves + leaves / (kFill - 1) + 8);
+    root_ = kNone;
+    free_slots_.clear();
+    obj_id_.resize(n);
+    obj_motion_.resize(n);
+    obj_leaf_.resize(n);
+    map_.clear();
+    for (std::uint32_t k = 0; k < n; ++k)
+      map_.insert(ids[keyed[k].index], k, k + 1);
+    count_ = n;
+    epoch_ = clock_ = n > 0 ? latest : 0;
+    mag_ = vmag_ = 0;
+    if (n == 0) {
+      clock_ = -std::numeric_limits<double>::infinity();
+      return;
     }
-    fresh.count_ = n;
-    // Pack each level into nodes of nearly equal counts, about 3/4 full.
-    for (int height = 0;; ++height) {
+    std::vector<Item> level(leaves);
+    for (std::size_t g = 0; g < leaves; ++g) {
+      const std::uint32_t node = nodes_.allocate(kName);
+      Node& nd = nodes_[node];
+      nd.parent = kNone;
+      nd.level = 0;
+      nd.count = 0;
+      nd.grouped = 0;
+      for (std::size_t k = n * g / leaves; k < n * (g + 1) / leaves; ++k) {
+        const std::uint32_t i = keyed[k].index;
+        const Box_ b = Box_::of(objects[i], epoch_);
+        for (int a = 0; a < D; ++a) {
+          mag_ = std::max(mag_, std::abs(b.lo[a]));
+          vmag_ = std::max(vmag_, std::abs(b.vlo[a]));
+        }
+        obj_id_[k] = ids[i];
+        obj_motion_[k] = objects[i];
+        obj_leaf_[k] = node;
+        put(nd, nd.count++, {b, std::uint32_t(k), objects[i], ids[i]});
+      }
+      level[g] = {bound(nd), node, {}, 0};
+    }
+    // Pack each level above into nodes of nearly equal counts, about 3/4 full.
+    for (int height = 1; level.size() > 1; ++height) {
       const std::size_t groups = (level.size() + kFill - 1) / kFill;
       std::vector<Item> up(groups);
       for (std::size_t g = 0; g < groups; ++g) {
-        const std::size_t from = level.size() * g / groups, to = level.size() * (g + 1) / groups;
-        const std::uint32_t node = fresh.nodes_.allocate(kName);
-        Node& nd = fresh.nodes_[node];
+        const std::uint32_t node = nodes_.allocate(kName);
+        Node& nd = nodes_[node];
         nd.parent = kNone;
         nd.level = std::uint8_t(height);
         nd.count = 0;
         nd.grouped = 0;
-        for (std::size_t e = from; e < to; ++e) {
+        for (std::size_t e = level.size() * g / groups; e < level.size() * (g + 1) / groups; ++e) {
           put(nd, nd.count, level[e]);
-          fresh.adopt(node, nd.count++);
+          adopt(node, nd.count++);
         }
-        up[g] = {fresh.bound(nd), node, {}, 0};
-      }
-      if (groups == 1) {
-        fresh.root_ = up[0].child;
-        break;
+        up[g] = {bound(nd), node, {}, 0};
       }
       level.swap(up);
     }
-    *this = std::move(fresh);
+    root_ = level[0].child;
   }
 
   bool contains(Id id) const { return map_.find(id) != kNone; }
@@ -362,6 +383,9 @@ class MovingRTree {
   };
 
   struct Node {
+    // User-provided, so that the pool's new nodes are not zero-filled first (a node is a few
+    // kilobytes; its users set what they read).
+    Node() {}
     std::uint32_t parent = kNone;  // also the free-list link
     std::uint8_t level = 0;        // 0: leaf (children are object slots)
     std::uint8_t count = 0;
