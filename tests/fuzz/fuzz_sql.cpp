@@ -4,6 +4,10 @@
 // among them the awkward ones (NULL, text, blobs, 1e999, integers past 2^53, inverted boxes).
 // Every write goes to the loci_rtree t and a plain table m alike; every query must answer as m
 // does and loci_check must say ok, until raw SQL has run (it may touch either table alone).
+// Fleet statements do the same with the loci_fleet f and a plain table of reports p: reports
+// inserted and objects deleted on both, windows at any time (before the latest report too)
+// through loci_fleet_window against the same question in SQL over p, conflicts and nearest with
+// awkward arguments, and f's current states against p's latest report of each id.
 // SQL errors are expected; a crash, a sanitizer report or a disagreement is a finding.
 #include <sqlite3.h>
 
@@ -85,16 +89,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   sqlite3_exec(db,
                "CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy, +tag);"
                "CREATE TABLE m(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, miny REAL, maxy "
-               "REAL, tag);",
+               "REAL, tag);"
+               "CREATE VIRTUAL TABLE f USING loci_fleet(id, t, x, y, vx, vy);"
+               "CREATE TABLE p(id INTEGER, t REAL, x REAL, y REAL, vx REAL, vy REAL, "
+               "PRIMARY KEY(id, t)) WITHOUT ROWID;",
                nullptr, nullptr, nullptr);
   Input in{data, size};
-  bool mirrored = true;
+  bool mirrored = true, fleet_mirrored = true;
   static const char* cols[] = {"minx", "maxx", "miny", "maxy", "id"};
   static const char* ops[] = {"<", "<=", ">", ">=", "="};
   while (!in.done()) {
     const std::uint8_t op = in.byte();
-    std::string sql;  // run on t and m, with $T for the table
-    switch (op % 12) {
+    std::string sql;  // run on t and m (or f and p), with $T for the table
+    bool fleet = false;
+    switch (op % 16) {
       case 0:
       case 1: {
         const std::string x = std::to_string(int(in.byte()) - 128),
@@ -163,7 +171,67 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         for (std::size_t i = 0; i < len && !in.done(); ++i)
           text += char(in.byte());
         sqlite3_exec(db, text.c_str(), nullptr, nullptr, nullptr);
-        mirrored = false;
+        mirrored = fleet_mirrored = false;
+        continue;
+      }
+      case 12: {  // a report: small numbers, or an awkward value now and then
+        fleet = true;
+        const auto num = [&] {
+          return in.byte() % 8 == 0 ? value(in) : std::to_string(int(in.byte()) - 128);
+        };
+        sql = "INSERT OR REPLACE INTO $T VALUES(" + std::to_string(in.byte() % 16) + ", " + num() +
+              ", " + num() + ", " + num() + ", " + num() + ", " + num() + ")";
+        break;
+      }
+      case 13:
+        fleet = true;
+        sql = "DELETE FROM $T WHERE id = " + std::to_string(in.byte() % 16);
+        break;
+      case 14: {
+        const std::string x = std::to_string(int(in.byte()) - 128),
+                          y = std::to_string(int(in.byte()) - 128),
+                          T = std::to_string(int(in.byte()) - 128);
+        const std::string x1 = x + " + " + std::to_string(in.byte() % 64),
+                          y1 = y + " + " + std::to_string(in.byte() % 64);
+        bool ok1, ok2;
+        const auto a = rows(db,
+                            "SELECT id FROM loci_fleet_window('f', " + x + ", " + y + ", " + x1 +
+                                ", " + y1 + ", " + T + ")",
+                            ok1);
+        const auto b =
+            rows(db,
+                 "SELECT id FROM (SELECT id, x + vx * (" + T + " - t) AS px, y + vy * (" + T +
+                     " - t) AS py FROM p r WHERE t = (SELECT max(t) FROM p WHERE id "
+                     "= r.id AND t <= " +
+                     T + ")) WHERE px >= " + x + " AND px <= " + x1 + " AND py >= " + y +
+                     " AND py <= " + y1 + " ORDER BY id",
+                 ok2);
+        if (fleet_mirrored && ok1 && ok2 && a != b) finding("f and p disagree at " + T);
+        continue;
+      }
+      case 15: {
+        bool ok;
+        if (in.byte() % 2)
+          rows(db,
+               "SELECT * FROM loci_conflicts('f', " + value(in) + ", " + value(in) + ", " +
+                   value(in) + ")",
+               ok);
+        else
+          rows(db,
+               "SELECT * FROM loci_fleet_nearest('f', " + value(in) + ", " + value(in) + ", " +
+                   value(in) + ", " + value(in) + ")",
+               ok);
+        const auto r = rows(db, "SELECT loci_check('f')", ok);
+        if (ok && (r.empty() || r[0][0] != "ok"))
+          finding("loci_check(f): " + (r.empty() ? "" : r[0][0]));
+        if (fleet_mirrored) {
+          const auto a = rows(db, "SELECT * FROM f ORDER BY id", ok);
+          const auto b = rows(db,
+                              "SELECT * FROM p r WHERE t = (SELECT max(t) FROM p WHERE id = r.id) "
+                              "ORDER BY id",
+                              ok);
+          if (a != b) finding("f and p hold different current reports");
+        }
         continue;
       }
       default: {
@@ -175,14 +243,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // Run the write on both tables; when one refuses and the other does not, they differ.
     std::string on_t = sql, on_m = sql;
     for (std::size_t p; (p = on_t.find("$T")) != std::string::npos;)
-      on_t.replace(p, 2, "t");
+      on_t.replace(p, 2, fleet ? "f" : "t");
     for (std::size_t p; (p = on_m.find("$T")) != std::string::npos;)
-      on_m.replace(p, 2, "m");
+      on_m.replace(p, 2, fleet ? "p" : "m");
+    bool& same = fleet ? fleet_mirrored : mirrored;
     const int a = sqlite3_exec(db, on_t.c_str(), nullptr, nullptr, nullptr);
     if (a == SQLITE_OK) {
-      if (sqlite3_exec(db, on_m.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) mirrored = false;
+      if (sqlite3_exec(db, on_m.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) same = false;
     } else {
-      mirrored = false;  // t refused a row m would take (NULL or inverted boxes): stop comparing
+      same = false;  // the loci table refused a row the plain one would take: stop comparing
     }
   }
   sqlite3_close(db);
