@@ -4,10 +4,14 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <signal.h>
 #include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -128,5 +132,29 @@ class TempDir {
  private:
   std::string path_;
 };
+
+// Forks a writer that opens `path` with the extension loaded and runs transaction(0),
+// transaction(1), ... until it is killed with SIGKILL after `after` microseconds, mid-way
+// through one of them. Returns false when the writer stopped by itself first.
+inline bool kill_a_writer(const std::string& path,
+                          const std::function<std::string(int)>& transaction, useconds_t after) {
+  const pid_t pid = ::fork();
+  if (pid < 0) return false;
+  if (pid == 0) {
+    sqlite3* raw = nullptr;
+    sqlite3_open(path.c_str(), &raw);
+    sqlite3_enable_load_extension(raw, 1);
+    if (sqlite3_load_extension(raw, LOCI_SQLITE_EXTENSION, nullptr, nullptr) != SQLITE_OK)
+      ::_exit(3);
+    for (int i = 0;; ++i)
+      if (sqlite3_exec(raw, transaction(i).c_str(), nullptr, nullptr, nullptr) != SQLITE_OK)
+        ::_exit(4);
+  }
+  ::usleep(after);
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFSIGNALED(status);
+}
 
 }  // namespace loci::test

@@ -4,9 +4,6 @@
 // table in SQL, transactions and savepoints, close and reopen, two connections, a killed
 // writer, errors and corrupt shadow tables.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -362,31 +359,18 @@ TEST(SqliteFleetSql, AWriterKilledMidTransactionLeavesItConsistent) {
     db.exec(kPlain);
   }
   for (int round = 0; round < 3; ++round) {
-    const pid_t pid = ::fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      sqlite3* raw = nullptr;
-      sqlite3_open(path.c_str(), &raw);
-      sqlite3_enable_load_extension(raw, 1);
-      if (sqlite3_load_extension(raw, LOCI_SQLITE_EXTENSION, nullptr, nullptr) != SQLITE_OK)
-        ::_exit(3);
-      for (int i = 0;; ++i) {
-        const std::string select =
-            " SELECT value % 500, " + std::to_string(round * 1000 + i) +
-            " + value * 0.001, value % 997, value % 991, 1, -1 FROM (WITH RECURSIVE s(value) AS "
-            "(SELECT 1 UNION ALL SELECT value + 1 FROM s WHERE value < 3000) SELECT value FROM s);";
-        const std::string sql =
-            "BEGIN; INSERT OR REPLACE INTO f" + select + "INSERT OR REPLACE INTO m" + select +
-            "DELETE FROM f WHERE id % 9 = " + std::to_string(i % 9) +
-            "; DELETE FROM m WHERE id % 9 = " + std::to_string(i % 9) + "; COMMIT;";
-        if (sqlite3_exec(raw, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) ::_exit(4);
-      }
-    }
-    ::usleep(useconds_t(80000 + round * 50000));
-    ::kill(pid, SIGKILL);
-    int status = 0;
-    ::waitpid(pid, &status, 0);
-    ASSERT_TRUE(WIFSIGNALED(status)) << "the writer stopped by itself, status " << status;
+    const auto transaction = [&](int i) {
+      const std::string select =
+          " SELECT value % 500, " + std::to_string(round * 1000 + i) +
+          " + value * 0.001, value % 997, value % 991, 1, -1 FROM (WITH RECURSIVE s(value) AS "
+          "(SELECT 1 UNION ALL SELECT value + 1 FROM s WHERE value < 3000) SELECT value FROM s);";
+      const std::string k = std::to_string(i % 9);
+      return "BEGIN; INSERT OR REPLACE INTO f" + select + "INSERT OR REPLACE INTO m" + select +
+             "DELETE FROM f WHERE id % 9 = " + k + "; DELETE FROM m WHERE id % 9 = " + k +
+             "; COMMIT;";
+    };
+    ASSERT_TRUE(loci::test::kill_a_writer(path, transaction, useconds_t(80000 + round * 50000)))
+        << "the writer stopped by itself";
     Db db(path);
     ASSERT_EQ(db.value("SELECT loci_check('f')"), "ok") << "round " << round;
     ASSERT_EQ(db.rows("SELECT * FROM f ORDER BY id"), db.rows(kCurrentOfPlain)) << round;

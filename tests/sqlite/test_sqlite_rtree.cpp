@@ -2,9 +2,6 @@
 // answering the same SQL (brute force, exact) and against SQLite's own rtree, loci_nearest
 // against brute force, transactions, reopening, a killed writer, errors and corruption.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -350,41 +347,23 @@ TEST(SqliteRtreeSql, AWriterKilledMidTransactionLeavesItConsistent) {
     make_tables(db, loci::test::make_boxes<2>(loci::test::Shape::uniform, 2000, 6));
   }
   for (int round = 0; round < 4; ++round) {
-    const pid_t pid = ::fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      sqlite3* raw = nullptr;
-      sqlite3_open(path.c_str(), &raw);
-      sqlite3_enable_load_extension(raw, 1);
-      if (sqlite3_load_extension(raw, LOCI_SQLITE_EXTENSION, nullptr, nullptr) != SQLITE_OK)
-        ::_exit(3);
-      for (int i = 0;; ++i) {
-        const std::string base = std::to_string(100000 + (round * 1000 + i) * 10000);
-        const std::string sql =
-            "BEGIN;"
-            "INSERT INTO t SELECT value + " +
-            base +
-            ", value % 1000, value % 1000 + 1, value % "
-            "777, value % 777 + 1 FROM nums WHERE value <= 5000;"
-            "INSERT INTO m SELECT value + " +
-            base +
-            ", value % 1000, value % 1000 + 1, value % "
-            "777, value % 777 + 1 FROM nums WHERE value <= 5000;"
-            "DELETE FROM t WHERE id % 7 = " +
-            std::to_string(i % 7) +
-            ";"
-            "DELETE FROM m WHERE id % 7 = " +
-            std::to_string(i % 7) +
-            ";"
-            "COMMIT;";
-        if (sqlite3_exec(raw, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) ::_exit(4);
-      }
-    }
-    ::usleep(useconds_t(60000 + round * 45000));
-    ::kill(pid, SIGKILL);
-    int status = 0;
-    ::waitpid(pid, &status, 0);
-    ASSERT_TRUE(WIFSIGNALED(status)) << "the writer stopped by itself, status " << status;
+    const auto transaction = [&](int i) {
+      const std::string base = std::to_string(100000 + (round * 1000 + i) * 10000);
+      return "BEGIN;"
+             "INSERT INTO t SELECT value + " +
+             base +
+             ", value % 1000, value % 1000 + 1, value % "
+             "777, value % 777 + 1 FROM nums WHERE value <= 5000;"
+             "INSERT INTO m SELECT value + " +
+             base +
+             ", value % 1000, value % 1000 + 1, value % "
+             "777, value % 777 + 1 FROM nums WHERE value <= 5000;"
+             "DELETE FROM t WHERE id % 7 = " +
+             std::to_string(i % 7) + "; DELETE FROM m WHERE id % 7 = " + std::to_string(i % 7) +
+             "; COMMIT;";
+    };
+    ASSERT_TRUE(loci::test::kill_a_writer(path, transaction, useconds_t(60000 + round * 45000)))
+        << "the writer stopped by itself";
     Db db(path);
     ASSERT_EQ(db.value("SELECT loci_check('t')"), "ok") << "round " << round;
     ASSERT_EQ(all(db, "t"), all(db, "m")) << "round " << round;
