@@ -24,7 +24,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
-#include <queue>
 #include <unordered_map>
 #include <vector>
 
@@ -101,37 +100,21 @@ class Fleet {
     check_point(q, "nearest point");
     QueryStats st;
     st.nodes_visited = 1;
-    std::priority_queue<std::pair<double, Id>> best;
-    std::unordered_map<Id, const Motion<D>*> motion;
-    for (const auto& [id, h] : history_) {
-      const Motion<D>* m = in_force(h, s);
-      if (!m) continue;
-      ++st.entries_tested;
-      const double d2 = squared_distance(position(*m, s), q);
-      if (best.size() < k) {
-        best.push({d2, id});
-        motion[id] = m;
-      } else if (k > 0 && d2 < best.top().first) {
-        best.pop();
-        best.push({d2, id});
-        motion[id] = m;
-      }
-    }
-    std::vector<std::pair<double, Id>> out(best.size());
-    for (std::size_t j = out.size(); j-- > 0; best.pop())
-      out[j] = best.top();
-    for (const auto& [d2, id] : out) {
+    std::vector<std::pair<Id, const Motion<D>*>> live;
+    for (const auto& [id, h] : history_)
+      if (const Motion<D>* m = in_force(h, s)) live.push_back({id, m});
+    st.entries_tested = live.size();
+    const auto out = detail::k_smallest(live.size(), k, [&](std::size_t i) {
+      return squared_distance(position(*live[i].second, s), q);
+    });
+    for (const auto& [d2, i] : out) {
       ++st.results;
-      if (!visit(id, *motion[id], std::sqrt(d2))) break;
+      if (!visit(live[i].first, *live[i].second, std::sqrt(d2))) break;
     }
     return st;
   }
   std::vector<Neighbor> nearest(const Point<D>& q, double s, std::size_t k) const {
-    std::vector<Neighbor> out;
-    nearest(q, s, k, [&](Id id, const Motion<D>&, double d) {
-      return out.push_back({id, d}), true;
-    });
-    return out;
+    return collect_neighbors([&](auto&& v) { return nearest(q, s, k, v); });
   }
 
   // Pairs within D during [now, now + H] among the reports in force at now, sorted, a < b.

@@ -32,6 +32,8 @@
 
 #include <concepts>
 #include <cstddef>
+#include <queue>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/motion.hpp"
@@ -58,6 +60,28 @@ template <int D>
 struct MotionNearestProbe {
   bool operator()(Id, const Motion<D>&, double) const;
 };
+}  // namespace detail
+
+namespace detail {
+// The k smallest of the squared distances d2(i), i < n, nearest first, as (d2, i): the
+// nearest-n of the scans.
+template <class D2>
+std::vector<std::pair<double, std::size_t>> k_smallest(std::size_t n, std::size_t k, D2&& d2) {
+  std::priority_queue<std::pair<double, std::size_t>> best;  // the k best so far, worst on top
+  for (std::size_t i = 0; i < n && k > 0; ++i) {
+    const double d = d2(i);
+    if (best.size() < k) {
+      best.push({d, i});
+    } else if (d < best.top().first) {
+      best.pop();
+      best.push({d, i});
+    }
+  }
+  std::vector<std::pair<double, std::size_t>> out(best.size());
+  for (std::size_t j = out.size(); j-- > 0; best.pop())
+    out[j] = best.top();
+  return out;
+}
 }  // namespace detail
 
 template <class T>

@@ -22,7 +22,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
-#include <queue>
 #include <string>
 #include <vector>
 
@@ -129,37 +128,23 @@ class MovingScan {
     st.nodes_visited = 1;
     st.entries_tested = ids_.size();
     if (k == 0) return st;
-    // A max-heap of the k best squared distances seen.
-    std::priority_queue<std::pair<double, std::uint32_t>> best;
-    for (std::uint32_t i = 0; i < ids_.size(); ++i) {
+    const auto out = detail::k_smallest(ids_.size(), k, [&](std::size_t i) {
       const double dt = s - t_[i];
       double dd = 0;
       for (int a = 0; a < D; ++a) {
         const double d = p_[a][i] + v_[a][i] * dt - q[a];
         dd += d * d;
       }
-      if (best.size() < k)
-        best.push({dd, i});
-      else if (dd < best.top().first) {
-        best.pop();
-        best.push({dd, i});
-      }
-    }
-    std::vector<std::pair<double, std::uint32_t>> out(best.size());
-    for (std::size_t j = out.size(); j-- > 0; best.pop())
-      out[j] = best.top();
+      return dd;
+    });
     for (const auto& [dd, i] : out) {
       ++st.results;
-      if (!visit(ids_[i], motion(i), std::sqrt(dd))) break;
+      if (!visit(ids_[i], motion(std::uint32_t(i)), std::sqrt(dd))) break;
     }
     return st;
   }
   std::vector<Neighbor> nearest(const Point<D>& q, double s, std::size_t k) const {
-    std::vector<Neighbor> out;
-    nearest(q, s, k, [&](Id id, const Motion<D>&, double d) {
-      return out.push_back({id, d}), true;
-    });
-    return out;
+    return collect_neighbors([&](auto&& v) { return nearest(q, s, k, v); });
   }
 
   template <MotionVisitor<D> F>

@@ -293,11 +293,7 @@ class MovingRTree {
     });
   }
   std::vector<Neighbor> nearest(const Point<D>& q, double s, std::size_t k) const {
-    std::vector<Neighbor> out;
-    nearest(q, s, k, [&](Id id, const Motion<D>&, double d) {
-      return out.push_back({id, d}), true;
-    });
-    return out;
+    return collect_neighbors([&](auto&& v) { return nearest(q, s, k, v); });
   }
 
   template <MotionVisitor<D> F>
