@@ -362,6 +362,26 @@ int run_fleet_generate(const Args& a) {
   return 0;
 }
 
+int run_fleet_draw(const Args& a) {
+  FleetDrawOptions o;
+  o.path = fleet_file(a, "draw");
+  o.over = a.get("--over");
+  o.over_layer = a.get("--layer");
+  o.at = at_flag(a);
+  if (a.has("--within")) o.within = parse_nonnegative("--within", a.get("--within"));
+  if (a.has("--horizon")) o.horizon = parse_nonnegative("--horizon", a.get("--horizon"));
+  if (a.has("--within") != a.has("--horizon"))
+    throw UsageError("loci fleet draw draws conflicts with both --within D and --horizon H");
+  if (a.has("--arrows")) o.arrows = parse_nonnegative("--arrows", a.get("--arrows"));
+  if (a.has("--width")) o.width = int(parse_count("--width", a.get("--width"), 16, 20000));
+  o.out_path = a.get("--output");
+  const FleetDrawReport r = fleet_draw(o, stdout);
+  print_fleet_run(a, r.run);
+  if (!a.has("--quiet"))
+    std::fprintf(stderr, "loci: drew %zu objects and %zu pairs in conflict\n", r.objects, r.pairs);
+  return 0;
+}
+
 int run_fleet_simulate(const Args& a) {
   FleetSimulateOptions o;
   o.path = fleet_file(a, "simulate");
@@ -544,6 +564,23 @@ const std::vector<Command>& commands() {
        "  loci fleet generate --count 300 --format ais --distribution lanes --along "
        "coastline.geojson -o ais.csv\n",
        run_fleet_generate},
+      {"fleet draw",
+       "loci fleet draw FILE [--over LAYER] [--at T] [--within D --horizon H] [--arrows T] -o "
+       "OUT.svg",
+       "an SVG of the fleet at a time: positions, velocity arrows and the pairs in conflict over "
+       "a layer",
+       {{"--over", nullptr, "LAYER", "a layer drawn underneath (lon/lat for AIS input)"},
+        kLayer,
+        {"--at", nullptr, "T", "the time drawn (default: the latest report time)"},
+        {"--within", nullptr, "D", "with --horizon: draw the pairs within D (metres for AIS)"},
+        {"--horizon", nullptr, "H", "with --within: how far ahead (seconds for AIS)"},
+        {"--arrows", nullptr, "T", "time an arrow covers (default: the horizon, else 60)"},
+        {"--width", nullptr, "PX", "drawing width in pixels (default 1200)"},
+        {"--output", "-o", "OUT", "the SVG (whole or not at all) instead of stdout"},
+        kQuiet},
+       "  loci fleet draw ais.csv --over coastline.geojson --within 926 --horizon 1200 -o "
+       "fleet.svg\n",
+       run_fleet_draw},
       {"fleet simulate",
        "loci fleet simulate FILE --ticks N --within D --horizon H [--update-fraction F] [--tick S]",
        "ticks of position updates and conflict checks, timed (CSV "

@@ -15,60 +15,13 @@
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/layer_cells.hpp"
+#include "svg.hpp"
 
 namespace loci::io {
 namespace {
 
-struct Frame {
-  Box2 world;
-  double scale;
-  int width, height;
-  double x(double wx) const { return (wx - world.min[0]) * scale; }
-  double y(double wy) const { return (world.max[1] - wy) * scale; }
-};
-
-bool ends_with(const std::string& s, const std::string& tail) {
-  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
-
-Frame frame_of(const Box2& world, int width) {
-  Frame f;
-  f.world = world;
-  const double w = std::max(world.extent(0), 1e-12), h = std::max(world.extent(1), 1e-12);
-  f.width = std::max(width, 16);
-  f.scale = f.width / w;
-  f.height = std::max(1, int(std::ceil(h * f.scale)));
-  return f;
-}
-
-void write_rect(std::FILE* o, const Frame& f, const Box2& r) {
-  std::fprintf(o, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", f.x(r.min[0]),
-               f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);
-}
-
-void write_linework(std::FILE* o, const Frame& f, const std::string& layer_path,
-                    const std::string& layer_name) {
-  auto src = detail::open_layer(layer_path, layer_name);
-  std::fprintf(o, "<g fill=\"none\" stroke=\"#555\" stroke-width=\"0.5\">\n");
-  for (auto& feature : *src.layer) {
-    detail::for_each_curve(
-        feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
-          const int n = c.getNumPoints();
-          if (n < 2) return;
-          std::fprintf(o, "<path d=\"");
-          long lx = LONG_MIN, ly = LONG_MIN;
-          for (int i = 0; i < n; ++i) {
-            const long px = std::lround(f.x(c.getX(i)) * 10), py = std::lround(f.y(c.getY(i)) * 10);
-            if (px == lx && py == ly && i + 1 < n) continue;
-            std::fprintf(o, "%c%.1f %.1f", i == 0 ? 'M' : 'L', px / 10.0, py / 10.0);
-            lx = px;
-            ly = py;
-          }
-          std::fprintf(o, "\"/>\n");
-        });
-  }
-  std::fprintf(o, "</g>\n");
-}
+using detail::Frame;
+using detail::write_rect;
 
 // Nodes, from the leaves' parents up to the root, coarser levels drawn last and thicker.
 std::size_t write_nodes(std::FILE* o, const Frame& f, const PackedRTree2& tree, int max_levels) {
@@ -115,7 +68,7 @@ std::size_t write_cells(std::FILE* o, const Frame& f, const RegionQuadtree& cell
 
 std::size_t draw_index(const DrawOptions& options) {
   LoadOptions load;
-  if (ends_with(options.path, ".loci")) {
+  if (detail::ends_with(options.path, ".loci")) {
     load.layer_path = options.path.substr(0, options.path.size() - 5);
     load.index_path = options.path;
   } else {
@@ -132,16 +85,13 @@ std::size_t draw_index(const DrawOptions& options) {
   RegionQuadtree quadtree;
   if (cells) quadtree = layer_cells(index, options.cell_levels, options.progress);
 
-  const Frame f = frame_of(cells ? quadtree.region() : tree->bounds(), options.width);
+  const Frame f = detail::frame_of(cells ? quadtree.region() : tree->bounds(), options.width);
   OutputFile out(options.out_path, stdout);
   std::FILE* o = out.stream();
-  std::fprintf(o,
-               "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
-               "viewBox=\"0 0 %d %d\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
-               f.width, f.height, f.width, f.height);
+  detail::write_svg_head(o, f);
   std::size_t drawn = 0;
   if (cells) drawn = write_cells(o, f, quadtree);
-  write_linework(o, f, load.layer_path, index.layer_name());
+  detail::write_linework(o, f, load.layer_path, index.layer_name());
   if (!cells) drawn = write_nodes(o, f, *tree, options.max_levels);
   std::fprintf(o, "</svg>\n");
   out.commit();

@@ -13,6 +13,7 @@
 #include "loci/index/moving/conflicts.hpp"
 #include "loci/index/moving/moving_scan.hpp"
 #include "loci/io/exact.hpp"
+#include "svg.hpp"
 
 namespace loci::io {
 
@@ -653,6 +654,85 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
     rep.mean_pairs = total_pairs / double(o.ticks);
   }
   return rep;
+}
+
+FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
+  if (o.within.has_value() != o.horizon.has_value())
+    throw InvalidArgument("conflicts are drawn with both --within and --horizon, or neither");
+  if (o.within) check_conflict_query(*o.within, 0, *o.horizon);
+  if (o.arrows && !(std::isfinite(*o.arrows) && *o.arrows >= 0))
+    throw InvalidArgument("the arrows' time must be a finite number >= 0");
+  if (!o.over.empty()) refuse_overwriting(o.out_path, o.over);
+  refuse_overwriting(o.out_path, o.path);
+  const Loaded l = load(o.path, o.at);
+  const auto now = in_force(l.data.reports, l.now);
+  if (now.empty()) throw Error(o.path + ": no object has reported by then; nothing to draw");
+  const double ahead = o.arrows.value_or(o.horizon.value_or(60));
+  std::vector<Id> ids;
+  std::vector<Motion2> motions;
+  for (const FleetReport& r : now) {
+    ids.push_back(r.id);
+    motions.push_back(r.m);
+  }
+  std::vector<Conflict> found;
+  if (o.within) found = find_conflicts<2>(ids, motions, *o.within, l.now, *o.horizon);
+  std::vector<Point2> at(motions.size()), to(motions.size());
+  Box2 world = Box2::empty();
+  for (std::size_t i = 0; i < motions.size(); ++i) {
+    at[i] = shown(l, position(motions[i], l.now));
+    to[i] = shown(l, position(motions[i], l.now + ahead));
+    world.expand(at[i]);
+    world.expand(to[i]);
+  }
+  // A margin of 5% (and some extent for a fleet at one point).
+  const double pad = 0.05 * std::max({world.extent(0), world.extent(1), 1e-9});
+  for (int a = 0; a < 2; ++a)
+    world.min[a] -= pad, world.max[a] += pad;
+  const detail::Frame f = detail::frame_of(world, o.width);
+  std::vector<bool> conflicting(ids.size(), false);
+  auto index_of = [&](Id id) {
+    return std::size_t(std::lower_bound(ids.begin(), ids.end(), id) - ids.begin());
+  };
+  for (const Conflict& c : found)
+    conflicting[index_of(c.a)] = conflicting[index_of(c.b)] = true;
+
+  OutputFile out(o.out_path, fallback);
+  std::FILE* svg = out.stream();
+  detail::write_svg_head(svg, f);
+  if (!o.over.empty()) detail::write_linework(svg, f, o.over, o.over_layer);
+  std::fprintf(svg, "<g stroke=\"#2b6cb0\" stroke-width=\"0.8\" fill=\"none\">\n");
+  for (std::size_t i = 0; i < at.size(); ++i)
+    std::fprintf(svg, "<path d=\"M%.1f %.1fL%.1f %.1f\"/>\n", f.x(at[i][0]), f.y(at[i][1]),
+                 f.x(to[i][0]), f.y(to[i][1]));
+  std::fprintf(svg, "</g>\n");
+  for (const bool red : {false, true}) {
+    std::fprintf(svg, "<g fill=\"%s\">\n", red ? "#d62728" : "#1a365d");
+    for (std::size_t i = 0; i < at.size(); ++i)
+      if (conflicting[i] == red)
+        std::fprintf(
+            svg, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\"><title>%llu</title></circle>\n",
+            f.x(at[i][0]), f.y(at[i][1]), red ? 2.5 : 1.8, static_cast<unsigned long long>(ids[i]));
+    std::fprintf(svg, "</g>\n");
+  }
+  std::fprintf(svg, "<g stroke=\"#d62728\" stroke-width=\"1.2\">\n");
+  for (const Conflict& c : found) {
+    const Point2 a = shown(l, position(motions[index_of(c.a)], c.approach.tcpa));
+    const Point2 b = shown(l, position(motions[index_of(c.b)], c.approach.tcpa));
+    std::fprintf(svg,
+                 "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"><title>%llu %llu: "
+                 "dcpa %s at %s</title></line>\n",
+                 f.x(a[0]), f.y(a[1]), f.x(b[0]), f.y(b[1]), static_cast<unsigned long long>(c.a),
+                 static_cast<unsigned long long>(c.b), num(c.approach.dcpa).c_str(),
+                 num(c.approach.tcpa).c_str());
+  }
+  std::fprintf(svg, "</g>\n</svg>\n");
+  out.commit();
+  FleetDrawReport r;
+  r.run = run_of(l);
+  r.objects = at.size();
+  r.pairs = found.size();
+  r.run.answers = found.size();
+  return r;
 }
 
 }  // namespace loci::io

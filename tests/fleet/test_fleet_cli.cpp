@@ -535,3 +535,69 @@ TEST_F(FleetCli, FailuresLeaveNothingWritten) {
 }
 
 }  // namespace
+
+namespace {
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+    ++n;
+  return n;
+}
+
+TEST_F(FleetCli, DrawShowsEveryObjectInForceAndEveryConflict) {
+  // Planar: the objects in force at t = 40 and the pairs `fleet conflicts` finds then.
+  const auto rows = make_rows(150, 71, 0, 100, 1000, 3);
+  const std::string f = write("fleet.csv", csv_of(rows));
+  std::set<Id> in_force;
+  for (const Row& r : rows)
+    if (r.m.t <= 40) in_force.insert(r.id);
+  const CliRun c =
+      run_loci("fleet conflicts " + shell_quote(f) + " --within 40 --horizon 30 --at 40 -q");
+  ASSERT_EQ(c.status, 0) << c.err;
+  const std::size_t pairs = lines(c.out).size() - 1;
+  ASSERT_GT(pairs, 0u);
+  const std::string out = path("fleet.svg");
+  const CliRun r = run_loci("fleet draw " + shell_quote(f) +
+                            " --within 40 --horizon 30 --at 40 -o " + shell_quote(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(out);
+  const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  EXPECT_EQ(count_of(svg, "<circle"), in_force.size());
+  EXPECT_EQ(count_of(svg, "<line"), pairs);
+  EXPECT_NE(r.err.find("drew " + std::to_string(in_force.size()) + " objects and " +
+                       std::to_string(pairs) + " pairs"),
+            std::string::npos)
+      << r.err;
+
+  // AIS over the coastline: 300 vessels, the 36 pairs of the quick start, and the linework.
+  const std::string ais = path("ais.svg");
+  const CliRun a =
+      run_loci("fleet draw " + shell_quote(kSample) + " --over " + shell_quote(kCoast) +
+               " --within 926 --horizon 1200 -q -o " + shell_quote(ais));
+  ASSERT_EQ(a.status, 0) << a.err;
+  std::ifstream ia(ais);
+  const std::string s2((std::istreambuf_iterator<char>(ia)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(count_of(s2, "<circle"), 300u);
+  EXPECT_EQ(count_of(s2, "<line"), 36u);
+  EXPECT_GT(count_of(s2, "<path d=\"M"), 300u);  // arrows and coastline
+
+  // Bad flags: one line, exit 1, nothing written.
+  const std::string none = path("none.svg");
+  for (const std::string bad : {" --within 5", " --horizon 5", " --within -1 --horizon 5",
+                                " --arrows nan", " --over /no/such/layer.shp"}) {
+    const CliRun b = run_loci("fleet draw " + shell_quote(f) + bad + " -o " + shell_quote(none));
+    EXPECT_EQ(b.status, 1) << bad;
+    EXPECT_EQ(lines(b.err).size(), 1u) << bad << ": " << b.err;
+    EXPECT_FALSE(fs::exists(none)) << bad;
+  }
+  // Before any report: nothing to draw.
+  const CliRun early =
+      run_loci("fleet draw " + shell_quote(f) + " --at -5 -o " + shell_quote(none));
+  EXPECT_EQ(early.status, 1);
+  EXPECT_FALSE(fs::exists(none));
+}
+
+}  // namespace

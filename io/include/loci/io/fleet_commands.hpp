@@ -8,6 +8,8 @@
 //   fleet_generate   synthetic fleets (uniform, clustered, or in lanes along a line layer),
 //                    in the planar or the AIS CSV format
 //   fleet_simulate   ticks of position updates and conflict checks, timed
+//   fleet_draw       an SVG of the fleet at a time: positions, velocity arrows and the pairs
+//                    in conflict, over a layer's linework
 //
 // Every command answers from the reports in force at its time (fleet.hpp): "now" is the latest
 // report time of the input unless `at` is set.
@@ -123,5 +125,29 @@ struct FleetSimulateReport {
 // row is written: `tick,t,updates,update_ms,conflict_ms,pairs,full` (full: 1 when the
 // conflicts were computed in full that tick).
 FleetSimulateReport fleet_simulate(const FleetSimulateOptions& options, std::FILE* fallback);
+
+struct FleetDrawOptions {
+  std::string path;
+  std::string over;              // a layer drawn underneath (lon/lat for AIS input), optional
+  std::string over_layer;        // its layer name in a multi-layer dataset
+  std::optional<double> at;      // default: now
+  std::optional<double> within;  // with horizon: the pairs in conflict are drawn too
+  std::optional<double> horizon;
+  std::optional<double> arrows;  // time an arrow covers (default: the horizon, else 60)
+  int width = 1200;              // pixels
+  std::string out_path;          // empty: the fallback stream
+};
+
+struct FleetDrawReport {
+  FleetRun run;
+  std::size_t objects = 0;  // positions drawn
+  std::size_t pairs = 0;    // conflicts drawn
+};
+
+// The objects in force at the time as dots with an arrow to where they will be `arrows` later,
+// the pairs in conflict (given within and horizon) as red lines between the two positions at
+// their closest approach, their objects in red, over the linework of `over`. The drawing
+// covers the fleet and its arrows (lon/lat for AIS input).
+FleetDrawReport fleet_draw(const FleetDrawOptions& options, std::FILE* fallback);
 
 }  // namespace loci::io

@@ -1,0 +1,76 @@
+// The drawing primitives of loci's SVG output (`loci draw`, `loci fleet draw`): a frame from
+// world coordinates to pixels (y up, the world's width fitted to the drawing's), rectangles,
+// and a layer's linework, projected and rounded to a tenth of a pixel with consecutive points
+// that round together dropped.
+#pragma once
+
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "gdal_layer.hpp"
+#include "loci/geom/box.hpp"
+
+namespace loci::io::detail {
+
+struct Frame {
+  Box2 world;
+  double scale;
+  int width, height;
+  double x(double wx) const { return (wx - world.min[0]) * scale; }
+  double y(double wy) const { return (world.max[1] - wy) * scale; }
+};
+
+inline bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+inline Frame frame_of(const Box2& world, int width) {
+  Frame f;
+  f.world = world;
+  const double w = std::max(world.extent(0), 1e-12), h = std::max(world.extent(1), 1e-12);
+  f.width = std::max(width, 16);
+  f.scale = f.width / w;
+  f.height = std::max(1, int(std::ceil(h * f.scale)));
+  return f;
+}
+
+inline void write_rect(std::FILE* o, const Frame& f, const Box2& r) {
+  std::fprintf(o, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", f.x(r.min[0]),
+               f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);
+}
+
+inline void write_linework(std::FILE* o, const Frame& f, const std::string& layer_path,
+                           const std::string& layer_name) {
+  auto src = open_layer(layer_path, layer_name);
+  std::fprintf(o, "<g fill=\"none\" stroke=\"#555\" stroke-width=\"0.5\">\n");
+  for (auto& feature : *src.layer) {
+    detail::for_each_curve(
+        feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
+          const int n = c.getNumPoints();
+          if (n < 2) return;
+          std::fprintf(o, "<path d=\"");
+          long lx = LONG_MIN, ly = LONG_MIN;
+          for (int i = 0; i < n; ++i) {
+            const long px = std::lround(f.x(c.getX(i)) * 10), py = std::lround(f.y(c.getY(i)) * 10);
+            if (px == lx && py == ly && i + 1 < n) continue;
+            std::fprintf(o, "%c%.1f %.1f", i == 0 ? 'M' : 'L', px / 10.0, py / 10.0);
+            lx = px;
+            ly = py;
+          }
+          std::fprintf(o, "\"/>\n");
+        });
+  }
+  std::fprintf(o, "</g>\n");
+}
+
+// The SVG's opening: size, view box and a white background.
+inline void write_svg_head(std::FILE* o, const Frame& f) {
+  std::fprintf(o,
+               "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
+               "viewBox=\"0 0 %d %d\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+               f.width, f.height, f.width, f.height);
+}
+
+}  // namespace loci::io::detail
