@@ -186,17 +186,6 @@ int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
   });
 }
 
-int x_open(sqlite3_vtab*, sqlite3_vtab_cursor** out) {
-  auto* c = new (std::nothrow) Cursor();
-  if (!c) return SQLITE_NOMEM;
-  *out = c;
-  return SQLITE_OK;
-}
-int x_close(sqlite3_vtab_cursor* cur) {
-  delete static_cast<Cursor*>(cur);
-  return SQLITE_OK;
-}
-
 int x_filter(sqlite3_vtab_cursor* cur, int plan, const char*, int argc, sqlite3_value** argv) {
   Cursor& c = *static_cast<Cursor*>(cur);
   return guarded(cur->pVtab, [&] {
@@ -297,9 +286,7 @@ int x_rename(sqlite3_vtab* v, const char* new_name) {
 }
 
 int x_shadow_name(const char* suffix) {
-  for (const char* s : kShadowSuffixes)
-    if (sqlite3_stricmp(suffix, s) == 0) return 1;
-  return 0;
+  return is_shadow_suffix(suffix, kShadowSuffixes);
 }
 
 sqlite3_module fleet_module() {
@@ -310,8 +297,8 @@ sqlite3_module fleet_module() {
   m.xBestIndex = x_best_index;
   m.xDisconnect = x_disconnect;
   m.xDestroy = x_destroy;
-  m.xOpen = x_open;
-  m.xClose = x_close;
+  m.xOpen = open_cursor<Cursor>;
+  m.xClose = close_cursor<Cursor>;
   m.xFilter = x_filter;
   m.xNext = x_next;
   m.xEof = x_eof;

@@ -446,9 +446,7 @@ int x_rename(sqlite3_vtab* v, const char* new_name) {
 }
 
 int x_shadow_name(const char* suffix) {
-  for (const char* s : kShadowSuffixes)
-    if (sqlite3_stricmp(suffix, s) == 0) return 1;
-  return 0;
+  return is_shadow_suffix(suffix, kShadowSuffixes);
 }
 
 sqlite3_module rtree_module() {

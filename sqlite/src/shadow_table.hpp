@@ -123,4 +123,11 @@ int register_fleet(sqlite3* db, const std::shared_ptr<Registry>& registry);
 int register_nearest(sqlite3* db, const std::shared_ptr<Registry>& registry);
 int register_fleet_functions(sqlite3* db, const std::shared_ptr<Registry>& registry);
 
+// xShadowName: whether `suffix` names one of a module's shadow tables.
+inline int is_shadow_suffix(const char* suffix, std::span<const char* const> suffixes) {
+  for (const char* s : suffixes)
+    if (sqlite3_stricmp(suffix, s) == 0) return 1;
+  return 0;
+}
+
 }  // namespace loci::sqlite

@@ -110,6 +110,20 @@ struct ResetOnExit {
 };
 
 // Runs SQL that returns nothing; throws SqlError.
+// xOpen and xClose of a module whose cursor type C needs nothing from its table.
+template <class C>
+int open_cursor(sqlite3_vtab*, sqlite3_vtab_cursor** out) {
+  auto* c = new (std::nothrow) C();
+  if (!c) return SQLITE_NOMEM;
+  *out = c;
+  return SQLITE_OK;
+}
+template <class C>
+int close_cursor(sqlite3_vtab_cursor* c) {
+  delete static_cast<C*>(c);
+  return SQLITE_OK;
+}
+
 inline void exec(sqlite3* db, const std::string& sql) {
   char* err = nullptr;
   if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {

@@ -82,17 +82,6 @@ int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
   return SQLITE_OK;
 }
 
-int x_open(sqlite3_vtab*, sqlite3_vtab_cursor** out) {
-  auto* c = new (std::nothrow) FunctionCursor();
-  if (!c) return SQLITE_NOMEM;
-  *out = c;
-  return SQLITE_OK;
-}
-int x_close(sqlite3_vtab_cursor* c) {
-  delete static_cast<FunctionCursor*>(c);
-  return SQLITE_OK;
-}
-
 int x_filter(sqlite3_vtab_cursor* cur, int, const char*, int argc, sqlite3_value** argv) {
   FunctionCursor& c = *static_cast<FunctionCursor*>(cur);
   const auto& t = *static_cast<FunctionTable*>(cur->pVtab);
@@ -141,8 +130,8 @@ sqlite3_module function_module() {
   m.xBestIndex = x_best_index;
   m.xDisconnect = x_disconnect;
   m.xDestroy = x_disconnect;
-  m.xOpen = x_open;
-  m.xClose = x_close;
+  m.xOpen = open_cursor<FunctionCursor>;
+  m.xClose = close_cursor<FunctionCursor>;
   m.xFilter = x_filter;
   m.xNext = x_next;
   m.xEof = x_eof;
