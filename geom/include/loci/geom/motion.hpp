@@ -95,7 +95,9 @@ struct LinearSpan {
   }
 };
 
-// A window whose bounds move linearly from `from` at t1 to `to` at t2 (t1 <= t2).
+// A window whose bounds move linearly from `from` at t1 to `to` at t2 (t1 <= t2). The
+// velocities of its bounds are worked out once, when it is made, since every test of an
+// object or a node against the window needs them; the window is a value, built whole.
 template <int D>
 struct MovingWindow {
   Box<D> from;
@@ -103,14 +105,22 @@ struct MovingWindow {
   double t1;
   double t2;
 
+  constexpr MovingWindow(const Box<D>& from_, const Box<D>& to_, double t1_, double t2_)
+      : from(from_),
+        to(to_),
+        t1(t1_),
+        t2(t2_),
+        vmin_(rate(from_.min, to_.min)),
+        vmax_(rate(from_.max, to_.max)) {}
+
   static constexpr MovingWindow at(const Box<D>& b, double t) { return {b, b, t, t}; }
   static constexpr MovingWindow during(const Box<D>& b, double t1, double t2) {
     return {b, b, t1, t2};
   }
 
   // Velocity of the bounds (zero for a fixed window or a timeslice).
-  constexpr Point<D> vmin() const { return rate(from.min, to.min); }
-  constexpr Point<D> vmax() const { return rate(from.max, to.max); }
+  constexpr const Point<D>& vmin() const { return vmin_; }
+  constexpr const Point<D>& vmax() const { return vmax_; }
 
   // The smallest box containing the window over [t1, t2].
   constexpr Box<D> hull() const { return merged(from, to); }
@@ -123,6 +133,8 @@ struct MovingWindow {
         r[i] = (b[i] - a[i]) / (t2 - t1);
     return r;
   }
+
+  Point<D> vmin_, vmax_;
 };
 
 // Throws InvalidGeometry for NaN or infinite bounds or times, an inverted box or t1 > t2.
@@ -141,7 +153,8 @@ template <int D>
 LinearSpan moving_box_meets(const Point<D>& lo, const Point<D>& vlo, const Point<D>& hi,
                             const Point<D>& vhi, double t, const MovingWindow<D>& w) {
   LinearSpan span{w.t1, w.t2};
-  const Point<D> wvmin = w.vmin(), wvmax = w.vmax();
+  const Point<D>& wvmin = w.vmin();
+  const Point<D>& wvmax = w.vmax();
   for (int i = 0; i < D && !span.empty(); ++i) {
     // Window bounds at time t (the box's reference time), extrapolated from t1.
     const double wlo = w.from.min[i] + wvmin[i] * (t - w.t1);

@@ -105,7 +105,8 @@ double swept_cost(const Tpbr<D>& b, double c, double horizon, const Point<D>& ex
 template <int D>
 bool tpbr_meets(const Tpbr<D>& b, double epoch, const MovingWindow<D>& w) {
   const double r1 = w.t1 - epoch, r2 = w.t2 - epoch;
-  const Point<D> wvmin = w.vmin(), wvmax = w.vmax();
+  const Point<D>& wvmin = w.vmin();
+  const Point<D>& wvmax = w.vmax();
   LinearSpan span{r1, r2};
   const double reach = std::max(std::abs(r1), std::abs(r2));
   for (int i = 0; i < D; ++i) {
