@@ -467,9 +467,7 @@ void run_conflicts(const Options& o) {
     const auto t0 = Clock::now();
     const auto full = loci::find_conflicts<2>(ids, fleet, within, now, horizon);
     const double tf = seconds_since(t0);
-    std::sort(inc.begin(), inc.end(), [](const loci::Conflict& x, const loci::Conflict& y) {
-      return x.a != y.a ? x.a < y.a : x.b < y.b;
-    });
+    loci::sort_conflicts(inc);
     bool same = inc.size() == full.size();
     for (std::size_t k = 0; same && k < inc.size(); ++k)
       same = inc[k].a == full[k].a && inc[k].b == full[k].b &&

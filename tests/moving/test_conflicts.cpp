@@ -19,9 +19,7 @@ std::vector<Conflict> brute(const std::vector<Id>& ids, const std::vector<Motion
     for (std::size_t j = i + 1; j < objs.size(); ++j)
       if (auto ap = closest_approach(objs[i], objs[j], now, horizon, within))
         out.push_back({std::min(ids[i], ids[j]), std::max(ids[i], ids[j]), *ap});
-  std::sort(out.begin(), out.end(), [](const Conflict& x, const Conflict& y) {
-    return x.a != y.a ? x.a < y.a : x.b < y.b;
-  });
+  sort_conflicts(out);
   return out;
 }
 
@@ -58,9 +56,7 @@ TEST(Conflicts, MatchBruteForceOnEveryFleet) {
                 return true;
               },
               slices);
-          std::sort(got.begin(), got.end(), [](const Conflict& x, const Conflict& y) {
-            return x.a != y.a ? x.a < y.a : x.b < y.b;
-          });
+          sort_conflicts(got);
           expect_same(got, want,
                       test::name(f) + " D=" + std::to_string(within) +
                           " H=" + std::to_string(horizon) + " slices=" + std::to_string(slices));

@@ -52,6 +52,13 @@ struct Conflict {
   Approach approach;
 };
 
+// Orders conflicts by (a, b), the order every list of conflicts is given in.
+inline void sort_conflicts(std::vector<Conflict>& v) {
+  std::sort(v.begin(), v.end(), [](const Conflict& x, const Conflict& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  });
+}
+
 // visitor(i, j, approach) with i < j; false stops.
 template <class F>
 concept ConflictVisitor = Visitor<F, std::uint32_t, std::uint32_t, const Approach&>;
@@ -249,9 +256,7 @@ std::vector<Conflict> find_conflicts(std::span<const Id> ids, std::span<const Mo
                       out.push_back({a, b, ap});
                       return true;
                     });
-  std::sort(out.begin(), out.end(), [](const Conflict& x, const Conflict& y) {
-    return x.a != y.a ? x.a < y.a : x.b < y.b;
-  });
+  sort_conflicts(out);
   return out;
 }
 
@@ -394,9 +399,7 @@ class ConflictMonitor {
   std::vector<Conflict> conflicts() const {
     std::vector<Conflict> out;
     conflicts([&](Id a, Id b, const Approach& ap) { return out.push_back({a, b, ap}), true; });
-    std::sort(out.begin(), out.end(), [](const Conflict& x, const Conflict& y) {
-      return x.a != y.a ? x.a < y.a : x.b < y.b;
-    });
+    sort_conflicts(out);
     return out;
   }
 
