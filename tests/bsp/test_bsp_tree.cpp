@@ -1,0 +1,367 @@
+// BspTree against brute force: point classification, and first impacts of moving points,
+// circles and boxes within the documented bevel error of the exact Minkowski answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "loci/index/broadphase/bsp_tree.hpp"
+#include "support/solid_reference.hpp"
+
+namespace loci {
+namespace {
+
+using test::first_contact_box;
+using test::first_contact_circle;
+using test::in_solid;
+using test::kNever;
+
+std::vector<Point2> star(double cx, double cy, int n, double rmin, double rmax,
+                         std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> rad(rmin, rmax);
+  std::vector<Point2> r;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * std::numbers::pi * i / n;
+    const double q = rad(rng);
+    r.push_back({cx + q * std::cos(a), cy + q * std::sin(a)});
+  }
+  return r;
+}
+
+// Rectangle with a vertex in the middle of every side (collinear neighbours).
+std::vector<Point2> rect(double x0, double y0, double x1, double y1) {
+  const double xm = (x0 + x1) / 2, ym = (y0 + y1) / 2;
+  return {{x0, y0}, {xm, y0}, {x1, y0}, {x1, ym}, {x1, y1}, {xm, y1}, {x0, y1}, {x0, ym}};
+}
+
+// An 8 x 8 grid of 10-unit cells holding stars (some with holes, some clockwise), full
+// blocks sharing their borders with neighbouring blocks, and half blocks meeting a
+// neighbour along part of a side.
+std::vector<BspPolygon> random_layer(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> kind(0, 5);
+  std::vector<BspPolygon> out;
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 8; ++j) {
+      const double x = 10.0 * i, y = 10.0 * j;
+      const int k = kind(rng);
+      BspPolygon p;
+      if (k <= 1) {
+        p.outer = star(x + 5, y + 5, 3 + static_cast<int>(rng() % 18), 1.5, 4.8, rng);
+        if (k == 1) {
+          p.holes.push_back(star(x + 5, y + 5, 3 + static_cast<int>(rng() % 8), 0.3, 1.2, rng));
+        }
+        if (rng() % 2) std::reverse(p.outer.begin(), p.outer.end());
+      } else if (k == 2) {
+        p.outer = rect(x, y, x + 10, y + 10);
+      } else if (k == 3) {
+        p.outer = rect(x, y + 2, x + 10, y + 7);
+      } else {
+        continue;
+      }
+      out.push_back(std::move(p));
+    }
+  }
+  return out;
+}
+
+double dist_to_edges(const std::vector<BspPolygon>& polys, const Point2& p) {
+  double near = kNever;
+  test::for_each_edge(std::span<const BspPolygon>(polys), [&](const Point2& a, const Point2& b) {
+    near = std::min(near, test::segment_distance(p, a, b));
+  });
+  return near;
+}
+
+TEST(BspTree, ClassifiesPointsLikeCrossingParity) {
+  for (std::uint64_t seed : {1, 2, 3}) {
+    const auto polys = random_layer(seed);
+    const BspTree tree = BspTree::build(polys);
+    tree.validate();
+    EXPECT_GT(tree.solid_leaves(), 0u);
+    std::mt19937_64 rng(seed * 7);
+    std::uniform_real_distribution<double> u(-5, 85);
+    int solid = 0;
+    for (int q = 0; q < 20000; ++q) {
+      const Point2 p{u(rng), u(rng)};
+      if (dist_to_edges(polys, p) < 1e-9) continue;
+      const bool want = in_solid(polys, p);
+      ASSERT_EQ(tree.solid(p), want) << "seed " << seed << " at " << p[0] << "," << p[1];
+      solid += want;
+    }
+    EXPECT_GT(solid, 1000);
+  }
+}
+
+TEST(BspTree, VerticesAndBordersCountAsSolid) {
+  const auto polys = random_layer(4);
+  const BspTree tree = BspTree::build(polys);
+  for (const BspPolygon& p : polys) {
+    for (const Point2& v : p.outer)
+      EXPECT_TRUE(tree.overlaps(v, BspCircle{1e-9}));
+    for (const auto& h : p.holes)
+      for (const Point2& v : h)
+        EXPECT_TRUE(tree.overlaps(v, BspCircle{1e-9}));
+  }
+}
+
+TEST(BspTree, SharedBordersLeaveOnlyTheOutline) {
+  std::vector<BspPolygon> polys;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      polys.push_back(
+          {{{1.0 * i, 1.0 * j}, {i + 1.0, 1.0 * j}, {i + 1.0, j + 1.0}, {1.0 * i, j + 1.0}}, {}});
+  const BspTree tree = BspTree::build(polys);
+  tree.validate();
+  EXPECT_EQ(tree.edges(), 40u);
+  EXPECT_TRUE(tree.solid({5, 5}));
+  EXPECT_TRUE(tree.solid({3, 4}));  // on an inner border
+  EXPECT_FALSE(tree.solid({-0.5, 5}));
+  EXPECT_FALSE(tree.solid({10.5, 5}));
+  // A circle moving right along y = 5 from x = -5 meets the block at x = -r.
+  const BspHit h = tree.trace({-5, 5}, {5, 5}, BspCircle{1});
+  ASSERT_TRUE(h.hit);
+  EXPECT_NEAR(h.point[0], -1, 1e-12);
+  EXPECT_NEAR(h.normal[0], -1, 1e-12);
+  EXPECT_NEAR(h.normal[1], 0, 1e-12);
+}
+
+// The guarantee of the header: never later than the exact first contact of the shape, never
+// earlier than that of a disc of radius R / cos(alpha / 2).
+void expect_within_bevel_error(const std::vector<BspPolygon>& polys, const BspTree& tree,
+                               double alpha, std::uint64_t seed, int moves) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-5, 85), len(0, 30), ang(0, 2 * std::numbers::pi),
+      rad(0, 3);
+  const double grow = 1 / std::cos(alpha / 2);
+  const double tol = 1e-9;
+  int hits = 0, inside = 0;
+  for (int q = 0; q < moves; ++q) {
+    const Point2 from{u(rng), u(rng)};
+    const double a = ang(rng), l = len(rng);
+    const Point2 to{from[0] + l * std::cos(a), from[1] + l * std::sin(a)};
+    const int shape = q % 3;
+    BspHit h;
+    double late = 0, early = 0;
+    if (shape == 0) {  // circle
+      const double r = rad(rng);
+      h = tree.trace(from, to, BspCircle{r});
+      late = first_contact_circle(polys, from, to, r);
+      early = first_contact_circle(polys, from, to, r * grow);
+    } else if (shape == 1) {  // box
+      const Point2 half{rad(rng), rad(rng)};
+      h = tree.trace(from, to, BspBox{half});
+      late = first_contact_box(polys, from, to, half);
+      early = first_contact_circle(polys, from, to, std::hypot(half[0], half[1]) * grow);
+    } else {  // a box whose reference point is its lower left corner
+      const Point2 half{rad(rng), rad(rng)};
+      const BspConvex k{{{0, 0}, {2 * half[0], 0}, {2 * half[0], 2 * half[1]}, {0, 2 * half[1]}}};
+      h = tree.trace(from, to, k);
+      const Point2 f2{from[0] + half[0], from[1] + half[1]}, t2{to[0] + half[0], to[1] + half[1]};
+      late = first_contact_box(polys, f2, t2, half);
+      early = first_contact_circle(polys, f2, t2, std::hypot(half[0], half[1]) * grow);
+    }
+    SCOPED_TRACE(testing::Message() << "move " << q << " shape " << shape << " from " << from[0]
+                                    << "," << from[1] << " to " << to[0] << "," << to[1]);
+    if (late <= 1) {
+      ASSERT_TRUE(h.hit);
+      ASSERT_LE(h.t, late + tol);
+    }
+    if (h.hit) {
+      ++hits;
+      ASSERT_LE(early, h.t + tol);
+      EXPECT_NEAR(h.point[0], from[0] + h.t * (to[0] - from[0]), 1e-9);
+      if (h.started_inside) {
+        ++inside;
+        EXPECT_EQ(h.t, 0);
+      } else {
+        EXPECT_NEAR(std::hypot(h.normal[0], h.normal[1]), 1, 1e-12);
+        // The plane of impact faces the motion.
+        EXPECT_LE(h.normal[0] * (to[0] - from[0]) + h.normal[1] * (to[1] - from[1]), 1e-9);
+      }
+    } else {
+      EXPECT_EQ(h.t, 1);
+    }
+  }
+  EXPECT_GT(hits, moves / 5);
+  EXPECT_GT(inside, 0);
+  EXPECT_LT(inside, hits);
+}
+
+TEST(BspTree, FirstImpactWithinBevelErrorDefault) {
+  for (std::uint64_t seed : {11, 12}) {
+    const auto polys = random_layer(seed);
+    const BspTree tree = BspTree::build(polys);
+    tree.validate();
+    EXPECT_GT(tree.bevel_count(), 0u);
+    expect_within_bevel_error(polys, tree, BspParams{}.bevel_angle, seed, 1500);
+  }
+}
+
+TEST(BspTree, FirstImpactWithinBevelErrorCoarseBevels) {
+  const auto polys = random_layer(13);
+  BspParams params;
+  params.bevel_angle = std::numbers::pi / 2;
+  const BspTree tree = BspTree::build(polys, params);
+  tree.validate();
+  expect_within_bevel_error(polys, tree, params.bevel_angle, 13, 1500);
+  // Finer bevels cost nodes.
+  EXPECT_LT(tree.node_count(), BspTree::build(polys).node_count());
+}
+
+TEST(BspTree, WithoutBevelsNothingIsMissed) {
+  const auto polys = random_layer(14);
+  BspParams params;
+  params.bevel_angle = std::numbers::pi;
+  const BspTree tree = BspTree::build(polys, params);
+  EXPECT_EQ(tree.bevel_count(), 0u);
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> u(-5, 85), rad(0, 3);
+  for (int q = 0; q < 800; ++q) {
+    const Point2 from{u(rng), u(rng)}, to{u(rng), u(rng)};
+    const double r = rad(rng);
+    const double late = first_contact_circle(polys, from, to, r);
+    const BspHit h = tree.trace(from, to, BspCircle{r});
+    if (late <= 1) {
+      ASSERT_TRUE(h.hit);
+      ASSERT_LE(h.t, late + 1e-9);
+    }
+  }
+}
+
+TEST(BspTree, PointTracesAreExact) {
+  const auto polys = random_layer(15);
+  const BspTree tree = BspTree::build(polys);
+  std::mt19937_64 rng(15);
+  std::uniform_real_distribution<double> u(-5, 85);
+  for (int q = 0; q < 2000; ++q) {
+    const Point2 from{u(rng), u(rng)}, to{u(rng), u(rng)};
+    const double want = first_contact_circle(polys, from, to, 0);
+    const BspHit h = tree.trace(from, to, BspPoint{});
+    if (want <= 1) {
+      ASSERT_TRUE(h.hit) << q;
+      ASSERT_NEAR(h.t, want, 1e-9) << q;
+    } else {
+      ASSERT_FALSE(h.hit) << q;
+    }
+  }
+}
+
+TEST(BspTree, StationaryOverlapWithinBevelError) {
+  const auto polys = random_layer(16);
+  const BspTree tree = BspTree::build(polys);
+  const double grow = 1 / std::cos(BspParams{}.bevel_angle / 2);
+  std::mt19937_64 rng(16);
+  std::uniform_real_distribution<double> u(-5, 85), rad(0, 3);
+  int yes = 0, no = 0;
+  for (int q = 0; q < 5000; ++q) {
+    const Point2 p{u(rng), u(rng)};
+    const double r = rad(rng);
+    const double dist = in_solid(polys, p) ? 0 : dist_to_edges(polys, p);
+    const bool got = tree.overlaps(p, BspCircle{r});
+    if (dist <= r * (1 - 1e-12)) ASSERT_TRUE(got) << q;
+    if (dist > r * grow * (1 + 1e-12)) ASSERT_FALSE(got) << q;
+    (got ? yes : no)++;
+  }
+  EXPECT_GT(yes, 500);
+  EXPECT_GT(no, 500);
+}
+
+TEST(BspTree, SlideAlongAWall) {
+  // Solid below y = 0; a circle of radius 1 moving down and right hits at (4, 1) halfway and
+  // slides along the wall for the rest of its move.
+  const std::vector<BspPolygon> polys{{{{-50, -10}, {50, -10}, {50, 0}, {-50, 0}}, {}}};
+  const BspTree tree = BspTree::build(polys);
+  const BspHit h = tree.trace({2, 5}, {6, -3}, BspCircle{1});
+  ASSERT_TRUE(h.hit);
+  EXPECT_NEAR(h.t, 0.5, 1e-12);
+  EXPECT_NEAR(h.point[0], 4, 1e-12);
+  EXPECT_NEAR(h.point[1], 1, 1e-12);
+  EXPECT_NEAR(h.normal[1], 1, 1e-12);
+  const BspSlide s = tree.slide({2, 5}, {6, -3}, BspCircle{1});
+  EXPECT_EQ(s.contacts, 1);
+  EXPECT_FALSE(s.stuck);
+  EXPECT_NEAR(s.position[0], 6, 1e-6);
+  EXPECT_NEAR(s.position[1], 1, 1e-6);
+  EXPECT_GE(s.position[1], 1);
+}
+
+TEST(BspTree, SlidesNeverEndInsideTheSolid) {
+  const auto polys = random_layer(17);
+  const BspTree tree = BspTree::build(polys);
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-5, 85), rad(0.1, 2);
+  int contacts = 0;
+  for (int q = 0; q < 600; ++q) {
+    const Point2 from{u(rng), u(rng)}, to{u(rng), u(rng)};
+    const double r = rad(rng);
+    if (tree.overlaps(from, BspCircle{r})) continue;
+    const BspSlide s = tree.slide(from, to, BspCircle{r});
+    contacts += s.contacts;
+    ASSERT_FALSE(tree.overlaps(s.position, BspCircle{r})) << q;
+    ASSERT_EQ(first_contact_circle(polys, s.position, s.position, r), kNever) << q;
+  }
+  EXPECT_GT(contacts, 100);
+}
+
+TEST(BspTree, DeepChainOfAConvexPolygon) {
+  // A regular 2,000-gon: every edge's line leaves all the others behind it.
+  std::vector<Point2> ring;
+  for (int i = 0; i < 2000; ++i) {
+    const double a = 2 * std::numbers::pi * i / 2000;
+    ring.push_back({100 * std::cos(a), 100 * std::sin(a)});
+  }
+  const std::vector<BspPolygon> polys{{ring, {}}};
+  const BspTree tree = BspTree::build(polys);
+  tree.validate();
+  EXPECT_TRUE(tree.solid({0, 0}));
+  EXPECT_FALSE(tree.solid({99.99, 99.99}));
+  const BspHit h = tree.trace({-300, 0}, {300, 0}, BspCircle{5});
+  ASSERT_TRUE(h.hit);
+  EXPECT_NEAR(h.point[0], -105, 1e-3);
+}
+
+TEST(BspTree, EmptyLayerAndDegenerateMoves) {
+  const BspTree none = BspTree::build(std::vector<BspPolygon>{});
+  none.validate();
+  EXPECT_TRUE(none.empty());
+  EXPECT_FALSE(none.trace({0, 0}, {1, 1}, BspCircle{5}).hit);
+  EXPECT_FALSE(none.solid({0, 0}));
+
+  const std::vector<BspPolygon> polys{{{{0, 0}, {10, 0}, {10, 10}, {0, 10}}, {}}};
+  const BspTree tree = BspTree::build(polys);
+  // Starting inside.
+  const BspHit in = tree.trace({5, 5}, {50, 50}, BspPoint{});
+  EXPECT_TRUE(in.hit && in.started_inside);
+  EXPECT_EQ(in.t, 0);
+  EXPECT_EQ(in.normal[0], 0);
+  // A move of length zero outside, and one touching a corner exactly.
+  EXPECT_FALSE(tree.trace({20, 20}, {20, 20}, BspCircle{1}).hit);
+  const BspHit corner = tree.trace({-1, 11}, {1, 9}, BspPoint{});
+  ASSERT_TRUE(corner.hit);
+  EXPECT_NEAR(corner.t, 0.5, 1e-12);
+  // Moving along the wall at exactly the radius touches it all the way.
+  EXPECT_TRUE(tree.trace({-5, 11}, {15, 11}, BspCircle{1}).hit);
+  EXPECT_FALSE(tree.trace({-5, 11.001}, {15, 11.001}, BspCircle{1}).hit);
+}
+
+TEST(BspTree, RejectsBadInput) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  using V = std::vector<BspPolygon>;
+  EXPECT_THROW(BspTree::build(V{{{{0, 0}, {1, 0}, {nan, 1}}, {}}}), InvalidGeometry);
+  EXPECT_THROW(BspTree::build(V{{{{0, 0}, {1, 0}, {0, 0}}, {}}}), InvalidGeometry);
+  EXPECT_THROW(BspTree::build(V{{{{0, 0}, {1, 1}, {2, 2}}, {}}}), InvalidGeometry);
+  EXPECT_THROW(BspTree::build(V{{{{0, 0}, {1, 0}, {1, 1}}, {{{0, 0}}}}}), InvalidGeometry);
+  BspParams bad;
+  bad.bevel_angle = 0;
+  EXPECT_THROW(BspTree::build(V{}, bad), InvalidArgument);
+  bad.bevel_angle = 4;
+  EXPECT_THROW(BspTree::build(V{}, bad), InvalidArgument);
+  const BspTree tree = BspTree::build(V{{{{0, 0}, {1, 0}, {1, 1}}, {}}});
+  EXPECT_THROW(tree.trace({nan, 0}, {1, 1}, BspPoint{}), InvalidGeometry);
+}
+
+}  // namespace
+}  // namespace loci
