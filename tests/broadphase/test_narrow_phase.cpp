@@ -232,7 +232,7 @@ double signed_area(std::span<const Point2> p) {
   return a / 2;
 }
 
-TEST(ConvexPolygon, NormalizesOrientationRepeatsAndStraightVertices) {
+TEST(NarrowPhaseInput, ConvexPolygonNormalizesOrientationRepeatsAndStraightVertices) {
   const ConvexPolygon ccw{{0, 0}, {2, 0}, {2, 2}, {0, 2}};
   const ConvexPolygon cw{{0, 2}, {2, 2}, {2, 0}, {0, 0}};
   EXPECT_EQ(ccw.size(), 4u);
@@ -253,7 +253,7 @@ TEST(ConvexPolygon, NormalizesOrientationRepeatsAndStraightVertices) {
   EXPECT_EQ(line.box(), (Box2{{0, 0}, {3, 3}}));
 }
 
-TEST(ConvexPolygon, RefusesBadInput) {
+TEST(NarrowPhaseInput, ConvexPolygonRefusesBadInput) {
   EXPECT_THROW(ConvexPolygon(std::span<const Point2>()), InvalidGeometry);
   const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
   EXPECT_THROW(ConvexPolygon({{0, 0}, {nan, 1}, {1, 1}}), InvalidGeometry);
@@ -271,7 +271,7 @@ TEST(ConvexPolygon, RefusesBadInput) {
                InvalidGeometry);
 }
 
-TEST(NarrowPhase, RefusesBadArguments) {
+TEST(NarrowPhaseInput, RefusesBadArguments) {
   const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
   EXPECT_THROW(Circle({0, 0}, -1), InvalidGeometry);
   EXPECT_THROW(Circle({0, 0}, nan), InvalidGeometry);
@@ -297,7 +297,7 @@ TEST(NarrowPhase, RefusesBadArguments) {
 
 // ---- Overlap -----------------------------------------------------------------------------
 
-TEST(Overlap, TouchingCounts) {
+TEST(NarrowPhaseOverlap, TouchingCounts) {
   const ConvexPolygon sq{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   // Edge to edge, vertex to vertex, vertex on an edge; then a hair apart.
   EXPECT_TRUE(intersects(sq, ConvexPolygon{{1, 0}, {2, 0}, {2, 1}, {1, 1}}));
@@ -323,7 +323,7 @@ TEST(Overlap, TouchingCounts) {
   EXPECT_TRUE(intersects(Sphere3({0, 0, 0}, 1), Box3{{1, -5, -5}, {2, 5, 5}}));
 }
 
-TEST(Overlap, DegenerateShapes) {
+TEST(NarrowPhaseOverlap, DegenerateShapes) {
   const ConvexPolygon sq{{0, 0}, {2, 0}, {2, 2}, {0, 2}};
   const ConvexPolygon point{{1, 1}}, corner{{2, 2}}, outside{{3, 1}};
   EXPECT_TRUE(intersects(sq, point));
@@ -363,7 +363,7 @@ TEST(Overlap, DegenerateShapes) {
 
 // Every ordered pair of kinds against the references: the exact one for polygons, GMP for
 // circles, allowing circles to differ within 1e-12 of tangency.
-TEST(Overlap, RandomAgainstReferences) {
+TEST(NarrowPhaseOverlap, RandomAgainstReferences) {
   Gen g(20240611);
   int agree = 0, met = 0, missed = 0, near_tangent = 0;
   for (int trial = 0; trial < 6000; ++trial) {
@@ -396,7 +396,7 @@ TEST(Overlap, RandomAgainstReferences) {
 
 // Integer polygons on a small grid: exact touches, shared and collinear edges, points and
 // segments. Polygons and boxes must agree with the reference exactly.
-TEST(Overlap, ExactTouchesOnAGrid) {
+TEST(NarrowPhaseOverlap, ExactTouchesOnAGrid) {
   Gen g(77);
   int met = 0, missed = 0;
   for (int trial = 0; trial < 4000; ++trial) {
@@ -424,7 +424,7 @@ TEST(Overlap, ExactTouchesOnAGrid) {
   EXPECT_GT(missed, 800);
 }
 
-TEST(Overlap, Random3D) {
+TEST(NarrowPhaseOverlap, Random3D) {
   Gen g(31);
   int met = 0, missed = 0;
   for (int trial = 0; trial < 4000; ++trial) {
@@ -560,15 +560,15 @@ void random_contacts(std::uint64_t seed, double offset, double tol) {
   EXPECT_GT(at_start, 5);
 }
 
-TEST(Contact, RandomAgainstSimulation) {
+TEST(NarrowPhaseContact, RandomAgainstSimulation) {
   random_contacts(5, 0, kTol);
 }
 
-TEST(Contact, LargeCoordinates) {
+TEST(NarrowPhaseContact, LargeCoordinates) {
   random_contacts(6, 1e6, 1e-7);
 }
 
-TEST(Contact, Random3DAgainstSimulation) {
+TEST(NarrowPhaseContact, Random3DAgainstSimulation) {
   Gen g(8);
   const double t0 = 0, t1 = 10, dt = 0.02;
   int hits = 0, misses = 0;
@@ -617,7 +617,7 @@ TEST(Contact, Random3DAgainstSimulation) {
 
 // The circle-box contact (piecewise quadratic) against the circle-polygon one (the grown
 // polygon) on the box's corners, and boxes against their polygons: two methods each.
-TEST(Contact, MethodsAgree) {
+TEST(NarrowPhaseContact, MethodsAgree) {
   Gen g(12);
   int hits = 0;
   for (int trial = 0; trial < 3000; ++trial) {
@@ -658,7 +658,7 @@ TEST(Contact, MethodsAgree) {
   EXPECT_GT(hits, 300);
 }
 
-TEST(Contact, HandCases) {
+TEST(NarrowPhaseContact, HandCases) {
   const Point2 still{0, 0};
   const ConvexPolygon sq{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   const ConvexPolygon right{{3, 0}, {4, 0}, {4, 1}, {3, 1}};
@@ -713,7 +713,7 @@ TEST(Contact, HandCases) {
   EXPECT_FALSE(intersects(Circle({10, 0}, 0.05), wall));
 }
 
-TEST(Contact, DegeneratePolygons) {
+TEST(NarrowPhaseContact, DegeneratePolygons) {
   const Point2 still{0, 0};
   const ConvexPolygon sq{{0, 0}, {2, 0}, {2, 2}, {0, 2}};
   // A point flying into a square, along an edge's line, past a corner.
