@@ -95,6 +95,39 @@ TEST(BspTree, ClassifiesPointsLikeCrossingParity) {
   }
 }
 
+// Real layers overlap a little where neighbours meet; here stars are laid across the corners
+// of the cells, over the blocks and stars of the layer.
+std::vector<BspPolygon> overlapping_layer(std::uint64_t seed) {
+  std::vector<BspPolygon> polys = random_layer(seed);
+  std::mt19937_64 rng(seed + 100);
+  for (int i = 1; i < 8; i += 2)
+    for (int j = 1; j < 8; j += 2)
+      polys.push_back({star(10.0 * i, 10.0 * j, 5 + static_cast<int>(rng() % 10), 2, 7, rng), {}});
+  return polys;
+}
+
+TEST(BspTree, OverlappingPolygons) {
+  for (std::uint64_t seed : {21, 22}) {
+    const auto polys = overlapping_layer(seed);
+    const BspTree tree = BspTree::build(polys);
+    tree.validate();
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-5, 85);
+    for (int q = 0; q < 20000; ++q) {
+      const Point2 p{u(rng), u(rng)};
+      if (dist_to_edges(polys, p) < 1e-9) continue;
+      ASSERT_EQ(tree.solid(p), in_solid(polys, p)) << p[0] << "," << p[1];
+    }
+    for (int q = 0; q < 1000; ++q) {
+      const Point2 from{u(rng), u(rng)}, to{u(rng), u(rng)};
+      const double want = first_contact_circle(polys, from, to, 0);
+      const BspHit h = tree.trace(from, to, BspPoint{});
+      ASSERT_EQ(h.hit, want <= 1) << q;
+      if (h.hit) ASSERT_NEAR(h.t, want, 1e-9) << q;
+    }
+  }
+}
+
 TEST(BspTree, VerticesAndBordersCountAsSolid) {
   const auto polys = random_layer(4);
   const BspTree tree = BspTree::build(polys);
@@ -198,6 +231,12 @@ TEST(BspTree, FirstImpactWithinBevelErrorDefault) {
     EXPECT_GT(tree.bevel_count(), 0u);
     expect_within_bevel_error(polys, tree, BspParams{}.bevel_angle, seed, 1500);
   }
+}
+
+TEST(BspTree, FirstImpactWithinBevelErrorOverlapping) {
+  const auto polys = overlapping_layer(23);
+  const BspTree tree = BspTree::build(polys);
+  expect_within_bevel_error(polys, tree, BspParams{}.bevel_angle, 23, 1000);
 }
 
 TEST(BspTree, FirstImpactWithinBevelErrorCoarseBevels) {

@@ -17,9 +17,14 @@
 // orientation predicate (geom/predicates.hpp) on the original end points, so that pieces
 // never drift across a line through rounding. Collinear edges facing the same way lie on the
 // node's plane and are done; collinear edges facing the other way (a border shared by two
-// polygons) go to the front side. A side left without edges is a leaf: empty in front of the
-// splitter, solid behind it (the boundary does not cross the region, and the splitter's own
-// edge tells which side is solid). Polygons may share borders, not overlap.
+// polygons) go to the front side. A side left without edges is a leaf, solid or empty as a
+// whole since no boundary crosses it. Behind the splitter it is solid (the splitter's own
+// polygon covers it). In front it is empty unless another polygon covers the splitter's
+// piece, which happens where polygons overlap (neighbouring countries in real data do, by
+// rounding): the middle of the piece is located by crossing parity against the other
+// polygons (edges bucketed in bands of y), a polygon whose boundary it lies on not counting.
+// Deciding from the piece rather than from a point inside the cell keeps thin cells right.
+// Polygons may overlap and share borders.
 //
 // Plane shifting. An object occupies x + K (K a convex shape around its reference point x).
 // It meets a convex solid cell C exactly when x lies in C + (-K), which is contained in the
@@ -340,6 +345,87 @@ namespace detail {
 struct BspEdge {
   Point2 a, b;
   double nx, ny, d;  // unit normal to the right (out of the solid), n.a = d
+  std::uint32_t polygon;
+};
+
+// Whether a point lies inside any of the polygons but one, by crossing parity of the ray
+// towards +x against each polygon's edges (decided exactly, half-open in y), the edges
+// bucketed in horizontal bands. A polygon with the point on its boundary does not count.
+class BspPointLocator {
+ public:
+  BspPointLocator(const std::vector<BspEdge>& edges, std::uint32_t polygons, const Box2& bounds)
+      : edges_(edges), parity_(polygons, 0) {
+    const std::size_t bands = std::clamp<std::size_t>(edges.size() / 8, 1, 1 << 14);
+    y0_ = bounds.min[1];
+    const double h = bounds.max[1] - bounds.min[1];
+    scale_ = h > 0 ? static_cast<double>(bands) / h : 0;
+    start_.assign(bands + 1, 0);
+    auto span = [&](const BspEdge& e) {
+      return std::pair{band(std::min(e.a[1], e.b[1])), band(std::max(e.a[1], e.b[1]))};
+    };
+    for (const BspEdge& e : edges) {
+      const auto [lo, hi] = span(e);
+      for (std::size_t b = lo; b <= hi; ++b)
+        ++start_[b + 1];
+    }
+    for (std::size_t b = 0; b < bands; ++b)
+      start_[b + 1] += start_[b];
+    items_.resize(start_[bands]);
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (std::uint32_t i = 0; i < edges.size(); ++i) {
+      const auto [lo, hi] = span(edges[i]);
+      for (std::size_t b = lo; b <= hi; ++b)
+        items_[fill[b]++] = i;
+    }
+  }
+
+  bool inside_other(const Point2& p, std::uint32_t except) {
+    if (!(p[1] >= y0_) || start_.size() < 2) return false;
+    const std::size_t b = band(p[1]);
+    bool any = false;
+    touched_.clear();
+    auto touch = [&](std::uint32_t q) {
+      if (!parity_[q]) touched_.push_back(q);
+    };
+    for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) {
+      const BspEdge& e = edges_[items_[k]];
+      if (e.polygon == except) continue;
+      const Point2& lo = e.a[1] < e.b[1] ? e.a : e.b;
+      const Point2& hi = e.a[1] < e.b[1] ? e.b : e.a;
+      if (p[1] < lo[1] || p[1] > hi[1]) continue;
+      const Orientation o = orientation(lo, hi, p);
+      if (o == Orientation::collinear) {
+        if (std::min(lo[0], hi[0]) <= p[0] && p[0] <= std::max(lo[0], hi[0])) {
+          touch(e.polygon);
+          parity_[e.polygon] |= 2;  // on its boundary
+        }
+        continue;
+      }
+      if (p[1] == hi[1] || o != Orientation::counterclockwise) continue;
+      touch(e.polygon);
+      parity_[e.polygon] ^= 1;
+      parity_[e.polygon] |= 4;  // touched
+    }
+    for (const std::uint32_t q : touched_) {
+      any = any || parity_[q] == 5;
+      parity_[q] = 0;
+    }
+    return any;
+  }
+
+ private:
+  std::size_t band(double y) const {
+    const double f = (y - y0_) * scale_;
+    const std::size_t last = start_.size() - 2;
+    if (!(f > 0)) return 0;
+    return std::min(last, static_cast<std::size_t>(f));
+  }
+
+  const std::vector<BspEdge>& edges_;
+  std::vector<std::uint8_t> parity_;
+  std::vector<std::uint32_t> touched_;
+  std::vector<std::uint32_t> start_, items_;
+  double y0_ = 0, scale_ = 0;
 };
 // A piece [s0, s1] of an edge (points a + s (b - a)), what is left of it inside a cell.
 struct BspPiece {
@@ -423,6 +509,7 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
   // Edges, the solid on their left.
   std::vector<BspEdge> edges;
   Box2 bounds = Box2::empty();
+  std::uint32_t polygon = 0;
   auto add_ring = [&](const std::vector<Point2>& ring, bool ccw, const std::string& what) {
     const std::vector<Point2> r = detail::bsp_ring(ring, ccw, what);
     for (std::size_t i = 0; i < r.size(); ++i) {
@@ -432,7 +519,7 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
       const double dx = b[0] - a[0], dy = b[1] - a[1];
       const double len = std::hypot(dx, dy);
       const double nx = dy / len, ny = -dx / len;
-      edges.push_back({a, b, nx, ny, nx * a[0] + ny * a[1]});
+      edges.push_back({a, b, nx, ny, nx * a[0] + ny * a[1], polygon});
     }
   };
   for (std::size_t i = 0; i < polygons.size(); ++i) {
@@ -440,7 +527,10 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
     add_ring(polygons[i].outer, true, what + " outer ring");
     for (std::size_t h = 0; h < polygons[i].holes.size(); ++h)
       add_ring(polygons[i].holes[h], false, what + " hole " + std::to_string(h));
+    ++polygon;
   }
+  // Every edge, for locating points against the polygons.
+  const std::vector<BspEdge> all_edges = edges;
 
   // A border shared by two polygons appears as an edge and its reverse, inside the union:
   // both go.
@@ -481,6 +571,7 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
   BspTree tree;
   tree.edges_ = edges.size();
   if (edges.empty()) return tree;
+  detail::BspPointLocator locator(all_edges, polygon, bounds);
 
   // The root cell: the layer's bounds with a wide margin (solid cells never reach it).
   const double margin =
@@ -592,6 +683,8 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
     }
     const std::uint32_t li = pieces[best].edge;
     const BspEdge& l = edges[li];
+    const double mid = (pieces[best].s0 + pieces[best].s1) / 2;
+    const Point2 piece_mid{l.a[0] + mid * (l.b[0] - l.a[0]), l.a[1] + mid * (l.b[1] - l.a[1])};
 
     std::vector<BspPiece> back, front;
     for (const BspPiece& q : pieces) {
@@ -631,6 +724,10 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
     std::vector<BspCellVertex> back_cell = detail::bsp_clip_cell(w.cell, l.nx, l.ny, l.d, 1);
     std::vector<BspCellVertex> front_cell = detail::bsp_clip_cell(w.cell, l.nx, l.ny, l.d, -1);
     if (front.empty()) {
+      // Empty unless another polygon covers the splitter's piece.
+      std::int32_t leaf = kEmpty;
+      if (locator.inside_other(piece_mid, l.polygon)) leaf = solid_leaf(front_cell, w.depth + 1);
+      tree.nodes_[static_cast<std::size_t>(k)].front = leaf;
       tree.depth_ = std::max(tree.depth_, w.depth + 1);
     } else {
       work.push_back({k, true, std::move(front), std::move(front_cell), w.depth + 1});
