@@ -4,9 +4,11 @@
 //
 // Workload (issue 9): boxes of half-size 1..3 on each axis, about one per 100 area units,
 // moving at constant speed (up to 1.4 per tick, or 0.05 for the coherent workload) and
-// bouncing off the world's walls. Every structure is told every box's new position each tick
-// and asked for every overlapping pair; the time of both is the tick's time. The pair sets are
-// checked identical (count and a hash of the sorted pairs) against the first library's.
+// bouncing off the world's walls. The large workload moves as the fast one, but a tenth of the
+// boxes (drawn at random) have half-sizes 10..30: a grid sized for the small boxes loses there.
+// Every structure is told every box's new position each tick and asked for every overlapping pair;
+// the time of both is the tick's time. The pair sets are checked identical (count and a hash of the
+// sorted pairs) against the first library's.
 //
 // Peers, as used here: CGAL gets a fresh vector of boxes each tick (it keeps nothing); Bullet's
 // broad phases get setAabb() for every proxy, then calculateOverlappingPairs(), and their pair
@@ -16,8 +18,9 @@
 // and queries the tree with every box, as a broad phase built on it does when all move.
 //
 // Usage: bench_broadphase [--n N[,N...]] [--ticks T] [--peer-ticks P] [--workload
-// fast|coherent|all] Slow peers (Bullet, Box2D) run P ticks (default 10) at N >= 50,000 to keep the
-// run short; medians are per tick, so the ratios stay comparable. Fixed seeds.
+// fast|coherent|large|all] [--peers no]. Slow peers (Bullet, Box2D) run P ticks (default 10) at N
+// >= 50,000 to keep the run short; medians are per tick, so the ratios stay comparable. Fixed
+// seeds.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -59,7 +62,10 @@ struct Motion {
   std::vector<double> vx, vy;
   double side;
 
-  Motion(std::size_t n, double max_speed, std::uint64_t seed) : side(std::sqrt(double(n) * 100)) {
+  // A fraction `large` of the boxes get half-sizes 10..30 instead of 1..3 (with large = 0 the
+  // random sequence, hence the boxes, are those of the other workloads).
+  Motion(std::size_t n, double max_speed, double large, std::uint64_t seed)
+      : side(std::sqrt(double(n) * 100)) {
     std::mt19937_64 rng(seed);
     auto u = [&](double lo, double hi) {
       return std::uniform_real_distribution<double>(lo, hi)(rng);
@@ -68,7 +74,9 @@ struct Motion {
     vx.resize(n);
     vy.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
-      const double hx = u(1, 3), hy = u(1, 3), cx = u(hx, side - hx), cy = u(hy, side - hy);
+      const double scale = large > 0 && u(0, 1) < large ? 10 : 1;
+      const double hx = scale * u(1, 3), hy = scale * u(1, 3);
+      const double cx = u(hx, side - hx), cy = u(hy, side - hy);
       boxes[i] = {{cx - hx, cy - hy}, {cx + hx, cy + hy}};
       const double speed = u(0, max_speed), angle = u(0, 2 * M_PI);
       vx[i] = speed * std::cos(angle);
@@ -239,9 +247,16 @@ std::uint64_t hash_pairs(Pairs& p) {
   return h ^ p.size();
 }
 
+// A workload: the speed limit and the fraction of large boxes.
+struct Workload {
+  const char* name;
+  double speed;
+  double large;
+};
+
 template <class Lib>
-Result run(Lib& lib, std::size_t n, double speed, int ticks) {
-  Motion m(n, speed, 42);
+Result run(Lib& lib, std::size_t n, const Workload& w, int ticks) {
+  Motion m(n, w.speed, w.large, 42);
   lib.init(m.boxes);
   Result r;
   r.name = lib.name();
@@ -303,47 +318,46 @@ void report(const std::vector<Result>& rs, std::size_t n, const char* workload) 
                 b2->median_ms / tree->median_ms);
 }
 
-void bench(std::size_t n, double speed, const char* workload, int ticks, int peer_ticks,
-           bool peers) {
+void bench(std::size_t n, const Workload& w, int ticks, int peer_ticks, bool peers) {
   const int slow = n >= 50000 ? std::min(ticks, peer_ticks) : ticks;
   std::vector<Result> rs;
   {
     Loci<loci::SweepPrune<2>> l("loci SweepPrune");
-    rs.push_back(run(l, n, speed, ticks));
+    rs.push_back(run(l, n, w, ticks));
   }
   {
     Loci<loci::IncrementalSweepPrune<2>> l("loci IncrementalSweepPrune");
-    rs.push_back(run(l, n, speed, ticks));
+    rs.push_back(run(l, n, w, ticks));
   }
   {
     Loci<loci::UniformGrid<2>> l("loci UniformGrid");
-    rs.push_back(run(l, n, speed, ticks));
+    rs.push_back(run(l, n, w, ticks));
   }
   {
     Loci<loci::DynamicAabbTree<2>> l("loci DynamicAabbTree");
-    rs.push_back(run(l, n, speed, ticks));
+    rs.push_back(run(l, n, w, ticks));
   }
   {
     Cgal c;
-    rs.push_back(run(c, n, speed, ticks));
+    rs.push_back(run(c, n, w, ticks));
   }
 #if LOCI_HAVE_BULLET
   if (peers) {
     BulletDbvt b;
-    rs.push_back(run(b, n, speed, slow));
+    rs.push_back(run(b, n, w, slow));
   }
   if (peers) {
     BulletSap b(std::sqrt(double(n) * 100));
-    rs.push_back(run(b, n, speed, slow));
+    rs.push_back(run(b, n, w, slow));
   }
 #endif
 #if LOCI_HAVE_BOX2D
   if (peers) {
     auto b = std::make_unique<Box2dTree>();
-    rs.push_back(run(*b, n, speed, slow));
+    rs.push_back(run(*b, n, w, slow));
   }
 #endif
-  report(rs, n, workload);
+  report(rs, n, w.name);
 }
 
 }  // namespace
@@ -373,16 +387,19 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: bench_broadphase [--n N,...] [--ticks T] [--peer-ticks P] [--workload "
-                   "fast|coherent|all]\n");
+                   "fast|coherent|large|all] [--peers no]\n");
       return 1;
     }
   }
   std::printf("bench_broadphase: median time per tick (moves + all pairs), fixed seed 42\n");
   for (const std::size_t n : ns) {
     if (workload == "all" || workload == "fast")
-      bench(n, 1.4, "fast (speed <= 1.4)", ticks, peer_ticks, peers);
+      bench(n, {"fast (speed <= 1.4)", 1.4, 0}, ticks, peer_ticks, peers);
     if (workload == "all" || workload == "coherent")
-      bench(n, 0.05, "coherent (speed <= 0.05)", ticks, peer_ticks, peers);
+      bench(n, {"coherent (speed <= 0.05)", 0.05, 0}, ticks, peer_ticks, peers);
+    if (workload == "all" || workload == "large")
+      bench(n, {"large (10% of boxes half-size 10..30, speed <= 1.4)", 1.4, 0.1}, ticks, peer_ticks,
+            peers);
   }
   return 0;
 }
