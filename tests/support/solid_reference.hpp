@@ -35,9 +35,9 @@ void for_each_edge(std::span<const BspPolygon> polys, F&& f) {
 }
 
 inline bool on_segment(const Point2& p, const Point2& a, const Point2& b) {
-  return orientation(a, b, p) == Orientation::collinear && std::min(a[0], b[0]) <= p[0] &&
-         p[0] <= std::max(a[0], b[0]) && std::min(a[1], b[1]) <= p[1] &&
-         p[1] <= std::max(a[1], b[1]);
+  return std::min(a[0], b[0]) <= p[0] && p[0] <= std::max(a[0], b[0]) &&
+         std::min(a[1], b[1]) <= p[1] && p[1] <= std::max(a[1], b[1]) &&
+         orientation(a, b, p) == Orientation::collinear;
 }
 
 // Whether p is in the closed solid: on an edge, or inside a polygon by crossing parity over
@@ -112,19 +112,26 @@ inline double capsule_entry(const Point2& p0, const Point2& d, const Point2& a, 
 }
 
 // Exact first contact (fraction of the move) of a circle of radius r moving from `from` to
-// `to` with the solid; 0 when it starts in contact, kNever when it never meets it.
+// `to` with the solid; 0 when it starts in contact, kNever when it never meets it. Every edge
+// is examined; those whose box is farther than r from the box of the move are passed over.
 inline double first_contact_circle(std::span<const BspPolygon> polys, const Point2& from,
                                    const Point2& to, double r) {
   if (in_solid(polys, from)) return 0;
-  double near = kNever;
+  const double x0 = std::min(from[0], to[0]) - r, x1 = std::max(from[0], to[0]) + r;
+  const double y0 = std::min(from[1], to[1]) - r, y1 = std::max(from[1], to[1]) + r;
+  auto near_move = [&](const Point2& a, const Point2& b) {
+    return std::max(a[0], b[0]) >= x0 && std::min(a[0], b[0]) <= x1 && std::max(a[1], b[1]) >= y0 &&
+           std::min(a[1], b[1]) <= y1;
+  };
+  bool touching = false;
   for_each_edge(polys, [&](const Point2& a, const Point2& b) {
-    near = std::min(near, segment_distance(from, a, b));
+    if (!touching && near_move(a, b) && segment_distance(from, a, b) <= r) touching = true;
   });
-  if (near <= r) return 0;
+  if (touching) return 0;
   const Point2 d{to[0] - from[0], to[1] - from[1]};
   double best = kNever;
   for_each_edge(polys, [&](const Point2& a, const Point2& b) {
-    best = std::min(best, capsule_entry(from, d, a, b, r));
+    if (near_move(a, b)) best = std::min(best, capsule_entry(from, d, a, b, r));
   });
   return best;
 }
