@@ -221,6 +221,24 @@ void check_query(const Query& q) {
 
 }  // namespace
 
+LayerIndex::FeatureRuns LayerIndex::feature_runs() const {
+  FeatureRuns runs;
+  const PackedRTree2* t = packed();
+  if (!t || t->size() == 0) return runs;
+  const std::size_t n = t->size();
+  runs.end.resize(n);
+  runs.fid.resize(n);
+  for (std::size_t pos = 0; pos < n; ++pos) {
+    const Id id = t->item_at(pos);
+    runs.fid[pos] = id < records_.size() ? records_[id].fid : -1;
+  }
+  runs.end[n - 1] = static_cast<std::uint32_t>(n);
+  for (std::size_t pos = n - 1; pos-- > 0;)
+    runs.end[pos] = runs.fid[pos] == runs.fid[pos + 1] ? runs.end[pos + 1]
+                                                       : static_cast<std::uint32_t>(pos + 1);
+  return runs;
+}
+
 // The ring segments crossing the ray from p towards +x, counted per feature.
 std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p) {
   std::vector<std::int64_t> out;
@@ -272,7 +290,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     if (per_segment && !candidates_only)
       for (const auto fid : containing_polygons(index_, p))
         offer(fid, 0.0);
-    index_.browse(p, [&](const ItemRecord& r, const Box2& b, double box_distance) {
+    auto visit = [&](const ItemRecord& r, const Box2& b, double box_distance) {
       settle(box_distance);
       if (found >= q.k) return false;
       if (done.count(r.fid)) return true;
@@ -283,7 +301,24 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       else
         offer(r.fid, distance(geometries_->get(r.fid), p));
       return true;
-    });
+    };
+    if (per_segment) {
+      if (!have_runs_) {
+        runs_ = index_.feature_runs();
+        have_runs_ = true;
+      }
+      // A run of one feature's segments cannot change the answer when that feature is final
+      // or already known at most as far as the run's box.
+      index_.browse(p, visit, [&](std::size_t first, std::size_t last, double box_distance) {
+        if (first >= runs_.end.size() || runs_.end[first] < last) return true;
+        const std::int64_t fid = runs_.fid[first];
+        if (done.count(fid)) return false;
+        const auto it = best.find(fid);
+        return it == best.end() || it->second > box_distance;
+      });
+    } else {
+      index_.browse(p, visit);
+    }
     settle(std::numeric_limits<double>::infinity());
     return;
   }

@@ -101,6 +101,52 @@ TEST_P(Browse, BoxTreesAgainstBruteForce) {
   }
 }
 
+// browse() with keep(): items are grouped (consecutive ids, like the segments of a feature)
+// and a third of the groups are banned; keep drops every run of banned items. The walk must
+// then give exactly the other items, nearest first, and keep must be shown lower bounds.
+TEST_P(Browse, PackedKeepDropsRuns) {
+  const auto boxes = make_boxes<2>(GetParam(), 4000, 43);
+  const auto tree = PackedRTree2::build(boxes);
+  auto banned = [](Id id) { return (id / 7) % 3 == 0; };
+  std::mt19937_64 rng(6);
+  for (int q = 0; q < 12; ++q) {
+    const Point<2> p = random_point<2>(rng, -50, 1050);
+    std::size_t asked = 0, dropped = 0;
+    bool bounds_ok = true;
+    std::vector<Id> seen;
+    double last = 0;
+    bool ordered = true;
+    tree.browse(
+        p,
+        [&](Id id, const Box<2>&, double d) {
+          ordered &= d >= last;
+          last = d;
+          seen.push_back(id);
+          return true;
+        },
+        [&](std::size_t first, std::size_t last_pos, double d) {
+          ++asked;
+          bool all_banned = true;
+          for (std::size_t pos = first; pos < last_pos; ++pos) {
+            const Id id = tree.item_at(pos);
+            all_banned &= banned(id);
+            bounds_ok &= d <= std::sqrt(squared_distance(p, boxes[id]));
+          }
+          dropped += all_banned;
+          return !all_banned;
+        });
+    EXPECT_TRUE(ordered);
+    EXPECT_TRUE(bounds_ok) << "keep was given more than the distance of an item it covers";
+    EXPECT_GT(dropped, 0u);
+    std::vector<Id> want;
+    for (Id id = 0; id < boxes.size(); ++id)
+      if (!banned(id)) want.push_back(id);
+    std::sort(seen.begin(), seen.end());
+    EXPECT_EQ(seen, want);
+    EXPECT_LT(asked, 2 * boxes.size());
+  }
+}
+
 TEST_P(Browse, PointTreesAgainstBruteForce) {
   const auto boxes = points_of(make_boxes<2>(GetParam(), 3000, 43));
   const auto pts = corners(boxes);

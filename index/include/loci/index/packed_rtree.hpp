@@ -31,6 +31,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -177,6 +178,14 @@ class PackedRTree {
   // costs what it takes to find it). Throws InvalidGeometry for a bad point.
   template <NearestVisitor<D> Visit>
   QueryStats browse(const Point<D>& p, Visit&& visit) const;
+  // browse() that asks keep(first, last, distance) before an entry or subtree waits in the
+  // queue, [first, last) being the packed positions of the items it covers (item_at) and
+  // distance its box's from p; false drops it with all it covers. Callers that group items
+  // (the segments of one feature) use it to skip whole runs of a group already answered.
+  template <NearestVisitor<D> Visit, class Keep>
+  QueryStats browse(const Point<D>& p, Visit&& visit, Keep&& keep) const;
+  // The id of the item at packed position pos < size().
+  Id item_at(std::size_t pos) const { return Id(items_[pos]); }
 
   // Throws loci::Error describing the first broken invariant.
   void validate() const;
@@ -184,8 +193,11 @@ class PackedRTree {
  private:
   // Runs walk(root, expand, report), detail::best_first or detail::browse, with this
   // tree's expansion around p.
-  template <class Visit, class Walk>
-  QueryStats walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const;
+  template <class Visit, class Walk, class Keep>
+  QueryStats walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk, Keep&& keep) const;
+  struct KeepAll {
+    bool operator()(std::size_t, std::size_t, double) const { return true; }
+  };
   PackedRTree(std::span<const Box<D>> boxes, Packing packing);
 
   struct Item {
@@ -392,9 +404,12 @@ QueryStats PackedRTree<D, NodeSize>::nearest(const Point<D>& p, std::size_t k,
   check_point(p, "query point");
   if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
   if (empty()) return {};
-  return walk_nearest(p, visit, [k](std::uint64_t root, auto& expand, auto& report) {
-    return detail::best_first(root, k, expand, report);
-  });
+  return walk_nearest(
+      p, visit,
+      [k](std::uint64_t root, auto& expand, auto& report) {
+        return detail::best_first(root, k, expand, report);
+      },
+      KeepAll{});
 }
 
 template <int D, int NodeSize>
@@ -402,15 +417,27 @@ template <NearestVisitor<D> Visit>
 QueryStats PackedRTree<D, NodeSize>::browse(const Point<D>& p, Visit&& visit) const {
   check_point(p, "query point");
   if (empty()) return {};
-  return walk_nearest(p, visit, [](std::uint64_t root, auto& expand, auto& report) {
-    return detail::browse(root, expand, report);
-  });
+  return browse(p, visit, KeepAll{});
 }
 
 template <int D, int NodeSize>
-template <class Visit, class Walk>
-QueryStats PackedRTree<D, NodeSize>::walk_nearest(const Point<D>& p, Visit& visit,
-                                                  Walk&& walk) const {
+template <NearestVisitor<D> Visit, class Keep>
+QueryStats PackedRTree<D, NodeSize>::browse(const Point<D>& p, Visit&& visit, Keep&& keep) const {
+  check_point(p, "query point");
+  if (empty()) return {};
+  return walk_nearest(
+      p, visit,
+      [](std::uint64_t root, auto& expand, auto& report) {
+        return detail::browse(root, expand, report);
+      },
+      keep);
+}
+
+template <int D, int NodeSize>
+template <class Visit, class Walk, class Keep>
+QueryStats PackedRTree<D, NodeSize>::walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk,
+                                                  Keep&& keep) const {
+  constexpr bool kAll = std::is_same_v<std::remove_cvref_t<Keep>, KeepAll>;
   auto expand = [&](std::uint64_t ref, auto& sink) -> std::size_t {
     const int level = int(ref >> 32);
     const std::size_t b = std::size_t(ref & 0xffffffffu);
@@ -418,6 +445,19 @@ QueryStats PackedRTree<D, NodeSize>::walk_nearest(const Point<D>& p, Visit& visi
     const int used = int(std::min<std::size_t>(NodeSize, this->level(level).entries - base));
     double d2[NodeSize];
     block(level, b).squared_distances(p, d2);
+    if constexpr (!kAll) {
+      // Entries the caller does not keep are pushed as nothing: each kept one separately.
+      const std::size_t span = this->level(level).span;
+      for (int i = 0; i < used; ++i) {
+        const std::size_t first = (base + i) * span;
+        if (!keep(first, std::min(first + span, size_), std::sqrt(d2[i]))) continue;
+        if (level == 0)
+          sink.push_entry(d2[i], base + i, Id(items_[base + i]));
+        else
+          sink.push_subtree(d2[i], (std::uint64_t(level - 1) << 32) | (base + i));
+      }
+      return std::size_t(used);
+    }
     if (level == 0)
       sink.push_entries(
           d2, used, [&](int i) { return base + i; }, [&](int i) { return Id(items_[base + i]); });

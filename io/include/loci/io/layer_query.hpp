@@ -22,7 +22,10 @@
 // Nearest-n browses entry boxes by increasing distance (the trees' browse()) and refines with
 // exact distances: a feature is final once its exact distance is no larger than the box
 // distance of the next entry, since every entry not yet seen is at least that far, and the
-// walk stops there. --candidates answers from boxes alone.
+// walk stops there. Per segment, a feature's many segments would all come out of the walk
+// before the next feature's; instead a subtree holding segments of one feature only (runs of
+// packed positions, found once per LayerQuery) is dropped unseen when that feature is final
+// or already known nearer than the subtree. --candidates answers from boxes alone.
 // Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry and belongs to one
 // thread.
 #pragma once
@@ -91,6 +94,30 @@ class LayerIndex {
         },
         tree_);
   }
+  // browse() that drops what keep(first, last, box_distance) refuses before it is queued:
+  // [first, last) are packed positions (feature_runs()) of a packed tree; the other
+  // structures browse everything.
+  template <class Visit, class Keep>
+  void browse(const Point2& p, Visit&& visit, Keep&& keep) const {
+    if (const PackedRTree2* t = packed()) {
+      t->browse(
+          p,
+          [&](Id id, const Box2& b, double d) {
+            return id < records_.size() ? visit(records_[id], b, d) : true;
+          },
+          keep);
+      return;
+    }
+    browse(p, visit);
+  }
+  // For a packed tree, per packed position: one past the last position of the run of
+  // entries of one feature that starts there, and that feature (-1 for a corrupt item
+  // index). Empty for the other structures.
+  struct FeatureRuns {
+    std::vector<std::uint32_t> end;
+    std::vector<std::int64_t> fid;
+  };
+  FeatureRuns feature_runs() const;
 
  private:
   std::variant<PackedRTree2, RStarTree2, RTree2> tree_;
@@ -141,6 +168,8 @@ class LayerQuery {
   struct Geometries;
   const LayerIndex& index_;
   std::unique_ptr<Geometries> geometries_;
+  LayerIndex::FeatureRuns runs_;  // per segment, on the first nearest-n query
+  bool have_runs_ = false;
 };
 
 }  // namespace loci::io
