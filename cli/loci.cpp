@@ -193,6 +193,8 @@ int run_query(const Args& a) {
   o.format = parse_flag("--format", a.get("--format", "ids"), parse_format);
   o.out_path = a.get("--output");
   o.progress = progress_bar(a, "querying");
+  if (a.has("--jobs"))
+    o.jobs = static_cast<unsigned>(parse_count("--jobs", a.get("--jobs"), 1, 1024));
   query_layer(o, stdout);
   return 0;
 }
@@ -452,6 +454,7 @@ const std::vector<Command>& commands() {
         {"--format", "-f", "ids|csv|geojson",
          "output: FIDs (default), CSV with attributes, GeoJSON"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        {"--jobs", "-j", "N", "threads for a batch file (default: one per core)"},
         kIndex,
         kStructure,
         kPer,

@@ -3,13 +3,18 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
@@ -265,15 +270,66 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   refuse_overwriting(options.out_path, options.load.layer_path);
   QueryReport report;
   const LayerIndex index = load_index(options.load, &report.index_origin);
-  LayerQuery lq(index, options.load.layer_path, index.layer_name());
   std::vector<Answer> answers;
   bool with_distance = false;
-  ProgressTicker ticker(options.progress, double(options.queries.size()));
-  std::size_t done = 0;
-  for (const auto& [number, q] : options.queries) {
-    lq.run(q, number, options.candidates, answers);
+  for (const auto& [number, q] : options.queries)
     with_distance |= q.kind == Query::Kind::within || q.kind == Query::Kind::nearest;
-    ticker.tick(double(++done));
+  const std::size_t n = options.queries.size();
+  ProgressTicker ticker(options.progress, double(n));
+  // A batch is cut into chunks that threads take in turn, each thread with its own
+  // LayerQuery (its geometry cache and layer handle) over the one immutable index; the
+  // chunks' answers are joined in query order.
+  constexpr std::size_t kChunk = 64;
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t jobs =
+      std::min<std::size_t>(options.jobs ? options.jobs : cores, (n + kChunk - 1) / kChunk);
+  if (jobs <= 1) {
+    LayerQuery lq(index, options.load.layer_path, index.layer_name());
+    std::size_t done = 0;
+    for (const auto& [number, q] : options.queries) {
+      lq.run(q, number, options.candidates, answers);
+      ticker.tick(double(++done));
+    }
+  } else {
+    const std::size_t chunks = (n + kChunk - 1) / kChunk;
+    std::vector<std::vector<Answer>> parts(chunks);
+    std::atomic<std::size_t> next{0}, done{0};
+    std::atomic<bool> failed{false};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    // Every thread takes chunks; this one also reports progress between its chunks.
+    auto work = [&](bool reporting) {
+      try {
+        LayerQuery lq(index, options.load.layer_path, index.layer_name());
+        for (std::size_t c; !failed && (c = next++) < chunks;) {
+          const std::size_t end = std::min(n, (c + 1) * kChunk);
+          for (std::size_t i = c * kChunk; i < end; ++i) {
+            const auto& [number, q] = options.queries[i];
+            lq.run(q, number, options.candidates, parts[c]);
+          }
+          done += end - c * kChunk;
+          if (reporting) ticker.tick(double(done));
+        }
+      } catch (...) {
+        const std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        failed = true;
+      }
+    };
+    std::vector<std::thread> threads;
+    for (std::size_t t = 1; t < jobs; ++t)
+      threads.emplace_back(work, false);
+    work(true);
+    for (auto& t : threads)
+      t.join();
+    if (error) std::rethrow_exception(error);
+    ticker.tick(double(n));
+    std::size_t total = 0;
+    for (const auto& p : parts)
+      total += p.size();
+    answers.reserve(total);
+    for (auto& p : parts)
+      answers.insert(answers.end(), p.begin(), p.end());
   }
   write_answers({options.load.layer_path, index.layer_name()}, answers, options.format,
                 options.numbered, with_distance, options.out_path, fallback);

@@ -380,6 +380,42 @@ void expect_error(const std::string& args, const std::string& fragment) {
   EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
 }
 
+// Batches run on threads (chunks of 64 queries each) answer exactly what one thread does, in
+// the same order; the batches here are long enough to be cut.
+TEST_F(LayersCli, BatchesOnThreadsMatchOneThread) {
+  std::mt19937_64 rng(77);
+  std::uniform_real_distribution<double> pos(-5, 105), size(0.5, 20);
+  const std::string windows = path("batch.windows"), points = path("batch.points");
+  {
+    std::ofstream w(windows), p(points);
+    w.precision(17);
+    p.precision(17);
+    for (int i = 0; i < 700; ++i) {
+      const double x = pos(rng), y = pos(rng);
+      w << x << ',' << y << ',' << x + size(rng) << ',' << y + size(rng) << '\n';
+      p << pos(rng) << ',' << pos(rng) << '\n';
+    }
+  }
+  for (const char* layer : {"polys.shp", "lines.shp"}) {
+    for (const char* per : {"feature", "segment"}) {
+      for (const std::string batch : {" --bbox-file " + shell_quote(windows),
+                                      " --nearest-file " + shell_quote(points) + " -k 4 -f csv"}) {
+        const std::string cmd =
+            "query " + shell_quote(path(layer)) + batch + " --per " + per + " -q";
+        const CliRun one = run_loci(cmd + " -j 1");
+        const CliRun three = run_loci(cmd + " -j 3");
+        ASSERT_EQ(one.status, 0) << one.err;
+        ASSERT_EQ(three.status, 0) << three.err;
+        EXPECT_GT(lines(one.out).size(), 700u) << cmd;
+        EXPECT_EQ(one.out, three.out) << cmd;
+      }
+    }
+  }
+  expect_error(
+      "query " + shell_quote(path("polys.shp")) + " --bbox-file " + shell_quote(windows) + " -j 0",
+      "--jobs");
+}
+
 TEST_F(LayersCli, ReportsBadInput) {
   const std::string polys = path("polys.shp");
   expect_error("query " + path("missing.shp") + " --bbox 0,0,1,1", "no such file");

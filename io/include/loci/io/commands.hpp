@@ -84,6 +84,7 @@ struct QueryOptions {
   Format format = Format::ids;
   std::string out_path;  // empty: `fallback`
   Progress progress;     // over the queries of a batch
+  unsigned jobs = 0;     // threads for a batch; 0: one per core
 };
 
 struct QueryReport {
