@@ -34,9 +34,9 @@
 // structure and for brute force; the program exits with 1 when they are not.
 //
 // Usage: bench_particles [--n N[,N...]] [--max N] [--brute-max N] [--steps S] [--radius R]
-// Defaults: --n 1000,8000,27000,64000, --brute-max 8000 (brute force takes 7.5 s at 8,000 on a
-// 2020s core, so about 85 s at 27,000), --steps 100, --radius 0.02. --max N drops the sizes
-// above N. Fixed seed.
+// Defaults: --n 1000,8000,27000,64000, --brute-max 8000 (brute force took 7.3 s at 8,000
+// particles on the machine of the README, and it grows as n^2), --steps 100, --radius 0.02.
+// --max N drops the sizes above N. Fixed seed.
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>

@@ -54,10 +54,12 @@
 //
 // Input. Sphere and ConvexPolygon check their arguments when made; a ConvexPolygon may be given
 // clockwise or counter-clockwise, and repeated consecutive vertices (a closing vertex equal to
-// the first) and collinear ones are dropped. Every box argument is checked at every call. A bad
-// shape throws InvalidGeometry: NaN, infinite or beyond 1e150 (kMaxCoordinate, so that squares
-// stay finite), a negative radius, a polygon with no vertex, not convex or winding more than
-// once. Velocities and times throw InvalidArgument for the same faults, or when t0 > t1.
+// the first) and collinear ones are dropped. Box arguments are checked at every call of the
+// functions below (box-box overlap included when it comes through Shape; box.hpp's own
+// intersects(Box, Box) checks nothing). A bad shape throws InvalidGeometry: NaN, infinite or
+// beyond 1e150 (kMaxCoordinate, so that squares stay finite), a negative radius, a polygon
+// with no vertex, not convex or winding more than once. Velocities and times throw
+// InvalidArgument for the same faults, or when t0 > t1.
 //
 // Cost: every test allocates nothing. Polygon tests take O(n m) orientation tests for n and m
 // vertices (fine for the small polygons of a simulation), and contact intervals take O(n + m)
