@@ -176,10 +176,13 @@ int run_query(const Args& a) {
   } else if (a.has("--segment")) {
     q.kind = Query::Kind::segment;
     q.segment = parse_segment(a.get("--segment"));
+    q.first = a.has("--first");
   } else if (a.has("--point")) {
     q.kind = Query::Kind::point;
     q.point = parse_point(a.get("--point"));
   }
+  if (a.has("--first") && !a.has("--segment"))
+    throw UsageError("--first goes with --segment (the feature the segment meets first)");
   if (a.has("--bbox-file")) {
     o.queries = read_query_file(a.get("--bbox-file"), Query::Kind::bbox, k);
     o.numbered = true;
@@ -448,7 +451,11 @@ const std::vector<Command>& commands() {
         {"--nearest-file", nullptr, "F", "one X,Y per line; rows start with the line number"},
         {"-k", nullptr, "N", "how many neighbours (default 1, must be >= 1)"},
         {"--within", nullptr, "X,Y,D", "features at distance <= D from the point"},
-        {"--segment", nullptr, "X0,Y0,X1,Y1", "features meeting the closed segment"},
+        {"--segment", nullptr, "X0,Y0,X1,Y1",
+         "features meeting the closed segment, with the first point of each (csv: x,y)"},
+        {"--first", nullptr, nullptr,
+         "with --segment: only the feature met first from X0,Y0 (line of sight), the point and "
+         "the distance along the segment"},
         {"--point", nullptr, "X,Y", "features containing or touching the point"},
         {"--candidates", nullptr, nullptr, "box-level answer from the index, no exact test"},
         {"--format", "-f", "ids|csv|geojson",
@@ -462,7 +469,8 @@ const std::vector<Command>& commands() {
         kQuiet},
        "  loci query countries.shp --bbox 5,45,15,55\n"
        "  loci query countries.shp --nearest 2.35,48.85 -k 3 -f csv\n"
-       "  loci query countries.shp --bbox-file windows.txt -o hits.txt\n",
+       "  loci query countries.shp --bbox-file windows.txt -o hits.txt\n"
+       "  loci query coast.shp --segment 8,55,12,55 --first -f csv\n",
        run_query},
       {"clip",
        "loci clip LAYER --bbox XMIN,YMIN,XMAX,YMAX -o OUT",

@@ -271,9 +271,11 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   QueryReport report;
   const LayerIndex index = load_index(options.load, &report.index_origin);
   std::vector<Answer> answers;
-  bool with_distance = false;
-  for (const auto& [number, q] : options.queries)
-    with_distance |= q.kind == Query::Kind::within || q.kind == Query::Kind::nearest;
+  bool with_distance = false, with_point = false;
+  for (const auto& [number, q] : options.queries) {
+    with_distance |= q.kind == Query::Kind::within || q.kind == Query::Kind::nearest || q.first;
+    with_point |= q.kind == Query::Kind::segment && !options.candidates;
+  }
   const std::size_t n = options.queries.size();
   ProgressTicker ticker(options.progress, double(n));
   // A batch is cut into chunks that threads take in turn, each thread with its own
@@ -332,7 +334,7 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
       answers.insert(answers.end(), p.begin(), p.end());
   }
   write_answers({options.load.layer_path, index.layer_name()}, answers, options.format,
-                options.numbered, with_distance, options.out_path, fallback);
+                options.numbered, with_distance, with_point, options.out_path, fallback);
   report.answers = answers.size();
   return report;
 }

@@ -1,10 +1,12 @@
 // Exact refinement on flattened geometries; see exact.hpp for the semantics.
 #include "loci/io/exact.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "loci/geom/predicates.hpp"
+#include "loci/geom/segment_intersection.hpp"
 
 namespace loci::io {
 namespace {
@@ -72,6 +74,49 @@ bool meets(const FlatGeometry& g, const Segment2& s) {
   }
   if (any_edge(g, [&](const Segment2& e) { return intersects(e, s); })) return true;
   return inside_polygon(g, s.a);
+}
+
+namespace {
+// The parameter of point x on the line of s, clamped to [0, 1] (x lies on s).
+double parameter(const Segment2& s, const Point2& x) {
+  const double dx = s.b[0] - s.a[0], dy = s.b[1] - s.a[1];
+  const double dd = dx * dx + dy * dy;
+  if (dd == 0) return 0;
+  const double t = ((x[0] - s.a[0]) * dx + (x[1] - s.a[1]) * dy) / dd;
+  return std::clamp(t, 0.0, 1.0);
+}
+}  // namespace
+
+std::optional<double> first_meet(const Segment2& e, const Segment2& s) {
+  const SegmentIntersection x = intersection(e, s);
+  switch (x.kind) {
+    case SegmentMeet::none:
+      return std::nullopt;
+    case SegmentMeet::point:
+      return parameter(s, x.a);
+    default:
+      return std::min(parameter(s, x.a), parameter(s, x.b));
+  }
+}
+
+std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s) {
+  if (g.empty()) return std::nullopt;
+  std::optional<double> best;
+  auto offer = [&](std::optional<double> t) {
+    if (t && (!best || *t < *best)) best = t;
+  };
+  for (const Part& part : g.parts) {
+    if (part.end - part.begin == 1 || part.kind == PartKind::point) {
+      for (std::uint32_t i = part.begin; i < part.end; ++i)
+        offer(first_meet(Segment2{g.points[i], g.points[i]}, s));
+      continue;
+    }
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+      offer(first_meet(Segment2{g.points[i], g.points[i + 1]}, s));
+  }
+  if (best && *best == 0) return best;
+  if (inside_polygon(g, s.a)) return 0.0;
+  return best;
 }
 
 double distance(const FlatGeometry& g, const Point2& p) {

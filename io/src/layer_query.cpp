@@ -164,14 +164,10 @@ Region region_of(const Query& q) {
       r.search = s.box();
       r.probe = s.a;
       r.box_ok = [s](const Box2& b) { return intersects(b, s); };
-      r.segment_ok = [s](const Segment2& e) -> std::optional<double> {
-        if (intersects(e, s)) return kNaN;
-        return std::nullopt;
-      };
-      r.feature_ok = [s](const FlatGeometry& g, const Box2&) -> std::optional<double> {
-        if (meets(g, s)) return kNaN;
-        return std::nullopt;
-      };
+      // The parameter of the first point of s in the segment or feature (turned into that
+      // point when the answers are made).
+      r.segment_ok = [s](const Segment2& e) { return first_meet(e, s); };
+      r.feature_ok = [s](const FlatGeometry& g, const Box2&) { return first_meet(g, s); };
       break;
     }
     default: {
@@ -195,6 +191,33 @@ Region region_of(const Query& q) {
     }
   }
   return r;
+}
+
+// The parameter at which segment s enters the closed box b (0 when it starts in it), less a
+// little slack so that it bounds the exact meeting parameters from below; infinity when s
+// misses b (by more than the slack).
+double entry_parameter(const Segment2& s, const Box2& b) {
+  constexpr double kSlack = 1e-9;
+  double t0 = 0, t1 = 1;
+  for (int k = 0; k < 2; ++k) {
+    const double d = s.b[k] - s.a[k];
+    if (d == 0) {
+      if (s.a[k] < b.min[k] || s.a[k] > b.max[k]) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    double u = (b.min[k] - s.a[k]) / d, v = (b.max[k] - s.a[k]) / d;
+    if (u > v) std::swap(u, v);
+    t0 = std::max(t0, u);
+    t1 = std::min(t1, v);
+  }
+  if (t0 > t1 + kSlack) return std::numeric_limits<double>::infinity();
+  return std::max(0.0, t0 - kSlack);
+}
+
+Point2 point_at(const Segment2& s, double t) {
+  if (t == 0) return s.a;
+  if (t == 1) return s.b;
+  return {s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])};
 }
 
 void check_query(const Query& q) {
@@ -323,6 +346,39 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     return;
   }
 
+  if (q.kind == Query::Kind::segment && q.first) {
+    // Best first along the segment: entries in increasing entry parameter of their boxes,
+    // until the next box is entered after the best hit so far.
+    const Segment2 s = q.segment;
+    double best_t = std::numeric_limits<double>::infinity();
+    std::int64_t best_fid = -1;
+    auto offer = [&](std::int64_t fid, double t) {
+      if (t < best_t || (t == best_t && fid < best_fid)) best_t = t, best_fid = fid;
+    };
+    if (per_segment && !candidates_only)
+      for (const auto fid : containing_polygons(index_, s.a))
+        offer(fid, 0.0);
+    index_.ordered(
+        s.box(), [&](const Box2& b) { return entry_parameter(s, b); },
+        [&](const ItemRecord& r, const Box2& b, double key) {
+          if (key > best_t) return false;
+          if (candidates_only) {
+            offer(r.fid, key);
+          } else if (per_segment) {
+            if (auto t = first_meet(segment_of(b, r.flags), s)) offer(r.fid, *t);
+          } else if (auto t = first_meet(geometries_->get(r.fid), s)) {
+            offer(r.fid, *t);
+          }
+          return true;
+        });
+    if (best_fid >= 0) {
+      const double length = std::hypot(s.b[0] - s.a[0], s.b[1] - s.a[1]);
+      out.push_back({number, best_fid, best_t * length,
+                     candidates_only ? Point2{kNaN, kNaN} : point_at(s, best_t)});
+    }
+    return;
+  }
+
   const Region region = region_of(q);
   std::unordered_map<std::int64_t, double> hits;
   auto hit = [&](std::int64_t fid, double d) {
@@ -341,7 +397,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     });
     if (!candidates_only)
       for (const auto fid : containing_polygons(index_, region.probe))
-        hit(fid, region.with_distance ? 0.0 : kNaN);
+        hit(fid, region.with_distance || q.kind == Query::Kind::segment ? 0.0 : kNaN);
   } else {
     std::vector<std::pair<std::int64_t, Box2>> candidates;
     index_.window(region.search, [&](const ItemRecord& r, const Box2& b) {
@@ -362,8 +418,12 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     }
   }
   const std::size_t first = out.size();
-  for (const auto& [fid, d] : hits)
-    out.push_back({number, fid, d});
+  for (const auto& [fid, d] : hits) {
+    if (q.kind == Query::Kind::segment && !candidates_only)
+      out.push_back({number, fid, kNaN, point_at(q.segment, d)});  // d: where s meets fid
+    else
+      out.push_back({number, fid, d});
+  }
   std::sort(out.begin() + std::ptrdiff_t(first), out.end(),
             [](const Answer& a, const Answer& b) { return a.fid < b.fid; });
 }

@@ -47,11 +47,12 @@ void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
 }
 
 void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
-               bool with_distance, std::FILE* out) {
+               bool with_distance, bool with_point, std::FILE* out) {
   auto ol = detail::open_layer(src.layer_path, src.layer_name);
   const OGRFeatureDefn* defn = ol.layer->GetLayerDefn();
   std::string line = numbered ? "query,fid" : "fid";
   if (with_distance) line += ",distance";
+  if (with_point) line += ",x,y";
   for (int i = 0; i < defn->GetFieldCount(); ++i)
     line += "," + csv_quoted(defn->GetFieldDefn(i)->GetNameRef());
   std::fprintf(out, "%s\n", line.c_str());
@@ -60,6 +61,7 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
     line = numbered ? std::to_string(a.query) + "," : "";
     line += std::to_string(a.fid);
     if (with_distance) line += "," + number(a.distance);
+    if (with_point) line += "," + number(a.at[0]) + "," + number(a.at[1]);
     for (int i = 0; i < defn->GetFieldCount(); ++i) {
       line += ',';
       if (f->IsFieldSetAndNotNull(i)) line += csv_quoted(f->GetFieldAsString(i));
@@ -69,7 +71,7 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
 }
 
 void write_geojson(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
-                   bool with_distance, const std::string& target) {
+                   bool with_distance, bool with_point, const std::string& target) {
   auto ol = detail::open_layer(src.layer_path, src.layer_name);
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GeoJSON");
   if (!driver) throw Error("GDAL has no GeoJSON driver");
@@ -90,11 +92,15 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
   const int query_field = numbered ? add_field("query", OFTInteger64) : -1;
   const int fid_field = add_field("fid", OFTInteger64);
   const int distance_field = with_distance ? add_field("distance", OFTReal) : -1;
+  const int x_field = with_point ? add_field("x", OFTReal) : -1;
+  const int y_field = with_point ? add_field("y", OFTReal) : -1;
   const OGRFeatureDefn* defn = ol.layer->GetLayerDefn();
   for (int i = 0; i < defn->GetFieldCount(); ++i) {
     const OGRFieldDefn* fd = defn->GetFieldDefn(i);
     const std::string name = fd->GetNameRef();
-    if (name == "query" || name == "fid" || name == "distance") continue;
+    if (name == "query" || name == "fid" || name == "distance" ||
+        (with_point && (name == "x" || name == "y")))
+      continue;
     OGRFieldDefn copy(fd);
     if (layer->CreateField(&copy) != OGRERR_NONE) throw Error("cannot create field " + name);
     copied.emplace_back(i, out_index++);
@@ -105,6 +111,8 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
     if (query_field >= 0) out.SetField(query_field, static_cast<GIntBig>(a.query));
     out.SetField(fid_field, static_cast<GIntBig>(a.fid));
     if (distance_field >= 0) out.SetField(distance_field, a.distance);
+    if (x_field >= 0) out.SetField(x_field, a.at[0]);
+    if (y_field >= 0) out.SetField(y_field, a.at[1]);
     for (const auto& [from, to] : copied)
       if (f->IsFieldSetAndNotNull(from)) out.SetField(to, f->GetRawFieldRef(from));
     out.SetGeometry(f->GetGeometryRef());
@@ -140,17 +148,17 @@ void OutputFile::commit() {
 }
 
 void write_answers(const AnswerSource& source, std::span<const Answer> answers, Format format,
-                   bool numbered, bool with_distance, const std::string& out_path,
+                   bool numbered, bool with_distance, bool with_point, const std::string& out_path,
                    std::FILE* fallback) {
   if (format == Format::geojson) {
     if (out_path.empty()) {
       std::fflush(fallback);
-      write_geojson(source, answers, numbered, with_distance, "/vsistdout/");
+      write_geojson(source, answers, numbered, with_distance, with_point, "/vsistdout/");
       OutputFile(std::string(), fallback).commit();  // a full or closed stdout is an error
       return;
     }
     OutputDataset out(out_path);
-    write_geojson(source, answers, numbered, with_distance, out.staging_path());
+    write_geojson(source, answers, numbered, with_distance, with_point, out.staging_path());
     out.commit();
     return;
   }
@@ -158,7 +166,7 @@ void write_answers(const AnswerSource& source, std::span<const Answer> answers, 
   if (format == Format::ids)
     write_ids(answers, numbered, out.stream());
   else
-    write_csv(source, answers, numbered, with_distance, out.stream());
+    write_csv(source, answers, numbered, with_distance, with_point, out.stream());
   out.commit();
 }
 

@@ -285,6 +285,107 @@ INSTANTIATE_TEST_SUITE_P(Layers, LayersExact,
                                   "_" + std::get<1>(info.param);
                          });
 
+// The first parameter t along s (from s.a) of a point of g, from GEOS's intersection of the
+// two; -1 when they do not meet.
+double ogr_first_meet(const OGRGeometry& g, double x0, double y0, double x1, double y1) {
+  OGRLineString seg;
+  seg.addPoint(x0, y0);
+  seg.addPoint(x1, y1);
+  if (!g.Intersects(&seg)) return -1;
+  std::unique_ptr<OGRGeometry> x(g.Intersection(&seg));
+  if (!x) return -1;
+  const double dx = x1 - x0, dy = y1 - y0, dd = dx * dx + dy * dy;
+  double best = 2;
+  auto visit = [&](double px, double py) {
+    best = std::min(best, dd > 0 ? ((px - x0) * dx + (py - y0) * dy) / dd : 0.0);
+  };
+  std::vector<const OGRGeometry*> stack{x.get()};
+  while (!stack.empty()) {
+    const OGRGeometry* h = stack.back();
+    stack.pop_back();
+    const auto type = wkbFlatten(h->getGeometryType());
+    if (type == wkbPoint) {
+      visit(h->toPoint()->getX(), h->toPoint()->getY());
+    } else if (type == wkbLineString) {
+      for (const auto& p : *h->toLineString())
+        visit(p.getX(), p.getY());
+    } else if (OGR_GT_IsSubClassOf(type, wkbGeometryCollection)) {
+      for (const auto* part : *h->toGeometryCollection())
+        stack.push_back(part);
+    } else if (type == wkbPolygon) {
+      for (const auto* ring : *h->toPolygon())
+        for (const auto& p : *ring)
+          visit(p.getX(), p.getY());
+    }
+  }
+  return std::clamp(best, 0.0, 1.0);
+}
+
+// --segment --first (line of sight): the feature met first and how far along, against GEOS
+// on every feature; and plain --segment's x,y are each feature's first point.
+TEST_F(LayersCli, SegmentFirstHitMatchesGeos) {
+  for (const char* name : {"polys.shp", "lines.shp"}) {
+    const std::string layer = path(name);
+    const OgrFeatureSet s = read_with_ogr(layer);
+    for (const char* per : {"feature", "segment"}) {
+      std::mt19937_64 rng(91);
+      std::uniform_real_distribution<double> pos(-5, 105), len(-60, 60);
+      int hits = 0;
+      for (int q = 0; q < 14; ++q) {
+        const double x0 = pos(rng), y0 = pos(rng), x1 = x0 + len(rng), y1 = y0 + len(rng);
+        std::vector<double> t(s.geoms.size());
+        double best = 2;
+        for (std::size_t i = 0; i < s.geoms.size(); ++i) {
+          t[i] = ogr_first_meet(*s.geoms[i], x0, y0, x1, y1);
+          if (t[i] >= 0) best = std::min(best, t[i]);
+        }
+        char buf[200];
+        std::snprintf(buf, sizeof buf, " --segment %.17g,%.17g,%.17g,%.17g", x0, y0, x1, y1);
+        const std::string cmd = "query " + shell_quote(layer) + buf + " --per " + per;
+        const CliRun r = run_loci(cmd + " --first -f csv");
+        ASSERT_EQ(r.status, 0) << r.err;
+        const auto rows = lines(r.out);
+        ASSERT_FALSE(rows.empty());
+        EXPECT_EQ(rows[0].rfind("fid,distance,x,y,", 0), 0u) << rows[0];
+        if (best > 1) {
+          EXPECT_EQ(rows.size(), 1u) << cmd;
+          continue;
+        }
+        ++hits;
+        ASSERT_EQ(rows.size(), 2u) << cmd;
+        std::istringstream in(rows[1]);
+        std::string fid, dist;
+        std::getline(in, fid, ',');
+        std::getline(in, dist, ',');
+        const double length = std::hypot(x1 - x0, y1 - y0);
+        EXPECT_NEAR(std::stod(dist), best * length, 1e-9 * (1 + length)) << cmd;
+        const auto it = std::find(s.fids.begin(), s.fids.end(), std::stoll(fid));
+        ASSERT_NE(it, s.fids.end());
+        EXPECT_NEAR(t[std::size_t(it - s.fids.begin())], best, 1e-9) << cmd << " fid " << fid;
+
+        // Every feature the segment meets, each with its own first point.
+        const CliRun all = run_loci(cmd + " -f csv");
+        ASSERT_EQ(all.status, 0) << all.err;
+        for (const auto& row : lines(all.out)) {
+          if (row.rfind("fid", 0) == 0) continue;
+          std::istringstream rin(row);
+          std::string f, x, y;
+          std::getline(rin, f, ',');
+          std::getline(rin, x, ',');
+          std::getline(rin, y, ',');
+          const auto jt = std::find(s.fids.begin(), s.fids.end(), std::stoll(f));
+          ASSERT_NE(jt, s.fids.end());
+          const double want = t[std::size_t(jt - s.fids.begin())];
+          ASSERT_GE(want, 0) << cmd << " fid " << f;
+          EXPECT_NEAR(std::stod(x), x0 + want * (x1 - x0), 1e-9 * (1 + length)) << cmd;
+          EXPECT_NEAR(std::stod(y), y0 + want * (y1 - y0), 1e-9 * (1 + length)) << cmd;
+        }
+      }
+      EXPECT_GT(hits, 5) << name << " " << per;
+    }
+  }
+}
+
 TEST_F(LayersCli, CandidatesAreASupersetOfTheExactAnswer) {
   const std::string layer = path("polys.shp");
   const char* window = " --bbox 20,20,45,40";

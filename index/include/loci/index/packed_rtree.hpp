@@ -184,6 +184,12 @@ class PackedRTree {
   // (the segments of one feature) use it to skip whole runs of a group already answered.
   template <NearestVisitor<D> Visit, class Keep>
   QueryStats browse(const Point<D>& p, Visit&& visit, Keep&& keep) const;
+  // Calls visit(id, box, key) for the items in increasing key(box) (a double >= 0, or
+  // infinity to leave the box and all under it out), one at a time, until it returns false.
+  // key must not decrease from a node's box to the boxes inside it: the order along a ray,
+  // for example (the first hit of a line of sight, without enumerating all it crosses).
+  template <class Key, class Visit>
+  QueryStats ordered(Key&& key, Visit&& visit) const;
   // The id of the item at packed position pos < size().
   Id item_at(std::size_t pos) const { return Id(items_[pos]); }
 
@@ -431,6 +437,35 @@ QueryStats PackedRTree<D, NodeSize>::browse(const Point<D>& p, Visit&& visit, Ke
         return detail::browse(root, expand, report);
       },
       keep);
+}
+
+template <int D, int NodeSize>
+template <class Key, class Visit>
+QueryStats PackedRTree<D, NodeSize>::ordered(Key&& key, Visit&& visit) const {
+  if (empty()) return {};
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  auto expand = [&](std::uint64_t ref, auto& sink) -> std::size_t {
+    const int level = int(ref >> 32);
+    const std::size_t b = std::size_t(ref & 0xffffffffu);
+    const std::size_t base = b * NodeSize;
+    const int used = int(std::min<std::size_t>(NodeSize, this->level(level).entries - base));
+    const Block& node = block(level, b);
+    for (int i = 0; i < used; ++i) {
+      const double k = key(node.box(i));
+      if (!(k < kInf)) continue;
+      // The walk orders by its first field and hands back its square root.
+      if (level == 0)
+        sink.push_entry(k * k, base + i, Id(items_[base + i]));
+      else
+        sink.push_subtree(k * k, (std::uint64_t(level - 1) << 32) | (base + i));
+    }
+    return std::size_t(used);
+  };
+  auto report = [&](Id id, std::uint64_t pos, double) {
+    const Box<D> box = leaf_box(pos);
+    return visit(id, box, key(box));
+  };
+  return detail::browse(std::uint64_t(levels() - 1) << 32, expand, report);
 }
 
 template <int D, int NodeSize>

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -47,6 +48,14 @@ bool meets(const FlatGeometry& g, const Box2& box);
 bool meets(const FlatGeometry& g, const Segment2& s);
 // Euclidean distance from p to the nearest point of the geometry (0 inside a polygon).
 double distance(const FlatGeometry& g, const Point2& p);
+
+// Where the closed segment s first meets g, as the parameter t in [0, 1] of the point
+// s.a + t (s.b - s.a) (0 when s starts inside or on g); nothing when they do not meet. Whether
+// and where they meet is decided exactly (the meeting point of two segments is rounded to
+// doubles); t is computed from that point in floating point.
+std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s);
+// The same for one segment e of linework.
+std::optional<double> first_meet(const Segment2& e, const Segment2& s);
 
 // Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
 // exactly; half-open in y so that a ray through a vertex counts once.

@@ -30,7 +30,9 @@
 // thread.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -110,6 +112,33 @@ class LayerIndex {
     }
     browse(p, visit);
   }
+  // visit(record, box, key) for entries in increasing key(box) (>= 0; infinity leaves a box
+  // out, and key must not decrease from a node to what it holds) until visit returns false.
+  // Packed trees walk nearest key first; the others collect the entries meeting `search`
+  // (which must hold every box of finite key) and sort them.
+  template <class Key, class Visit>
+  void ordered(const Box2& search, Key&& key, Visit&& visit) const {
+    if (const PackedRTree2* t = packed()) {
+      t->ordered(key, [&](Id id, const Box2& b, double k) {
+        return id < records_.size() ? visit(records_[id], b, k) : true;
+      });
+      return;
+    }
+    struct Hit {
+      double key;
+      const ItemRecord* record;
+      Box2 box;
+    };
+    std::vector<Hit> hits;
+    window(search, [&](const ItemRecord& r, const Box2& b) {
+      const double k = key(b);
+      if (k < std::numeric_limits<double>::infinity()) hits.push_back({k, &r, b});
+      return true;
+    });
+    std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) { return a.key < b.key; });
+    for (const Hit& h : hits)
+      if (!visit(*h.record, h.box, h.key)) return;
+  }
   // For a packed tree, per packed position: one past the last position of the run of
   // entries of one feature that starts there, and that feature (-1 for a corrupt item
   // index). Empty for the other structures.
@@ -144,12 +173,15 @@ struct Query {
   Segment2 segment{};  // segment
   double radius = 0;   // within
   std::size_t k = 1;   // nearest
+  bool first = false;  // segment: only the feature met first from the segment's start
 };
 
 struct Answer {
   std::size_t query;  // 1-based number of the query in its batch
   std::int64_t fid;
-  double distance;  // within and nearest; NaN otherwise
+  double distance;  // within, nearest, and a segment's first hit (along it); NaN otherwise
+  Point2 at{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  // segment: the first point of the segment in the feature; NaN otherwise
 };
 
 class LayerQuery {

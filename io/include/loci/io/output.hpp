@@ -48,8 +48,9 @@ struct AnswerSource {
 };
 
 // Throws Error when the output cannot be written or a feature is missing from the layer.
+// with_point adds the columns (csv) or fields (GeoJSON) x and y: Answer::at.
 void write_answers(const AnswerSource& source, std::span<const Answer> answers, Format format,
-                   bool numbered, bool with_distance, const std::string& out_path,
+                   bool numbered, bool with_distance, bool with_point, const std::string& out_path,
                    std::FILE* fallback);
 
 }  // namespace loci::io
