@@ -154,14 +154,14 @@ int run_query(const Args& a) {
   const std::string& layer = layer_arg(a, "query");
   o.load = load_options(a, layer);
   const char* kinds[] = {"--bbox",   "--bbox-file", "--nearest", "--nearest-file",
-                         "--within", "--segment",   "--point"};
+                         "--within", "--segment",   "--point",   "--point-file"};
   int given = 0;
   for (const char* k : kinds)
     given += a.has(k);
   if (given != 1)
     throw UsageError(
         "loci query needs exactly one of --bbox, --bbox-file, --nearest, "
-        "--nearest-file, --within, --segment, --point");
+        "--nearest-file, --within, --segment, --point, --point-file");
   const std::size_t k = a.has("-k") ? parse_count("-k", a.get("-k"), 1, kMaxK) : 1;
   Query q;
   q.k = k;
@@ -188,6 +188,9 @@ int run_query(const Args& a) {
     o.numbered = true;
   } else if (a.has("--nearest-file")) {
     o.queries = read_query_file(a.get("--nearest-file"), Query::Kind::nearest, k);
+    o.numbered = true;
+  } else if (a.has("--point-file")) {
+    o.queries = read_query_file(a.get("--point-file"), Query::Kind::point, k);
     o.numbered = true;
   } else {
     o.queries.emplace_back(1, q);
@@ -457,6 +460,8 @@ const std::vector<Command>& commands() {
          "with --segment: only the feature met first from X0,Y0 (line of sight), the point and "
          "the distance along the segment"},
         {"--point", nullptr, "X,Y", "features containing or touching the point"},
+        {"--point-file", nullptr, "F",
+         "point location in batch: one X,Y per line; rows start with the line number"},
         {"--candidates", nullptr, nullptr, "box-level answer from the index, no exact test"},
         {"--format", "-f", "ids|csv|geojson",
          "output: FIDs (default), CSV with attributes, GeoJSON"},

@@ -321,6 +321,39 @@ double ogr_first_meet(const OGRGeometry& g, double x0, double y0, double x1, dou
   return std::clamp(best, 0.0, 1.0);
 }
 
+// --point-file: point location in batch, every point against GEOS, per feature and per
+// segment (crossing parity over the index's ring segments).
+TEST_F(LayersCli, PointFileLocatesEveryPoint) {
+  const std::string layer = path("polys.shp");
+  const OgrFeatureSet s = read_with_ogr(layer);
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> pos(-5, 105);
+  const std::string file = path("located.points");
+  std::vector<std::pair<double, double>> points;
+  {
+    std::ofstream out(file);
+    out.precision(17);
+    for (int i = 0; i < 300; ++i) {
+      points.emplace_back(pos(rng), pos(rng));
+      out << points.back().first << ',' << points.back().second << '\n';
+    }
+  }
+  for (const char* per : {"feature", "segment"}) {
+    const CliRun r = run_loci("query " + shell_quote(layer) + " --point-file " + shell_quote(file) +
+                              " --per " + per + " -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto got = parse_ids(r.out, points.size());
+    std::size_t inside = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      OGRPoint p(points[i].first, points[i].second);
+      const auto want = brute_intersects(s, p);
+      EXPECT_EQ(got[i + 1], want) << per << " point " << i + 1;
+      inside += !want.empty();
+    }
+    EXPECT_GT(inside, 20u);
+  }
+}
+
 // --segment --first (line of sight): the feature met first and how far along, against GEOS
 // on every feature; and plain --segment's x,y are each feature's first point.
 TEST_F(LayersCli, SegmentFirstHitMatchesGeos) {

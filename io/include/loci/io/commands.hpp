@@ -35,7 +35,7 @@ Segment2 parse_segment(const std::string& text);
 // "X,Y,D"
 Query parse_within(const std::string& text);
 
-// One query per non-empty line (XMIN,YMIN,XMAX,YMAX for bbox, X,Y for nearest); blank lines
+// One query per non-empty line (XMIN,YMIN,XMAX,YMAX for bbox, X,Y otherwise); blank lines
 // and lines starting with '#' are skipped but still counted, so answers name file lines.
 // Throws Error naming the file and line of a bad line.
 std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& path,
