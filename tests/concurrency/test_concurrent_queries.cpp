@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <thread>
 #include <vector>
@@ -23,6 +24,7 @@
 #ifdef LOCI_HAVE_IO
 #include <unistd.h>
 
+#include "loci/io/commands.hpp"
 #include "loci/io/sidecar.hpp"
 #endif
 
@@ -183,6 +185,43 @@ TEST(ConcurrentQueries, MappedSidecar) {
               return fids_ok;
             }),
             0u);
+}
+
+// A batch of layer queries spread over threads (one LayerIndex, a LayerQuery per thread)
+// writes what one thread writes: windows, nearest-n and point location on the sample, per
+// segment (no GDAL handle is used off the main thread).
+TEST(ConcurrentQueries, LayerBatchOnThreads) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> x(7, 16), y(53.5, 58.5), w(0.01, 0.8);
+  for (const auto kind :
+       {io::Query::Kind::bbox, io::Query::Kind::nearest, io::Query::Kind::point}) {
+    io::QueryOptions o;
+    o.load.layer_path = std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson";
+    o.load.per = io::Per::segment;
+    o.numbered = true;
+    for (std::size_t n = 1; n <= 600; ++n) {
+      io::Query q;
+      q.kind = kind;
+      q.k = 3;
+      q.point = {x(rng), y(rng)};
+      q.box = {q.point, {q.point[0] + w(rng), q.point[1] + w(rng)}};
+      o.queries.emplace_back(n, q);
+    }
+    auto run = [&](unsigned jobs) {
+      o.jobs = jobs;
+      std::FILE* f = std::tmpfile();
+      io::query_layer(o, f);
+      std::string text;
+      std::rewind(f);
+      for (int c; (c = std::fgetc(f)) != EOF;)
+        text += char(c);
+      std::fclose(f);
+      return text;
+    };
+    const std::string one = run(1);
+    EXPECT_GT(one.size(), 600u);
+    EXPECT_EQ(run(4), one);
+  }
 }
 #endif
 
