@@ -23,6 +23,7 @@
 #include "loci/io/commands.hpp"
 #include "loci/io/fleet_commands.hpp"
 #include "loci/io/intersections.hpp"
+#include "loci/io/join.hpp"
 #include "loci/io/layer_cells.hpp"
 
 namespace {
@@ -234,6 +235,28 @@ int run_intersections(const Args& a) {
   const std::size_t n = write_intersections(o, stdout);
   if (!a.has("--quiet") && !o.out_path.empty())
     std::fprintf(stderr, "loci: %zu rows written into %s\n", n, o.out_path.c_str());
+  return 0;
+}
+
+int run_join(const Args& a) {
+  if (a.positional.size() != 2)
+    throw UsageError("loci join needs LEFT and RIGHT layers (see loci join --help)");
+  if (!a.has("--predicate")) throw UsageError("loci join needs --predicate intersects|dwithin:D");
+  JoinOptions o;
+  o.left_path = a.positional[0];
+  o.left_name = a.get("--layer");
+  o.right_path = a.positional[1];
+  o.right_name = a.get("--layer2");
+  parse_flag("--predicate", a.get("--predicate"), [&](const std::string& t) {
+    parse_join_predicate(t, o);
+    return 0;
+  });
+  o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
+  o.out_path = a.get("--output");
+  o.progress = progress_bar(a, "joining");
+  const std::size_t n = write_join(o, stdout);
+  if (!a.has("--quiet") && !o.out_path.empty())
+    std::fprintf(stderr, "loci: %zu pairs written into %s\n", n, o.out_path.c_str());
   return 0;
 }
 
@@ -502,6 +525,21 @@ const std::vector<Command>& commands() {
        "  loci intersections roads.shp rivers.shp -f csv\n"
        "  loci intersections coastline.geojson --pairs-only\n",
        run_intersections},
+      {"join",
+       "loci join LEFT RIGHT --predicate intersects|dwithin:D [-f csv|ids] [-o OUT]",
+       "pairs of features of two layers whose exact geometries meet, or lie within D",
+       {{"--predicate", "-p", "intersects|dwithin:D",
+         "intersects: the geometries share a point (touching counts); dwithin:D: at distance "
+         "<= D, reported"},
+        {"--format", "-f", "csv|ids",
+         "CSV `fid_left,fid_right` (plus `distance` for dwithin; default) or `LEFT RIGHT` lines"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        kLayer,
+        {"--layer2", nullptr, "NAME", "layer of RIGHT (default: its first)"},
+        kQuiet},
+       "  loci join counties.shp roads.shp --predicate intersects\n"
+       "  loci join ports.shp coast.shp --predicate dwithin:0.05 -f csv\n",
+       run_join},
       {"draw",
        "loci draw LAYER|FILE.loci -o OUT.svg [--levels N | --cells L] [--width PX]",
        "SVG of the layer's linework and the packed index's nodes, one colour per level, or "

@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include "loci/geom/predicates.hpp"
 #include "loci/geom/segment_intersection.hpp"
+#include "loci/index/sweep_join.hpp"
 
 namespace loci::io {
 namespace {
@@ -117,6 +119,71 @@ std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s) {
   if (best && *best == 0) return best;
   if (inside_polygon(g, s.a)) return 0.0;
   return best;
+}
+
+namespace {
+// Every edge of g, isolated points as edges of length zero, and their boxes (grown by `grow`).
+struct Edges {
+  std::vector<Segment2> segs;
+  std::vector<Box2> boxes;
+  Edges(const FlatGeometry& g, double grow) {
+    for (const Part& part : g.parts) {
+      if (part.end - part.begin == 1 || part.kind == PartKind::point) {
+        for (std::uint32_t i = part.begin; i < part.end; ++i)
+          segs.push_back({g.points[i], g.points[i]});
+        continue;
+      }
+      for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+        segs.push_back({g.points[i], g.points[i + 1]});
+    }
+    boxes.reserve(segs.size());
+    const double inf = std::numeric_limits<double>::infinity();
+    for (const Segment2& e : segs) {
+      Box2 b = e.box();
+      if (grow > 0)
+        b = {{std::nextafter(b.min[0] - grow, -inf), std::nextafter(b.min[1] - grow, -inf)},
+             {std::nextafter(b.max[0] + grow, inf), std::nextafter(b.max[1] + grow, inf)}};
+      boxes.push_back(b);
+    }
+  }
+};
+}  // namespace
+
+bool meets(const FlatGeometry& a, const FlatGeometry& b) {
+  if (a.empty() || b.empty() || !intersects(a.envelope(), b.envelope())) return false;
+  const Edges ea(a, 0), eb(b, 0);
+  bool found = false;
+  join(std::span<const Box2>(ea.boxes), std::span<const Box2>(eb.boxes), [&](Id i, Id j) {
+    found = intersects(ea.segs[i], eb.segs[j]);
+    return !found;
+  });
+  if (found) return true;
+  // No edges meet: each connected part of one lies inside the other's polygons or outside.
+  auto part_inside = [](const FlatGeometry& g, const FlatGeometry& other) {
+    for (const Part& part : g.parts)
+      if (inside_polygon(other, g.points[part.begin])) return true;
+    return false;
+  };
+  return part_inside(a, b) || part_inside(b, a);
+}
+
+std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry& b, double d) {
+  if (a.empty() || b.empty()) return std::nullopt;
+  if (meets(a, b)) return 0.0;
+  const Edges ea(a, d), eb(b, 0);
+  double best = std::numeric_limits<double>::infinity();
+  join(std::span<const Box2>(ea.boxes), std::span<const Box2>(eb.boxes), [&](Id i, Id j) {
+    const Segment2& s = ea.segs[i];
+    const Segment2& t = eb.segs[j];
+    // The segments do not meet: the nearest points include an end point of one of them.
+    const double d2 = std::min({squared_distance(s.a, t), squared_distance(s.b, t),
+                                squared_distance(t.a, s), squared_distance(t.b, s)});
+    best = std::min(best, d2);
+    return true;
+  });
+  const double dist = std::sqrt(best);
+  if (dist <= d) return dist;
+  return std::nullopt;
 }
 
 double distance(const FlatGeometry& g, const Point2& p) {

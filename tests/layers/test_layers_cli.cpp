@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "layers/cli_support.hpp"
 
@@ -548,6 +549,54 @@ TEST_F(LayersCli, BatchesOnThreadsMatchOneThread) {
   expect_error(
       "query " + shell_quote(path("polys.shp")) + " --bbox-file " + shell_quote(windows) + " -j 0",
       "--jobs");
+}
+
+// loci join: intersects and dwithin:D between two layers (and a layer with itself), every
+// pair against GEOS's Intersects and Distance on all pairs of features.
+TEST_F(LayersCli, JoinMatchesGeosOnAllPairs) {
+  const std::vector<std::pair<const char*, const char*>> pairs{
+      {"polys.shp", "lines.shp"}, {"polys.shp", "polys.shp"}, {"polys.shp", "points.shp"}};
+  for (const auto& [l, r] : pairs) {
+    const OgrFeatureSet left = read_with_ogr(path(l)), right = read_with_ogr(path(r));
+    for (const std::string pred : {"intersects", "dwithin:3.5"}) {
+      const bool dwithin = pred != "intersects";
+      const CliRun run = run_loci("join " + shell_quote(path(l)) + " " + shell_quote(path(r)) +
+                                  " --predicate " + pred + " -q");
+      ASSERT_EQ(run.status, 0) << run.err;
+      const auto rows = lines(run.out);
+      ASSERT_FALSE(rows.empty());
+      EXPECT_EQ(rows[0], dwithin ? "fid_left,fid_right,distance" : "fid_left,fid_right");
+      std::map<std::pair<long long, long long>, double> got;
+      for (std::size_t k = 1; k < rows.size(); ++k) {
+        std::istringstream in(rows[k]);
+        std::string a, b, d;
+        std::getline(in, a, ',');
+        std::getline(in, b, ',');
+        std::getline(in, d, ',');
+        got[{std::stoll(a), std::stoll(b)}] = dwithin ? std::stod(d) : 0;
+      }
+      std::size_t want = 0;
+      for (std::size_t i = 0; i < left.geoms.size(); ++i) {
+        for (std::size_t j = 0; j < right.geoms.size(); ++j) {
+          const auto key = std::pair{left.fids[i], right.fids[j]};
+          const double dist = left.geoms[i]->Distance(right.geoms[j].get());
+          const bool meets = left.geoms[i]->Intersects(right.geoms[j].get());
+          const bool in = dwithin ? (meets || dist <= 3.5) : meets;
+          if (!dwithin || std::fabs(dist - 3.5) > 1e-9)
+            EXPECT_EQ(got.count(key), in ? 1u : 0u)
+                << l << " " << r << " " << pred << " pair " << key.first << "," << key.second;
+          if (in && dwithin && got.count(key))
+            EXPECT_NEAR(got[key], meets ? 0 : dist, 1e-9) << key.first << "," << key.second;
+          want += in;
+        }
+      }
+      EXPECT_GT(want, 5u) << l << " " << r << " " << pred;
+    }
+  }
+  expect_error("join " + shell_quote(path("polys.shp")) + " " + shell_quote(path("lines.shp")) +
+                   " --predicate dwithin:-1",
+               "dwithin");
+  expect_error("join " + shell_quote(path("polys.shp")), "LEFT and RIGHT");
 }
 
 TEST_F(LayersCli, ReportsBadInput) {

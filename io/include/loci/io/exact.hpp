@@ -57,6 +57,15 @@ std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s);
 // The same for one segment e of linework.
 std::optional<double> first_meet(const Segment2& e, const Segment2& s);
 
+// True when the geometries share at least one point (closed: touching counts). Their edges
+// (isolated points as edges of length zero) are joined by sort-and-sweep on their boxes and
+// tested exactly, stopping at the first pair that meets; without one, a geometry lies inside
+// the other's polygon or apart from it, and one of its points decides which.
+bool meets(const FlatGeometry& a, const FlatGeometry& b);
+// The distance between a and b (0 when they meet) when it is at most d, nothing otherwise;
+// only edge pairs whose boxes come within d are measured.
+std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry& b, double d);
+
 // Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
 // exactly; half-open in y so that a ray through a vertex counts once.
 bool ray_crosses(const Point2& a, const Point2& b, const Point2& p);

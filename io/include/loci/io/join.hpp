@@ -1,0 +1,53 @@
+// Spatial joins of two layers: every pair (left feature, right feature) whose geometries
+// satisfy a predicate, decided exactly (DESIGN.md sections 4 and 6).
+//
+//   intersects   the geometries share a point (closed: touching counts)
+//   dwithin:D    their distance is at most D; the distance is reported
+//
+// Candidates come from a sort-and-sweep join of the features' envelopes (index/sweep_join.hpp),
+// the left ones grown by D for dwithin; each candidate is refined on the flattened geometries
+// (exact.hpp: their edges joined the same way, so that two big polygons cost what their close
+// edges cost, not the product of their sizes). Rows are sorted by (left, right).
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "loci/io/output.hpp"
+#include "loci/io/progress.hpp"
+
+namespace loci::io {
+
+enum class JoinPredicate : std::uint8_t { intersects, dwithin };
+
+struct JoinOptions {
+  std::string left_path, left_name;
+  std::string right_path, right_name;
+  JoinPredicate predicate = JoinPredicate::intersects;
+  double distance = 0;          // dwithin
+  Format format = Format::csv;  // csv or ids
+  std::string out_path;         // empty: the fallback stream
+  Progress progress;            // over the candidate pairs
+};
+
+struct JoinRow {
+  std::int64_t left;
+  std::int64_t right;
+  double distance;  // dwithin; 0 otherwise
+  friend bool operator<(const JoinRow& a, const JoinRow& b) {
+    return a.left != b.left ? a.left < b.left : a.right < b.right;
+  }
+};
+
+// Accepts "intersects" and "dwithin:D" (D finite, >= 0); throws InvalidArgument otherwise.
+void parse_join_predicate(const std::string& text, JoinOptions& options);
+
+std::vector<JoinRow> join_layers(const JoinOptions& options);
+
+// join_layers written as CSV (header `fid_left,fid_right`, plus `distance` for dwithin) or as
+// ids (`LEFT RIGHT` per line). Returns the number of rows. Throws InvalidArgument for geojson.
+std::size_t write_join(const JoinOptions& options, std::FILE* fallback);
+
+}  // namespace loci::io
