@@ -241,16 +241,20 @@ int run_intersections(const Args& a) {
 int run_join(const Args& a) {
   if (a.positional.size() != 2)
     throw UsageError("loci join needs LEFT and RIGHT layers (see loci join --help)");
-  if (!a.has("--predicate")) throw UsageError("loci join needs --predicate intersects|dwithin:D");
+  if (a.has("--predicate") == a.has("--closest"))
+    throw UsageError("loci join needs one of --predicate intersects|dwithin:D and --closest");
   JoinOptions o;
   o.left_path = a.positional[0];
   o.left_name = a.get("--layer");
   o.right_path = a.positional[1];
   o.right_name = a.get("--layer2");
-  parse_flag("--predicate", a.get("--predicate"), [&](const std::string& t) {
-    parse_join_predicate(t, o);
-    return 0;
-  });
+  if (a.has("--closest"))
+    o.predicate = JoinPredicate::closest;
+  else
+    parse_flag("--predicate", a.get("--predicate"), [&](const std::string& t) {
+      parse_join_predicate(t, o);
+      return 0;
+    });
   o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
   o.out_path = a.get("--output");
   o.progress = progress_bar(a, "joining");
@@ -526,13 +530,17 @@ const std::vector<Command>& commands() {
        "  loci intersections coastline.geojson --pairs-only\n",
        run_intersections},
       {"join",
-       "loci join LEFT RIGHT --predicate intersects|dwithin:D [-f csv|ids] [-o OUT]",
+       "loci join LEFT RIGHT (--predicate intersects|dwithin:D | --closest) [-f csv|ids] [-o OUT]",
        "pairs of features of two layers whose exact geometries meet, or lie within D",
        {{"--predicate", "-p", "intersects|dwithin:D",
          "intersects: the geometries share a point (touching counts); dwithin:D: at distance "
          "<= D, reported"},
+        {"--closest", nullptr, nullptr,
+         "instead: the pair at the smallest distance (two different features when LEFT and "
+         "RIGHT are the same layer), with the distance"},
         {"--format", "-f", "csv|ids",
-         "CSV `fid_left,fid_right` (plus `distance` for dwithin; default) or `LEFT RIGHT` lines"},
+         "CSV `fid_left,fid_right` (plus `distance` for dwithin and --closest; default) or "
+         "`LEFT RIGHT` lines"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
         kLayer,
         {"--layer2", nullptr, "NAME", "layer of RIGHT (default: its first)"},

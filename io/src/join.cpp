@@ -8,6 +8,7 @@
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
+#include "loci/index/packed_rtree.hpp"
 #include "loci/index/sweep_join.hpp"
 #include "loci/io/atomic_file.hpp"
 #include "loci/io/exact.hpp"
@@ -60,9 +61,88 @@ void parse_join_predicate(const std::string& text, JoinOptions& o) {
   throw InvalidArgument("unknown predicate '" + text + "' (choose intersects or dwithin:D)");
 }
 
+namespace {
+
+// The distance between two closed boxes (0 when they meet).
+double box_distance(const Box2& a, const Box2& b) {
+  const double dx = std::max({0.0, a.min[0] - b.max[0], b.min[0] - a.max[0]});
+  const double dy = std::max({0.0, a.min[1] - b.max[1], b.min[1] - a.max[1]});
+  return std::hypot(dx, dy);
+}
+
+Box2 grown_by(const Box2& b, double d) {
+  const double inf = std::numeric_limits<double>::infinity();
+  return {{std::nextafter(b.min[0] - d, -inf), std::nextafter(b.min[1] - d, -inf)},
+          {std::nextafter(b.max[0] + d, inf), std::nextafter(b.max[1] + d, inf)}};
+}
+
+// The exact distance of two geometries: within the distance of their first points, which
+// bounds it from above.
+double exact_distance(const FlatGeometry& a, const FlatGeometry& b) {
+  const Point2& p = a.points[0];
+  const Point2& q = b.points[0];
+  const double bound =
+      std::nextafter(std::hypot(p[0] - q[0], p[1] - q[1]), std::numeric_limits<double>::infinity());
+  return distance_within(a, b, bound).value_or(bound);
+}
+
+std::vector<JoinRow> closest_pair(const Features& left, const Features& right, bool self,
+                                  const Progress& progress) {
+  std::vector<JoinRow> rows;
+  if (left.fids.empty() || right.fids.empty() || (self && left.fids.size() < 2)) return rows;
+  // An upper bound: each left feature with the right one whose envelope is nearest its centre.
+  PackedRTree2::Builder builder(right.boxes.size());
+  for (const Box2& b : right.boxes)
+    builder.add(b);
+  const PackedRTree2 tree = std::move(builder).finish();
+  double bound = std::numeric_limits<double>::infinity();
+  JoinRow best{-1, -1, bound};
+  auto offer = [&](std::size_t i, std::size_t j, double d) {
+    const JoinRow r{left.fids[i], right.fids[j], d};
+    if (d < best.distance || (d == best.distance && r < best)) best = r;
+    bound = std::min(bound, d);
+  };
+  for (std::size_t i = 0; i < left.boxes.size(); ++i) {
+    const Box2& b = left.boxes[i];
+    const Point2 c{(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2};
+    tree.browse(c, [&](Id j, const Box2&, double) {
+      if (self && j == i) return true;
+      offer(i, j, exact_distance(left.geoms[i], right.geoms[j]));
+      return false;
+    });
+  }
+  // Every pair whose envelopes lie within the bound, nearest envelopes first.
+  std::vector<Box2> grown(left.boxes.size());
+  for (std::size_t i = 0; i < grown.size(); ++i)
+    grown[i] = grown_by(left.boxes[i], bound);
+  std::vector<std::pair<double, std::pair<Id, Id>>> candidates;
+  join(std::span<const Box2>(grown), std::span<const Box2>(right.boxes), [&](Id i, Id j) {
+    if (!(self && i == j))
+      candidates.push_back({box_distance(left.boxes[i], right.boxes[j]), {i, j}});
+    return true;
+  });
+  std::sort(candidates.begin(), candidates.end());
+  ProgressTicker ticker(progress, double(candidates.size()));
+  std::size_t done = 0;
+  for (const auto& [box_distance, ij] : candidates) {
+    if (box_distance > bound) break;
+    const auto [i, j] = ij;
+    if (auto d = distance_within(left.geoms[i], right.geoms[j], bound)) offer(i, j, *d);
+    ticker.tick(double(++done));
+  }
+  rows.push_back(best);
+  return rows;
+}
+
+}  // namespace
+
 std::vector<JoinRow> join_layers(const JoinOptions& o) {
   const Features left = read_features(o.left_path, o.left_name);
   const Features right = read_features(o.right_path, o.right_name);
+  if (o.predicate == JoinPredicate::closest) {
+    const bool self = o.left_path == o.right_path && o.left_name == o.right_name;
+    return closest_pair(left, right, self, o.progress);
+  }
   const bool dwithin = o.predicate == JoinPredicate::dwithin;
   std::vector<Box2> grown = left.boxes;
   if (dwithin) {
@@ -98,7 +178,7 @@ std::size_t write_join(const JoinOptions& o, std::FILE* fallback) {
   refuse_overwriting(o.out_path, o.left_path);
   refuse_overwriting(o.out_path, o.right_path);
   const std::vector<JoinRow> rows = join_layers(o);
-  const bool dwithin = o.predicate == JoinPredicate::dwithin;
+  const bool dwithin = o.predicate != JoinPredicate::intersects;
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
   if (o.format == Format::csv)

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 
 #include "layers/cli_support.hpp"
@@ -593,9 +594,45 @@ TEST_F(LayersCli, JoinMatchesGeosOnAllPairs) {
       EXPECT_GT(want, 5u) << l << " " << r << " " << pred;
     }
   }
+  // --closest: the pair at the smallest distance, against every pair's GEOS distance (two
+  // different features of a layer joined with itself).
+  for (const auto& [l, r] :
+       std::vector<std::pair<const char*, const char*>>{{"polys.shp", "lines.shp"},
+                                                        {"lines.shp", "lines.shp"},
+                                                        {"points.shp", "points.shp"},
+                                                        {"lines.shp", "points.shp"}}) {
+    const OgrFeatureSet left = read_with_ogr(path(l)), right = read_with_ogr(path(r));
+    const bool self = std::string(l) == r;
+    double want = std::numeric_limits<double>::infinity();
+    std::map<std::pair<long long, long long>, double> dist;
+    for (std::size_t i = 0; i < left.geoms.size(); ++i)
+      for (std::size_t j = 0; j < right.geoms.size(); ++j) {
+        if (self && i == j) continue;
+        const double d = left.geoms[i]->Distance(right.geoms[j].get());
+        dist[{left.fids[i], right.fids[j]}] = d;
+        want = std::min(want, d);
+      }
+    const CliRun run =
+        run_loci("join " + shell_quote(path(l)) + " " + shell_quote(path(r)) + " --closest -q");
+    ASSERT_EQ(run.status, 0) << run.err;
+    const auto rows = lines(run.out);
+    ASSERT_EQ(rows.size(), 2u) << run.out;
+    EXPECT_EQ(rows[0], "fid_left,fid_right,distance");
+    std::istringstream in(rows[1]);
+    std::string a, b, d;
+    std::getline(in, a, ',');
+    std::getline(in, b, ',');
+    std::getline(in, d, ',');
+    EXPECT_NEAR(std::stod(d), want, 1e-9) << l << " " << r;
+    const auto it = dist.find({std::stoll(a), std::stoll(b)});
+    ASSERT_NE(it, dist.end()) << l << " " << r << ": " << rows[1];
+    EXPECT_NEAR(it->second, want, 1e-9) << l << " " << r;
+  }
   expect_error("join " + shell_quote(path("polys.shp")) + " " + shell_quote(path("lines.shp")) +
                    " --predicate dwithin:-1",
                "dwithin");
+  expect_error("join " + shell_quote(path("polys.shp")) + " " + shell_quote(path("lines.shp")),
+               "--closest");
   expect_error("join " + shell_quote(path("polys.shp")), "LEFT and RIGHT");
 }
 

@@ -4,10 +4,15 @@
 //   intersects   the geometries share a point (closed: touching counts)
 //   dwithin:D    their distance is at most D; the distance is reported
 //
+//   closest      the pair at the smallest distance (--closest)
+//
 // Candidates come from a sort-and-sweep join of the features' envelopes (index/sweep_join.hpp),
 // the left ones grown by D for dwithin; each candidate is refined on the flattened geometries
 // (exact.hpp: their edges joined the same way, so that two big polygons cost what their close
-// edges cost, not the product of their sizes). Rows are sorted by (left, right).
+// edges cost, not the product of their sizes). Rows are sorted by (left, right). The closest
+// pair starts from an upper bound (each left feature against the right feature whose envelope
+// is nearest its envelope's centre), joins the envelopes within that bound and refines them
+// nearest envelope first, tightening the bound, until the next envelope distance exceeds it.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +25,9 @@
 
 namespace loci::io {
 
-enum class JoinPredicate : std::uint8_t { intersects, dwithin };
+// closest: the one pair of features (of the two layers, or two different features of one
+// layer when both sides are the same file) at the smallest distance, with that distance.
+enum class JoinPredicate : std::uint8_t { intersects, dwithin, closest };
 
 struct JoinOptions {
   std::string left_path, left_name;
@@ -46,7 +53,8 @@ void parse_join_predicate(const std::string& text, JoinOptions& options);
 
 std::vector<JoinRow> join_layers(const JoinOptions& options);
 
-// join_layers written as CSV (header `fid_left,fid_right`, plus `distance` for dwithin) or as
+// join_layers written as CSV (header `fid_left,fid_right`, plus `distance` for dwithin and
+// closest) or as
 // ids (`LEFT RIGHT` per line). Returns the number of rows. Throws InvalidArgument for geojson.
 std::size_t write_join(const JoinOptions& options, std::FILE* fallback);
 
