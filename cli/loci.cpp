@@ -242,7 +242,8 @@ int run_join(const Args& a) {
   if (a.positional.size() != 2)
     throw UsageError("loci join needs LEFT and RIGHT layers (see loci join --help)");
   if (a.has("--predicate") == a.has("--closest"))
-    throw UsageError("loci join needs one of --predicate intersects|dwithin:D and --closest");
+    throw UsageError(
+        "loci join needs one of --predicate intersects|contains|within|dwithin:D and --closest");
   JoinOptions o;
   o.left_path = a.positional[0];
   o.left_name = a.get("--layer");
@@ -530,11 +531,14 @@ const std::vector<Command>& commands() {
        "  loci intersections coastline.geojson --pairs-only\n",
        run_intersections},
       {"join",
-       "loci join LEFT RIGHT (--predicate intersects|dwithin:D | --closest) [-f csv|ids] [-o OUT]",
+       "loci join LEFT RIGHT (--predicate intersects|contains|within|dwithin:D | --closest) [-f "
+       "csv|ids] "
+       "[-o OUT]",
        "pairs of features of two layers whose exact geometries meet, or lie within D",
-       {{"--predicate", "-p", "intersects|dwithin:D",
-         "intersects: the geometries share a point (touching counts); dwithin:D: at distance "
-         "<= D, reported"},
+       {{"--predicate", "-p", "intersects|contains|within|dwithin:D",
+         "intersects: the geometries share a point (touching counts); contains / within: every "
+         "point of RIGHT lies in LEFT / of LEFT in RIGHT, boundary included; dwithin:D: at "
+         "distance <= D, reported"},
         {"--closest", nullptr, nullptr,
          "instead: the pair at the smallest distance (two different features when LEFT and "
          "RIGHT are the same layer), with the distance"},

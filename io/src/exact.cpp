@@ -167,6 +167,75 @@ bool meets(const FlatGeometry& a, const FlatGeometry& b) {
   return part_inside(a, b) || part_inside(b, a);
 }
 
+namespace {
+// Whether p lies on an edge (or isolated point) of g, exactly.
+bool on_edges(const FlatGeometry& g, const Point2& p) {
+  const Segment2 q{p, p};
+  for (const Part& part : g.parts) {
+    if (part.end - part.begin == 1 || part.kind == PartKind::point) {
+      for (std::uint32_t i = part.begin; i < part.end; ++i)
+        if (g.points[i] == p) return true;
+      continue;
+    }
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+      if (intersects(Segment2{g.points[i], g.points[i + 1]}, q)) return true;
+  }
+  return false;
+}
+
+bool in_closed(const FlatGeometry& g, const Point2& p) {
+  return on_edges(g, p) || inside_polygon(g, p);
+}
+}  // namespace
+
+bool covers(const FlatGeometry& a, const FlatGeometry& b) {
+  if (a.empty() || b.empty() || !within(b.envelope(), a.envelope())) return false;
+  const Edges ea(a, 0), eb(b, 0);
+  // Where a's linework meets each edge of b: cut parameters, and the stretches along a's
+  // edges (collinear overlaps), which lie in a.
+  std::vector<std::vector<double>> cuts(eb.segs.size());
+  std::vector<std::vector<std::pair<double, double>>> along(eb.segs.size());
+  join(std::span<const Box2>(eb.boxes), std::span<const Box2>(ea.boxes), [&](Id i, Id j) {
+    const Segment2& s = eb.segs[i];
+    const SegmentIntersection x = intersection(s, ea.segs[j]);
+    if (x.kind == SegmentMeet::none) return true;
+    const double u = parameter(s, x.a), v = parameter(s, x.b);
+    cuts[i].push_back(u);
+    if (x.kind != SegmentMeet::point) {
+      cuts[i].push_back(v);
+      along[i].emplace_back(std::min(u, v), std::max(u, v));
+    }
+    return true;
+  });
+  for (std::size_t i = 0; i < eb.segs.size(); ++i) {
+    const Segment2& s = eb.segs[i];
+    if (!in_closed(a, s.a) || !in_closed(a, s.b)) return false;
+    if (s.a == s.b) continue;
+    std::vector<double>& c = cuts[i];
+    c.push_back(0);
+    c.push_back(1);
+    std::sort(c.begin(), c.end());
+    for (std::size_t k = 0; k + 1 < c.size(); ++k) {
+      const double t0 = c[k], t1 = c[k + 1];
+      if (!(t1 > t0)) continue;
+      bool on_a = false;
+      for (const auto& [lo, hi] : along[i])
+        on_a = on_a || (lo <= t0 && t1 <= hi);
+      if (on_a) continue;
+      const double t = (t0 + t1) / 2;
+      if (!in_closed(a, {s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])}))
+        return false;
+    }
+  }
+  if (b.polygons > 0) {
+    if (a.polygons == 0) return false;  // linework and points cover no area
+    const Box2 env = b.envelope();
+    for (const Point2& v : a.points)
+      if (intersects(env, v) && inside_polygon(b, v) && !on_edges(b, v)) return false;
+  }
+  return true;
+}
+
 std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry& b, double d) {
   if (a.empty() || b.empty()) return std::nullopt;
   if (meets(a, b)) return 0.0;

@@ -43,8 +43,10 @@ Features read_features(const std::string& path, const std::string& name) {
 }  // namespace
 
 void parse_join_predicate(const std::string& text, JoinOptions& o) {
-  if (text == "intersects") {
-    o.predicate = JoinPredicate::intersects;
+  if (text == "intersects" || text == "contains" || text == "within") {
+    o.predicate = text == "intersects" ? JoinPredicate::intersects
+                  : text == "contains" ? JoinPredicate::contains
+                                       : JoinPredicate::within;
     return;
   }
   if (text.rfind("dwithin:", 0) == 0) {
@@ -58,7 +60,8 @@ void parse_join_predicate(const std::string& text, JoinOptions& o) {
     }
     throw InvalidArgument("dwithin needs a finite distance >= 0, as in dwithin:2.5");
   }
-  throw InvalidArgument("unknown predicate '" + text + "' (choose intersects or dwithin:D)");
+  throw InvalidArgument("unknown predicate '" + text +
+                        "' (choose intersects, contains, within or dwithin:D)");
 }
 
 namespace {
@@ -163,8 +166,13 @@ std::vector<JoinRow> join_layers(const JoinOptions& o) {
     if (dwithin) {
       if (auto d = distance_within(left.geoms[i], right.geoms[j], o.distance))
         rows.push_back({left.fids[i], right.fids[j], *d});
-    } else if (meets(left.geoms[i], right.geoms[j])) {
-      rows.push_back({left.fids[i], right.fids[j], 0});
+    } else {
+      const FlatGeometry& a = left.geoms[i];
+      const FlatGeometry& b = right.geoms[j];
+      const bool yes = o.predicate == JoinPredicate::contains ? covers(a, b)
+                       : o.predicate == JoinPredicate::within ? covers(b, a)
+                                                              : meets(a, b);
+      if (yes) rows.push_back({left.fids[i], right.fids[j], 0});
     }
     ticker.tick(double(++done));
   }
@@ -178,7 +186,8 @@ std::size_t write_join(const JoinOptions& o, std::FILE* fallback) {
   refuse_overwriting(o.out_path, o.left_path);
   refuse_overwriting(o.out_path, o.right_path);
   const std::vector<JoinRow> rows = join_layers(o);
-  const bool dwithin = o.predicate != JoinPredicate::intersects;
+  const bool dwithin =
+      o.predicate == JoinPredicate::dwithin || o.predicate == JoinPredicate::closest;
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
   if (o.format == Format::csv)

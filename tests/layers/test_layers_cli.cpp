@@ -559,8 +559,8 @@ TEST_F(LayersCli, JoinMatchesGeosOnAllPairs) {
       {"polys.shp", "lines.shp"}, {"polys.shp", "polys.shp"}, {"polys.shp", "points.shp"}};
   for (const auto& [l, r] : pairs) {
     const OgrFeatureSet left = read_with_ogr(path(l)), right = read_with_ogr(path(r));
-    for (const std::string pred : {"intersects", "dwithin:3.5"}) {
-      const bool dwithin = pred != "intersects";
+    for (const std::string pred : {"intersects", "contains", "within", "dwithin:3.5"}) {
+      const bool dwithin = pred == "dwithin:3.5";
       const CliRun run = run_loci("join " + shell_quote(path(l)) + " " + shell_quote(path(r)) +
                                   " --predicate " + pred + " -q");
       ASSERT_EQ(run.status, 0) << run.err;
@@ -582,7 +582,16 @@ TEST_F(LayersCli, JoinMatchesGeosOnAllPairs) {
           const auto key = std::pair{left.fids[i], right.fids[j]};
           const double dist = left.geoms[i]->Distance(right.geoms[j].get());
           const bool meets = left.geoms[i]->Intersects(right.geoms[j].get());
-          const bool in = dwithin ? (meets || dist <= 3.5) : meets;
+          // covers: nothing of the covered geometry left outside the other (GEOS overlay).
+          auto covers = [](const OGRGeometry& a, const OGRGeometry& b) {
+            if (!a.Intersects(&b)) return false;
+            const std::unique_ptr<OGRGeometry> rest(b.Difference(&a));
+            return rest && rest->IsEmpty();
+          };
+          const bool in = dwithin              ? (meets || dist <= 3.5)
+                          : pred == "contains" ? covers(*left.geoms[i], *right.geoms[j])
+                          : pred == "within"   ? covers(*right.geoms[j], *left.geoms[i])
+                                               : meets;
           if (!dwithin || std::fabs(dist - 3.5) > 1e-9)
             EXPECT_EQ(got.count(key), in ? 1u : 0u)
                 << l << " " << r << " " << pred << " pair " << key.first << "," << key.second;
@@ -591,7 +600,11 @@ TEST_F(LayersCli, JoinMatchesGeosOnAllPairs) {
           want += in;
         }
       }
-      EXPECT_GT(want, 5u) << l << " " << r << " " << pred;
+      // Polygons hold a few lines whole and no line or point holds a polygon.
+      std::size_t at_least = 5;
+      if (pred == "within" && std::string(r) != "polys.shp") at_least = 0;
+      if (pred == "contains" && std::string(r) == "lines.shp") at_least = 1;
+      EXPECT_GE(want, at_least) << l << " " << r << " " << pred;
     }
   }
   // --closest: the pair at the smallest distance, against every pair's GEOS distance (two
@@ -627,6 +640,32 @@ TEST_F(LayersCli, JoinMatchesGeosOnAllPairs) {
     const auto it = dist.find({std::stoll(a), std::stoll(b)});
     ASSERT_NE(it, dist.end()) << l << " " << r << ": " << rows[1];
     EXPECT_NEAR(it->second, want, 1e-9) << l << " " << r;
+  }
+  // A square with a hole covers a square beside the hole, not one over it, nor one along its
+  // outer edge that sticks out; a square covers itself.
+  {
+    const std::string holed = path("holed.geojson"), squares = path("squares.geojson");
+    std::ofstream(holed) << R"({"type":"FeatureCollection","features":[{"type":"Feature",
+      "properties":{},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],
+      [0,0]],[[4,4],[6,4],[6,6],[4,6],[4,4]]]}}]})";
+    auto square = [](double x0, double y0, double x1, double y1) {
+      std::ostringstream o;
+      o << R"({"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[)"
+        << x0 << ',' << y0 << "],[" << x1 << ',' << y0 << "],[" << x1 << ',' << y1 << "],[" << x0
+        << ',' << y1 << "],[" << x0 << ',' << y0 << "]]]}}";
+      return o.str();
+    };
+    std::ofstream(squares) << R"({"type":"FeatureCollection","features":[)" << square(1, 1, 3, 3)
+                           << ',' << square(3, 3, 7, 7) << ',' << square(8, 0, 12, 2) << ','
+                           << square(0, 0, 10, 10) << "]}";
+    const CliRun run = run_loci("join " + shell_quote(holed) + " " + shell_quote(squares) +
+                                " --predicate contains -f ids -q");
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_EQ(run.out, "0 0\n");
+    const CliRun self = run_loci("join " + shell_quote(squares) + " " + shell_quote(squares) +
+                                 " --predicate within -f ids -q");
+    ASSERT_EQ(self.status, 0) << self.err;
+    EXPECT_EQ(self.out, "0 0\n0 3\n1 1\n1 3\n2 2\n3 3\n");
   }
   expect_error("join " + shell_quote(path("polys.shp")) + " " + shell_quote(path("lines.shp")) +
                    " --predicate dwithin:-1",

@@ -66,6 +66,13 @@ bool meets(const FlatGeometry& a, const FlatGeometry& b);
 // only edge pairs whose boxes come within d are measured.
 std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry& b, double d);
 
+// True when every point of b lies in a, a's boundary included (OGC's "covers"). b's edges
+// are cut where a's linework meets them; every vertex of b and the middle of every piece must
+// lie in a (pieces running along a's edges do), and when b has polygons no vertex of a may lie
+// strictly inside them (a hole of a, or a notch, inside b). The vertex tests are exact; the
+// middle of a piece is rounded, which can matter only for pieces shorter than the rounding.
+bool covers(const FlatGeometry& a, const FlatGeometry& b);
+
 // Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
 // exactly; half-open in y so that a ray through a vertex counts once.
 bool ray_crosses(const Point2& a, const Point2& b, const Point2& p);

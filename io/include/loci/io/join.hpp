@@ -2,6 +2,9 @@
 // satisfy a predicate, decided exactly (DESIGN.md sections 4 and 6).
 //
 //   intersects   the geometries share a point (closed: touching counts)
+//   contains     every point of the right feature lies in the left one, boundary included
+//                (OGC's covers; exact.hpp's covers())
+//   within       every point of the left feature lies in the right one (covered by)
 //   dwithin:D    their distance is at most D; the distance is reported
 //
 //   closest      the pair at the smallest distance (--closest)
@@ -27,7 +30,7 @@ namespace loci::io {
 
 // closest: the one pair of features (of the two layers, or two different features of one
 // layer when both sides are the same file) at the smallest distance, with that distance.
-enum class JoinPredicate : std::uint8_t { intersects, dwithin, closest };
+enum class JoinPredicate : std::uint8_t { intersects, contains, within, dwithin, closest };
 
 struct JoinOptions {
   std::string left_path, left_name;
@@ -48,7 +51,8 @@ struct JoinRow {
   }
 };
 
-// Accepts "intersects" and "dwithin:D" (D finite, >= 0); throws InvalidArgument otherwise.
+// Accepts "intersects", "contains", "within" and "dwithin:D" (D finite, >= 0); throws
+// InvalidArgument otherwise.
 void parse_join_predicate(const std::string& text, JoinOptions& options);
 
 std::vector<JoinRow> join_layers(const JoinOptions& options);
