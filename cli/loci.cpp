@@ -209,9 +209,15 @@ int run_query(const Args& a) {
 int run_clip(const Args& a) {
   ClipOptions o;
   o.load = load_options(a, layer_arg(a, "clip"));
-  if (!a.has("--bbox")) throw UsageError("loci clip needs --bbox XMIN,YMIN,XMAX,YMAX");
+  if (a.has("--bbox") + a.has("--wkt") + a.has("--window-layer") != 1)
+    throw UsageError(
+        "loci clip needs exactly one window: --bbox XMIN,YMIN,XMAX,YMAX, --wkt POLYGON or "
+        "--window-layer POLYGONS");
   if (!a.has("--output")) throw UsageError("loci clip needs -o OUT");
-  o.window = parse_bbox(a.get("--bbox"));
+  if (a.has("--bbox")) o.window = parse_bbox(a.get("--bbox"));
+  o.window_wkt = a.get("--wkt");
+  o.window_layer = a.get("--window-layer");
+  o.window_layer_name = a.get("--window-layer-name");
   o.out_path = a.get("--output");
   const std::size_t n = clip_layer(o);
   if (!a.has("--quiet"))
@@ -506,16 +512,22 @@ const std::vector<Command>& commands() {
        "  loci query coast.shp --segment 8,55,12,55 --first -f csv\n",
        run_query},
       {"clip",
-       "loci clip LAYER --bbox XMIN,YMIN,XMAX,YMAX -o OUT",
+       "loci clip LAYER (--bbox XMIN,YMIN,XMAX,YMAX | --wkt POLYGON | --window-layer POLYGONS) "
+       "-o OUT",
        "windowing: the features meeting the window, cut to it (format from OUT's extension)",
        {{"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX", "the window"},
+        {"--wkt", nullptr, "WKT", "a polygonal window: POLYGON or MULTIPOLYGON in WKT"},
+        {"--window-layer", nullptr, "POLYGONS",
+         "a polygonal window: the union of the polygons of this layer"},
+        {"--window-layer-name", nullptr, "NAME", "layer of POLYGONS (default: its first)"},
         {"--output", "-o", "OUT", "output dataset: .geojson, .shp, .gpkg, .fgb, ..."},
         kIndex,
         kStructure,
         kPer,
         kLayer,
         kQuiet},
-       "  loci clip countries.shp --bbox 5,45,15,55 -o alps.gpkg\n",
+       "  loci clip countries.shp --bbox 5,45,15,55 -o alps.gpkg\n"
+       "  loci clip roads.shp --window-layer parks.shp -o park-roads.gpkg\n",
        run_clip},
       {"intersections",
        "loci intersections LAYER [LAYER2] [-f csv|geojson] [--pairs-only] [-o OUT]",

@@ -6,6 +6,11 @@
 // (a polygon sharing an edge leaves a line, a corner a point) in formats whose layers hold mixed
 // geometry (GeoJSON, GeoPackage, ...); a shapefile holds one geometry type, so there such
 // pieces are dropped and counted.
+//
+// A polygonal window (--wkt, or the union of a layer's polygons with --window-layer) is the
+// windowing problem with a non-rectangular window: the index gives the features meeting the
+// window's envelope, the exact test of exact.hpp keeps those that meet the window itself, and
+// GEOS cuts them.
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,15 +21,87 @@
 
 namespace loci::io {
 
+namespace {
+
+bool polygonal(const OGRGeometry& g) {
+  const auto t = wkbFlatten(g.getGeometryType());
+  return t == wkbPolygon || t == wkbMultiPolygon;
+}
+
+// The window as one valid polygonal geometry: the rectangle, the WKT, or the union of the
+// window layer's polygons.
+std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o) {
+  std::unique_ptr<OGRGeometry> w;
+  if (!o.window_wkt.empty()) {
+    OGRGeometry* g = nullptr;
+    if (OGRGeometryFactory::createFromWkt(o.window_wkt.c_str(), nullptr, &g) != OGRERR_NONE || !g)
+      throw InvalidGeometry("--wkt: not a geometry in WKT");
+    w.reset(g);
+    if (!polygonal(*w))
+      throw InvalidGeometry("--wkt: the window must be a POLYGON or MULTIPOLYGON");
+  } else if (!o.window_layer.empty()) {
+    auto wl = detail::open_layer(o.window_layer, o.window_layer_name);
+    const detail::ReadCheck check(o.window_layer);
+    OGRMultiPolygon all;
+    for (auto& f : *wl.layer) {
+      const OGRGeometry* g = f->GetGeometryRef();
+      if (!g || g->IsEmpty()) continue;
+      if (!polygonal(*g))
+        throw InvalidGeometry(detail::where(o.window_layer, f->GetFID()) +
+                              " is not a polygon; a window layer holds polygons");
+      std::unique_ptr<OGRGeometry> valid(g->IsValid() ? g->clone() : g->MakeValid());
+      if (!valid) throw InvalidGeometry(detail::where(o.window_layer, f->GetFID()) + " is invalid");
+      if (wkbFlatten(valid->getGeometryType()) == wkbPolygon)
+        all.addGeometry(valid.get());
+      else if (wkbFlatten(valid->getGeometryType()) == wkbMultiPolygon)
+        for (const OGRPolygon* p : *valid->toMultiPolygon())
+          all.addGeometry(p);
+    }
+    check.finish();
+    if (all.IsEmpty()) throw InvalidGeometry(o.window_layer + ": no polygon to clip with");
+    w.reset(all.UnionCascaded());
+    if (!w) throw Error(o.window_layer + ": the polygons cannot be united");
+  } else {
+    const Box2& b = o.window;
+    check_box(b, "bbox");
+    auto poly = std::make_unique<OGRPolygon>();
+    OGRLinearRing ring;
+    ring.addPoint(b.min[0], b.min[1]);
+    ring.addPoint(b.max[0], b.min[1]);
+    ring.addPoint(b.max[0], b.max[1]);
+    ring.addPoint(b.min[0], b.max[1]);
+    ring.addPoint(b.min[0], b.min[1]);
+    poly->addRing(&ring);
+    return poly;
+  }
+  if (w->IsEmpty()) throw InvalidGeometry("the window is empty");
+  if (!w->IsValid()) {
+    std::unique_ptr<OGRGeometry> valid(w->MakeValid());
+    if (!valid || !polygonal(*valid)) throw InvalidGeometry("the window is an invalid polygon");
+    w = std::move(valid);
+  }
+  return w;
+}
+
+}  // namespace
+
 std::size_t clip_layer(const ClipOptions& options) {
   if (!OGRGeometryFactory::haveGEOS()) throw Error("clipping needs GDAL built with GEOS");
-  check_box(options.window, "bbox");
+  const bool rectangle = options.window_wkt.empty() && options.window_layer.empty();
+  const std::unique_ptr<OGRGeometry> window = window_of(options);
   refuse_overwriting(options.out_path, options.load.layer_path);
+  if (!options.window_layer.empty()) refuse_overwriting(options.out_path, options.window_layer);
   const LayerIndex index = load_index(options.load);
   LayerQuery query(index, options.load.layer_path, index.layer_name());
   Query q;
   q.kind = Query::Kind::bbox;
-  q.box = options.window;
+  if (rectangle) {
+    q.box = options.window;
+  } else {
+    OGREnvelope e;
+    window->getEnvelope(&e);
+    q.box = {{e.MinX, e.MinY}, {e.MaxX, e.MaxY}};
+  }
   std::vector<Answer> answers;
   query.run(q, 1, false, answers);
 
@@ -36,17 +113,9 @@ std::size_t clip_layer(const ClipOptions& options) {
     GDALDatasetUniquePtr ds(
         driver->Create(out.staging_path().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
     if (!ds) throw Error("cannot write " + options.out_path + ": " + CPLGetLastErrorMsg());
-    const Box2& w = options.window;
-    OGRPolygon window;
-    {
-      OGRLinearRing ring;
-      ring.addPoint(w.min[0], w.min[1]);
-      ring.addPoint(w.max[0], w.min[1]);
-      ring.addPoint(w.max[0], w.max[1]);
-      ring.addPoint(w.min[0], w.max[1]);
-      ring.addPoint(w.min[0], w.min[1]);
-      window.addRing(&ring);
-    }
+    // A polygonal window keeps, of the features meeting its envelope, those meeting it.
+    FlatGeometry window_flat;
+    if (!rectangle) window_flat = detail::flatten(window.get(), "the window");
     // The pieces first: an invalid polygon (a bowtie) is made valid before it is cut, and a
     // feature the window only touches keeps its degenerate piece (a point or a line), so clip
     // answers exactly what query does.
@@ -62,6 +131,9 @@ std::size_t clip_layer(const ClipOptions& options) {
       OGRFeatureUniquePtr f(src.layer->GetFeature(a.fid));
       if (!f || !f->GetGeometryRef()) continue;
       const OGRGeometry* g = f->GetGeometryRef();
+      if (!rectangle &&
+          !meets(detail::flatten(g, detail::where(options.load.layer_path, a.fid)), window_flat))
+        continue;
       std::unique_ptr<OGRGeometry> valid;
       if (!g->IsValid()) {
         valid.reset(g->MakeValid());
@@ -70,7 +142,7 @@ std::size_t clip_layer(const ClipOptions& options) {
                       " is an invalid geometry that cannot be repaired");
         g = valid.get();
       }
-      std::unique_ptr<OGRGeometry> piece(g->Intersection(&window));
+      std::unique_ptr<OGRGeometry> piece(g->Intersection(window.get()));
       if (!piece)
         throw Error(options.load.layer_path + ": feature " + std::to_string(a.fid) +
                     " cannot be cut to the window (" + CPLGetLastErrorMsg() + ")");
@@ -81,7 +153,18 @@ std::size_t clip_layer(const ClipOptions& options) {
       }
       pieces.push_back({std::move(f), std::move(piece)});
     }
-    const OGRwkbGeometryType type = degenerate ? wkbUnknown : source_type;
+    // A layer that says Polygon (as every shapefile of polygons does) may hold features the
+    // window cuts into several parts: forced back to one polygon, the parts would turn into
+    // holes of the first. Such a layer is written as MultiPolygon (likewise for lines and
+    // points).
+    OGRwkbGeometryType type = degenerate ? wkbUnknown : source_type;
+    if (wkbFlatten(type) != wkbUnknown &&
+        !OGR_GT_IsSubClassOf(wkbFlatten(type), wkbGeometryCollection))
+      for (const Piece& p : pieces)
+        if (wkbFlatten(p.geometry->getGeometryType()) == OGR_GT_GetCollection(wkbFlatten(type))) {
+          type = OGR_GT_GetCollection(type);
+          break;
+        }
     OGRLayer* layer =
         ds->CreateLayer(src.layer->GetName(), src.layer->GetSpatialRef(), type, nullptr);
     if (!layer) throw Error("cannot write " + options.out_path + ": " + CPLGetLastErrorMsg());

@@ -675,6 +675,85 @@ TEST_F(LayersCli, JoinMatchesGeosOnAllPairs) {
   expect_error("join " + shell_quote(path("polys.shp")), "LEFT and RIGHT");
 }
 
+// Clipping by a polygonal window (--wkt, --window-layer): the features GEOS says meet the
+// window, each cut to it (areas and lengths as GEOS's intersection).
+TEST_F(LayersCli, ClipByPolygonWindows) {
+  // A non-convex window: a star with a notch, and a two-polygon window layer that overlaps.
+  const std::string wkt =
+      "POLYGON((20 20,50 25,80 20,60 50,80 80,50 60,20 80,35 50,20 20),(45 40,55 40,50 48,45 40))";
+  const std::string windows = path("windows.geojson");
+  std::ofstream(windows) << R"({"type":"FeatureCollection","features":[
+    {"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":
+      [[[10,10],[40,10],[40,40],[10,40],[10,10]]]}},
+    {"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":
+      [[[30,30],[70,35],[50,70],[30,30]]]}}]})";
+  std::unique_ptr<OGRGeometry> star;
+  {
+    OGRGeometry* g = nullptr;
+    ASSERT_EQ(OGRGeometryFactory::createFromWkt(wkt.c_str(), nullptr, &g), OGRERR_NONE);
+    star.reset(g);
+  }
+  std::unique_ptr<OGRGeometry> united;
+  {
+    const OgrFeatureSet w = read_with_ogr(windows);
+    united.reset(w.geoms[0]->Union(w.geoms[1].get()));
+  }
+  for (const char* name : {"polys.shp", "lines.shp"}) {
+    const OgrFeatureSet s = read_with_ogr(path(name));
+    for (int which = 0; which < 2; ++which) {
+      const OGRGeometry& window = which == 0 ? *star : *united;
+      const std::string out = path("clip-" + std::to_string(which) + ".geojson");
+      fs::remove(out);
+      const std::string arg =
+          which == 0 ? " --wkt " + shell_quote(wkt) : " --window-layer " + shell_quote(windows);
+      const CliRun r = run_loci("clip " + shell_quote(path(name)) + arg + " -q -o " + out);
+      ASSERT_EQ(r.status, 0) << r.err;
+      const OgrFeatureSet got = read_with_ogr(out);
+      std::map<double, int> want_measures, got_measures;  // area or length, counted
+      auto measure = [](const OGRGeometry& g) {
+        switch (wkbFlatten(g.getGeometryType())) {
+          case wkbPolygon:
+            return g.toPolygon()->get_Area();
+          case wkbMultiPolygon:
+            return g.toMultiPolygon()->get_Area();
+          case wkbLineString:
+            return g.toLineString()->get_Length();
+          case wkbMultiLineString:
+            return g.toMultiLineString()->get_Length();
+          default:
+            return 0.0;
+        }
+      };
+      std::size_t want = 0;
+      for (std::size_t i = 0; i < s.geoms.size(); ++i) {
+        if (!s.geoms[i]->Intersects(&window)) continue;
+        ++want;
+        // Clip repairs an invalid polygon (a bowtie) before cutting it, as GEOS needs.
+        const std::unique_ptr<OGRGeometry> valid(s.geoms[i]->IsValid() ? s.geoms[i]->clone()
+                                                                       : s.geoms[i]->MakeValid());
+        const std::unique_ptr<OGRGeometry> piece(valid->Intersection(&window));
+        ++want_measures[std::round(std::fabs(measure(*piece)) * 1e6) / 1e6];
+      }
+      for (const auto& g : got.geoms)
+        ++got_measures[std::round(std::fabs(measure(*g)) * 1e6) / 1e6];
+      EXPECT_EQ(got.fids.size(), want) << name << " window " << which;
+      EXPECT_EQ(got_measures, want_measures) << name << " window " << which;
+      EXPECT_GT(want, 3u);
+      fs::remove(out);
+    }
+  }
+  expect_error("clip " + shell_quote(path("polys.shp")) + " --wkt " +
+                   shell_quote("LINESTRING(0 0,1 1)") + " -o " + path("x.geojson"),
+               "POLYGON");
+  expect_error("clip " + shell_quote(path("polys.shp")) + " --wkt " + shell_quote(wkt) +
+                   " --bbox 0,0,1,1 -o " + path("x.geojson"),
+               "exactly one window");
+  expect_error("clip " + shell_quote(path("polys.shp")) + " --window-layer " +
+                   shell_quote(path("lines.shp")) + " -o " + path("x.geojson"),
+               "not a polygon");
+  EXPECT_FALSE(fs::exists(path("x.geojson")));
+}
+
 TEST_F(LayersCli, ReportsBadInput) {
   const std::string polys = path("polys.shp");
   expect_error("query " + path("missing.shp") + " --bbox 0,0,1,1", "no such file");

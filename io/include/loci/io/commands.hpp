@@ -96,7 +96,10 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 
 struct ClipOptions {
   LoadOptions load;
-  Box2 window{};
+  Box2 window{};                  // the window, unless one of the two below is given
+  std::string window_wkt;         // a polygonal window as WKT (POLYGON or MULTIPOLYGON)
+  std::string window_layer;       // a polygonal window: the union of this layer's polygons
+  std::string window_layer_name;  // its layer (default: the first)
   std::string out_path;
 };
 
