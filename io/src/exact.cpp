@@ -137,14 +137,8 @@ struct Edges {
         segs.push_back({g.points[i], g.points[i + 1]});
     }
     boxes.reserve(segs.size());
-    const double inf = std::numeric_limits<double>::infinity();
-    for (const Segment2& e : segs) {
-      Box2 b = e.box();
-      if (grow > 0)
-        b = {{std::nextafter(b.min[0] - grow, -inf), std::nextafter(b.min[1] - grow, -inf)},
-             {std::nextafter(b.max[0] + grow, inf), std::nextafter(b.max[1] + grow, inf)}};
-      boxes.push_back(b);
-    }
+    for (const Segment2& e : segs)
+      boxes.push_back(grow > 0 ? outset(e.box(), grow) : e.box());
   }
 };
 }  // namespace

@@ -73,12 +73,6 @@ double box_distance(const Box2& a, const Box2& b) {
   return std::hypot(dx, dy);
 }
 
-Box2 grown_by(const Box2& b, double d) {
-  const double inf = std::numeric_limits<double>::infinity();
-  return {{std::nextafter(b.min[0] - d, -inf), std::nextafter(b.min[1] - d, -inf)},
-          {std::nextafter(b.max[0] + d, inf), std::nextafter(b.max[1] + d, inf)}};
-}
-
 // The exact distance of two geometries: within the distance of their first points, which
 // bounds it from above.
 double exact_distance(const FlatGeometry& a, const FlatGeometry& b) {
@@ -117,7 +111,7 @@ std::vector<JoinRow> closest_pair(const Features& left, const Features& right, b
   // Every pair whose envelopes lie within the bound, nearest envelopes first.
   std::vector<Box2> grown(left.boxes.size());
   for (std::size_t i = 0; i < grown.size(); ++i)
-    grown[i] = grown_by(left.boxes[i], bound);
+    grown[i] = outset(left.boxes[i], bound);
   std::vector<std::pair<double, std::pair<Id, Id>>> candidates;
   join(std::span<const Box2>(grown), std::span<const Box2>(right.boxes), [&](Id i, Id j) {
     if (!(self && i == j))
@@ -148,12 +142,9 @@ std::vector<JoinRow> join_layers(const JoinOptions& o) {
   }
   const bool dwithin = o.predicate == JoinPredicate::dwithin;
   std::vector<Box2> grown = left.boxes;
-  if (dwithin) {
-    const double inf = std::numeric_limits<double>::infinity(), d = o.distance;
+  if (dwithin)
     for (Box2& b : grown)
-      b = {{std::nextafter(b.min[0] - d, -inf), std::nextafter(b.min[1] - d, -inf)},
-           {std::nextafter(b.max[0] + d, inf), std::nextafter(b.max[1] + d, inf)}};
-  }
+      b = outset(b, o.distance);
   std::vector<std::pair<Id, Id>> candidates;
   join(std::span<const Box2>(grown), std::span<const Box2>(right.boxes), [&](Id i, Id j) {
     candidates.emplace_back(i, j);

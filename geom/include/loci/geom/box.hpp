@@ -8,6 +8,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -111,6 +112,19 @@ constexpr bool contains(const Box<D>& outer, const Box<D>& inner) {
 template <int D>
 constexpr bool within(const Box<D>& inner, const Box<D>& outer) {
   return contains(outer, inner);
+}
+
+// b grown by d >= 0 on every side, its bounds rounded outward, so that every point within
+// distance d of b lies in it.
+template <int D>
+Box<D> outset(const Box<D>& b, double d) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Box<D> g = b;
+  for (int i = 0; i < D; ++i) {
+    g.min[i] = std::nextafter(b.min[i] - d, -inf);
+    g.max[i] = std::nextafter(b.max[i] + d, inf);
+  }
+  return g;
 }
 
 // Content of the intersection of a and b (0 when they are disjoint or only touch).
