@@ -249,6 +249,67 @@ std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry&
   return std::nullopt;
 }
 
+PreparedGeometry::PreparedGeometry(const FlatGeometry& g) : g_(&g), parity_(g.polygons, 0) {
+  for (const Part& part : g.parts) {
+    if (part.end - part.begin == 1 || part.kind == PartKind::point) {
+      for (std::uint32_t i = part.begin; i < part.end; ++i)
+        edges_.push_back({i, kPoint});
+      continue;
+    }
+    const std::uint32_t polygon = part.kind == PartKind::ring ? part.polygon : kNotRing;
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+      edges_.push_back({i, polygon});
+  }
+  const Box2 env = g.envelope();
+  bands_ = detail::YBands(
+      edges_.size(),
+      [&](std::size_t k) {
+        const Edge& e = edges_[k];
+        const double ya = g.points[e.first][1];
+        const double yb = e.polygon == kPoint ? ya : g.points[e.first + 1][1];
+        return std::pair{std::min(ya, yb), std::max(ya, yb)};
+      },
+      env.min[1], env.max[1], std::clamp<std::size_t>(edges_.size() / 8, 1, 1 << 16));
+}
+
+bool PreparedGeometry::meets(const Point2& p) const {
+  const std::vector<Point2>& pts = g_->points;
+  bool hit = false;
+  touched_.clear();
+  for (const std::uint32_t k : bands_.at(p[1])) {
+    const Edge& e = edges_[k];
+    const Point2& a = pts[e.first];
+    if (e.polygon == kPoint) {
+      if (a == p) {
+        hit = true;
+        break;
+      }
+      continue;
+    }
+    const Point2& b = pts[e.first + 1];
+    if (p[1] < std::min(a[1], b[1]) || p[1] > std::max(a[1], b[1])) continue;
+    if (std::min(a[0], b[0]) <= p[0] && p[0] <= std::max(a[0], b[0]) &&
+        orientation(a, b, p) == Orientation::collinear) {
+      hit = true;  // on the edge
+      break;
+    }
+    if (e.polygon != kNotRing && ray_crosses(a, b, p)) {
+      if (!parity_[e.polygon]) touched_.push_back(e.polygon);
+      parity_[e.polygon] ^= 1;
+      parity_[e.polygon] |= 2;
+    }
+  }
+  for (const std::uint32_t q : touched_) {
+    hit = hit || parity_[q] == 3;
+    parity_[q] = 0;
+  }
+  return hit;
+}
+
+std::size_t PreparedGeometry::memory_bytes() const {
+  return edges_.capacity() * sizeof(Edge) + bands_.memory_bytes() + parity_.capacity();
+}
+
 double distance(const FlatGeometry& g, const Point2& p) {
   double best = std::numeric_limits<double>::infinity();
   for (const Part& part : g.parts) {

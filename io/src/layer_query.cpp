@@ -110,6 +110,13 @@ struct LayerQuery::Geometries {
     return cache.emplace(fid, detail::flatten(f->GetGeometryRef(), detail::where(path, fid)))
         .first->second;
   }
+
+  // The feature prepared for point tests (its edges bucketed by y), made on first use.
+  std::unordered_map<std::int64_t, PreparedGeometry> prepared_cache;
+  const PreparedGeometry& prepared(std::int64_t fid) {
+    if (auto it = prepared_cache.find(fid); it != prepared_cache.end()) return it->second;
+    return prepared_cache.emplace(fid, PreparedGeometry(get(fid))).first->second;
+  }
 };
 
 LayerQuery::LayerQuery(const LayerIndex& index, std::string layer_path, std::string layer_name)
@@ -376,6 +383,19 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       out.push_back({number, best_fid, best_t * length,
                      candidates_only ? Point2{kNaN, kNaN} : point_at(s, best_t)});
     }
+    return;
+  }
+
+  if (q.kind == Query::Kind::point && !per_segment && !candidates_only) {
+    // Point location per feature: the features whose envelope holds the point, each tested
+    // on its edges near the point's y (one entry per feature: no duplicates to merge).
+    const std::size_t first = out.size();
+    index_.window(Box2::of_point(q.point), [&](const ItemRecord& r, const Box2&) {
+      if (geometries_->prepared(r.fid).meets(q.point)) out.push_back({number, r.fid, kNaN});
+      return true;
+    });
+    std::sort(out.begin() + std::ptrdiff_t(first), out.end(),
+              [](const Answer& a, const Answer& b) { return a.fid < b.fid; });
     return;
   }
 

@@ -21,6 +21,7 @@
 
 #include "loci/geom/box.hpp"
 #include "loci/geom/segment.hpp"
+#include "loci/index/detail/y_bands.hpp"
 
 namespace loci::io {
 
@@ -72,6 +73,31 @@ std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry&
 // strictly inside them (a hole of a, or a notch, inside b). The vertex tests are exact; the
 // middle of a piece is rounded, which can matter only for pieces shorter than the rounding.
 bool covers(const FlatGeometry& a, const FlatGeometry& b);
+
+// A geometry prepared for many point tests: its edges bucketed by y (index/detail/
+// y_bands.hpp), so that a test costs the edges near the point's y instead of all of them (what
+// GEOS's prepared polygons do for point-in-polygon). It refers to `g`, which must outlive it;
+// one test at a time (it keeps scratch parity state).
+class PreparedGeometry {
+ public:
+  explicit PreparedGeometry(const FlatGeometry& g);
+  // The answer of meets(g, Box2::of_point(p)).
+  bool meets(const Point2& p) const;
+  std::size_t memory_bytes() const;
+
+ private:
+  struct Edge {
+    std::uint32_t first;    // the edge runs from points[first] to points[first + 1]
+    std::uint32_t polygon;  // rings: the polygon it bounds; kNotRing otherwise
+  };
+  static constexpr std::uint32_t kNotRing = 0xffffffffu;
+  static constexpr std::uint32_t kPoint = 0xfffffffeu;  // an isolated point: first only
+  const FlatGeometry* g_;
+  std::vector<Edge> edges_;
+  detail::YBands bands_;
+  mutable std::vector<std::uint8_t> parity_;
+  mutable std::vector<std::uint32_t> touched_;
+};
 
 // Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
 // exactly; half-open in y so that a ray through a vertex counts once.

@@ -77,6 +77,7 @@
 #include "loci/geom/point.hpp"
 #include "loci/geom/predicates.hpp"
 #include "loci/index/detail/scratch.hpp"
+#include "loci/index/detail/y_bands.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci {
@@ -354,41 +355,24 @@ struct BspEdge {
 class BspPointLocator {
  public:
   BspPointLocator(const std::vector<BspEdge>& edges, std::uint32_t polygons, const Box2& bounds)
-      : edges_(edges), parity_(polygons, 0) {
-    const std::size_t bands = std::clamp<std::size_t>(edges.size() / 8, 1, 1 << 14);
-    y0_ = bounds.min[1];
-    const double h = bounds.max[1] - bounds.min[1];
-    scale_ = h > 0 ? static_cast<double>(bands) / h : 0;
-    start_.assign(bands + 1, 0);
-    auto span = [&](const BspEdge& e) {
-      return std::pair{band(std::min(e.a[1], e.b[1])), band(std::max(e.a[1], e.b[1]))};
-    };
-    for (const BspEdge& e : edges) {
-      const auto [lo, hi] = span(e);
-      for (std::size_t b = lo; b <= hi; ++b)
-        ++start_[b + 1];
-    }
-    for (std::size_t b = 0; b < bands; ++b)
-      start_[b + 1] += start_[b];
-    items_.resize(start_[bands]);
-    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (std::uint32_t i = 0; i < edges.size(); ++i) {
-      const auto [lo, hi] = span(edges[i]);
-      for (std::size_t b = lo; b <= hi; ++b)
-        items_[fill[b]++] = i;
-    }
-  }
+      : edges_(edges),
+        parity_(polygons, 0),
+        bands_(
+            edges.size(),
+            [&](std::size_t i) {
+              return std::pair{std::min(edges[i].a[1], edges[i].b[1]),
+                               std::max(edges[i].a[1], edges[i].b[1])};
+            },
+            bounds.min[1], bounds.max[1], std::clamp<std::size_t>(edges.size() / 8, 1, 1 << 14)) {}
 
   bool inside_other(const Point2& p, std::uint32_t except) {
-    if (!(p[1] >= y0_) || start_.size() < 2) return false;
-    const std::size_t b = band(p[1]);
     bool any = false;
     touched_.clear();
     auto touch = [&](std::uint32_t q) {
       if (!parity_[q]) touched_.push_back(q);
     };
-    for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) {
-      const BspEdge& e = edges_[items_[k]];
+    for (const std::uint32_t k : bands_.at(p[1])) {
+      const BspEdge& e = edges_[k];
       if (e.polygon == except) continue;
       const Point2& lo = e.a[1] < e.b[1] ? e.a : e.b;
       const Point2& hi = e.a[1] < e.b[1] ? e.b : e.a;
@@ -414,18 +398,10 @@ class BspPointLocator {
   }
 
  private:
-  std::size_t band(double y) const {
-    const double f = (y - y0_) * scale_;
-    const std::size_t last = start_.size() - 2;
-    if (!(f > 0)) return 0;
-    return std::min(last, static_cast<std::size_t>(f));
-  }
-
   const std::vector<BspEdge>& edges_;
   std::vector<std::uint8_t> parity_;
   std::vector<std::uint32_t> touched_;
-  std::vector<std::uint32_t> start_, items_;
-  double y0_ = 0, scale_ = 0;
+  YBands bands_;
 };
 // A piece [s0, s1] of an edge (points a + s (b - a)), what is left of it inside a cell.
 struct BspPiece {
