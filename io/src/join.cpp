@@ -134,12 +134,12 @@ std::vector<JoinRow> closest_pair(const Features& left, const Features& right, b
 }  // namespace
 
 std::vector<JoinRow> join_layers(const JoinOptions& o) {
+  // A layer joined with itself is read once.
+  const bool self = o.left_path == o.right_path && o.left_name == o.right_name;
   const Features left = read_features(o.left_path, o.left_name);
-  const Features right = read_features(o.right_path, o.right_name);
-  if (o.predicate == JoinPredicate::closest) {
-    const bool self = o.left_path == o.right_path && o.left_name == o.right_name;
-    return closest_pair(left, right, self, o.progress);
-  }
+  const Features other = self ? Features{} : read_features(o.right_path, o.right_name);
+  const Features& right = self ? left : other;
+  if (o.predicate == JoinPredicate::closest) return closest_pair(left, right, self, o.progress);
   const bool dwithin = o.predicate == JoinPredicate::dwithin;
   std::vector<Box2> grown = left.boxes;
   if (dwithin)
