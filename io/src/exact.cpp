@@ -23,19 +23,17 @@ bool any_edge(const FlatGeometry& g, F&& f) {
   return false;
 }
 
-// True when p is strictly inside one of the polygons of g. Points on a ring may answer either
-// way; callers test the boundary separately.
+// True when p is strictly inside g's polygons: an odd number of its rings cross the ray from
+// p towards +x. Points on a ring may answer either way; callers test the boundary separately.
 bool inside_polygon(const FlatGeometry& g, const Point2& p) {
   if (g.polygons == 0) return false;
-  std::vector<std::uint8_t> parity(g.polygons, 0);
+  bool odd = false;
   for (const Part& part : g.parts) {
     if (part.kind != PartKind::ring) continue;
     for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-      if (ray_crosses(g.points[i], g.points[i + 1], p)) parity[part.polygon] ^= 1;
+      odd ^= ray_crosses(g.points[i], g.points[i + 1], p);
   }
-  for (auto odd : parity)
-    if (odd) return true;
-  return false;
+  return odd;
 }
 
 }  // namespace
@@ -122,30 +120,49 @@ std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s) {
 }
 
 namespace {
-// Every edge of g, isolated points as edges of length zero, and their boxes (grown by `grow`).
+// The edges of g (isolated points as edges of length zero) whose boxes, grown by `grow`, meet
+// `window`, with those boxes. Restricting a pair test to the other geometry's envelope keeps a
+// big feature met by a small one at the cost of its edges near the small one.
 struct Edges {
   std::vector<Segment2> segs;
   std::vector<Box2> boxes;
-  Edges(const FlatGeometry& g, double grow) {
+  Edges(const FlatGeometry& g, double grow, const Box2& window) {
+    auto add = [&](const Segment2& e) {
+      const Box2 box = grow > 0 ? outset(e.box(), grow) : e.box();
+      if (!intersects(box, window)) return;
+      segs.push_back(e);
+      boxes.push_back(box);
+    };
     for (const Part& part : g.parts) {
       if (part.end - part.begin == 1 || part.kind == PartKind::point) {
         for (std::uint32_t i = part.begin; i < part.end; ++i)
-          segs.push_back({g.points[i], g.points[i]});
+          add({g.points[i], g.points[i]});
         continue;
       }
       for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-        segs.push_back({g.points[i], g.points[i + 1]});
+        add({g.points[i], g.points[i + 1]});
     }
-    boxes.reserve(segs.size());
-    for (const Segment2& e : segs)
-      boxes.push_back(grow > 0 ? outset(e.box(), grow) : e.box());
   }
 };
+
+Box2 common(const Box2& a, const Box2& b) {
+  return {{std::max(a.min[0], b.min[0]), std::max(a.min[1], b.min[1])},
+          {std::min(a.max[0], b.max[0]), std::min(a.max[1], b.max[1])}};
+}
+
+double box_gap(const Box2& a, const Box2& b) {
+  return std::hypot(std::max({0.0, a.min[0] - b.max[0], b.min[0] - a.max[0]}),
+                    std::max({0.0, a.min[1] - b.max[1], b.min[1] - a.max[1]}));
+}
 }  // namespace
 
-bool meets(const FlatGeometry& a, const FlatGeometry& b) {
-  if (a.empty() || b.empty() || !intersects(a.envelope(), b.envelope())) return false;
-  const Edges ea(a, 0), eb(b, 0);
+bool meets(const PreparedGeometry& pa, const PreparedGeometry& pb) {
+  const FlatGeometry& a = pa.geometry();
+  const FlatGeometry& b = pb.geometry();
+  if (a.empty() || b.empty() || !intersects(pa.envelope(), pb.envelope())) return false;
+  // Edges that meet lie in both envelopes.
+  const Box2 both = common(pa.envelope(), pb.envelope());
+  const Edges ea(a, 0, both), eb(b, 0, both);
   bool found = false;
   join(std::span<const Box2>(ea.boxes), std::span<const Box2>(eb.boxes), [&](Id i, Id j) {
     found = intersects(ea.segs[i], eb.segs[j]);
@@ -153,38 +170,25 @@ bool meets(const FlatGeometry& a, const FlatGeometry& b) {
   });
   if (found) return true;
   // No edges meet: each connected part of one lies inside the other's polygons or outside.
-  auto part_inside = [](const FlatGeometry& g, const FlatGeometry& other) {
+  auto part_inside = [](const FlatGeometry& g, const PreparedGeometry& other) {
+    if (other.geometry().polygons == 0) return false;
     for (const Part& part : g.parts)
-      if (inside_polygon(other, g.points[part.begin])) return true;
+      if (other.locate(g.points[part.begin]) != Location::outside) return true;
     return false;
   };
-  return part_inside(a, b) || part_inside(b, a);
+  return part_inside(a, pb) || part_inside(b, pa);
 }
 
-namespace {
-// Whether p lies on an edge (or isolated point) of g, exactly.
-bool on_edges(const FlatGeometry& g, const Point2& p) {
-  const Segment2 q{p, p};
-  for (const Part& part : g.parts) {
-    if (part.end - part.begin == 1 || part.kind == PartKind::point) {
-      for (std::uint32_t i = part.begin; i < part.end; ++i)
-        if (g.points[i] == p) return true;
-      continue;
-    }
-    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-      if (intersects(Segment2{g.points[i], g.points[i + 1]}, q)) return true;
-  }
-  return false;
+bool meets(const FlatGeometry& a, const FlatGeometry& b) {
+  if (a.empty() || b.empty() || !intersects(a.envelope(), b.envelope())) return false;
+  return meets(PreparedGeometry(a), PreparedGeometry(b));
 }
 
-bool in_closed(const FlatGeometry& g, const Point2& p) {
-  return on_edges(g, p) || inside_polygon(g, p);
-}
-}  // namespace
-
-bool covers(const FlatGeometry& a, const FlatGeometry& b) {
-  if (a.empty() || b.empty() || !within(b.envelope(), a.envelope())) return false;
-  const Edges ea(a, 0), eb(b, 0);
+bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
+  const FlatGeometry& a = pa.geometry();
+  const FlatGeometry& b = pb.geometry();
+  if (a.empty() || b.empty() || !within(pb.envelope(), pa.envelope())) return false;
+  const Edges ea(a, 0, pb.envelope()), eb(b, 0, pb.envelope());
   // Where a's linework meets each edge of b: cut parameters, and the stretches along a's
   // edges (collinear overlaps), which lie in a.
   std::vector<std::vector<double>> cuts(eb.segs.size());
@@ -203,7 +207,7 @@ bool covers(const FlatGeometry& a, const FlatGeometry& b) {
   });
   for (std::size_t i = 0; i < eb.segs.size(); ++i) {
     const Segment2& s = eb.segs[i];
-    if (!in_closed(a, s.a) || !in_closed(a, s.b)) return false;
+    if (!pa.meets(s.a) || !pa.meets(s.b)) return false;
     if (s.a == s.b) continue;
     std::vector<double>& c = cuts[i];
     c.push_back(0);
@@ -217,23 +221,31 @@ bool covers(const FlatGeometry& a, const FlatGeometry& b) {
         on_a = on_a || (lo <= t0 && t1 <= hi);
       if (on_a) continue;
       const double t = (t0 + t1) / 2;
-      if (!in_closed(a, {s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])}))
-        return false;
+      if (!pa.meets({s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])})) return false;
     }
   }
   if (b.polygons > 0) {
     if (a.polygons == 0) return false;  // linework and points cover no area
-    const Box2 env = b.envelope();
+    const Box2& env = pb.envelope();
     for (const Point2& v : a.points)
-      if (intersects(env, v) && inside_polygon(b, v) && !on_edges(b, v)) return false;
+      if (intersects(env, v) && pb.locate(v) == Location::inside) return false;
   }
   return true;
 }
 
-std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry& b, double d) {
-  if (a.empty() || b.empty()) return std::nullopt;
-  if (meets(a, b)) return 0.0;
-  const Edges ea(a, d), eb(b, 0);
+bool covers(const FlatGeometry& a, const FlatGeometry& b) {
+  if (a.empty() || b.empty() || !within(b.envelope(), a.envelope())) return false;
+  return covers(PreparedGeometry(a), PreparedGeometry(b));
+}
+
+std::optional<double> distance_within(const PreparedGeometry& pa, const PreparedGeometry& pb,
+                                      double d) {
+  const FlatGeometry& a = pa.geometry();
+  const FlatGeometry& b = pb.geometry();
+  if (a.empty() || b.empty() || box_gap(pa.envelope(), pb.envelope()) > d) return std::nullopt;
+  if (meets(pa, pb)) return 0.0;
+  // Only edges within d of the other's envelope can come within d of its edges.
+  const Edges ea(a, d, pb.envelope()), eb(b, 0, outset(pa.envelope(), d));
   double best = std::numeric_limits<double>::infinity();
   join(std::span<const Box2>(ea.boxes), std::span<const Box2>(eb.boxes), [&](Id i, Id j) {
     const Segment2& s = ea.segs[i];
@@ -249,65 +261,67 @@ std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry&
   return std::nullopt;
 }
 
-PreparedGeometry::PreparedGeometry(const FlatGeometry& g) : g_(&g), parity_(g.polygons, 0) {
+std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry& b, double d) {
+  if (a.empty() || b.empty()) return std::nullopt;
+  return distance_within(PreparedGeometry(a), PreparedGeometry(b), d);
+}
+
+double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bound) {
+  const double gap = box_gap(a.envelope(), b.envelope());
+  for (int k = 8; k > 0; --k) {
+    const double d = std::ldexp(bound, -2 * k);
+    if (d < gap) continue;
+    if (auto found = distance_within(a, b, d)) return *found;
+  }
+  return distance_within(a, b, bound).value_or(bound);
+}
+
+PreparedGeometry::PreparedGeometry(const FlatGeometry& g) : g_(&g), envelope_(g.envelope()) {
   for (const Part& part : g.parts) {
     if (part.end - part.begin == 1 || part.kind == PartKind::point) {
       for (std::uint32_t i = part.begin; i < part.end; ++i)
         edges_.push_back({i, kPoint});
       continue;
     }
-    const std::uint32_t polygon = part.kind == PartKind::ring ? part.polygon : kNotRing;
+    const std::uint32_t kind = part.kind == PartKind::ring ? kRing : kLine;
     for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-      edges_.push_back({i, polygon});
+      edges_.push_back({i, kind});
   }
-  const Box2 env = g.envelope();
+  const Box2& env = envelope_;
   bands_ = detail::YBands(
       edges_.size(),
       [&](std::size_t k) {
         const Edge& e = edges_[k];
         const double ya = g.points[e.first][1];
-        const double yb = e.polygon == kPoint ? ya : g.points[e.first + 1][1];
+        const double yb = e.kind == kPoint ? ya : g.points[e.first + 1][1];
         return std::pair{std::min(ya, yb), std::max(ya, yb)};
       },
       env.min[1], env.max[1], std::clamp<std::size_t>(edges_.size() / 8, 1, 1 << 16));
 }
 
-bool PreparedGeometry::meets(const Point2& p) const {
+Location PreparedGeometry::locate(const Point2& p) const {
+  if (!intersects(envelope_, p)) return Location::outside;
   const std::vector<Point2>& pts = g_->points;
-  bool hit = false;
-  touched_.clear();
+  bool odd = false;
   for (const std::uint32_t k : bands_.at(p[1])) {
     const Edge& e = edges_[k];
     const Point2& a = pts[e.first];
-    if (e.polygon == kPoint) {
-      if (a == p) {
-        hit = true;
-        break;
-      }
+    if (e.kind == kPoint) {
+      if (a == p) return Location::boundary;
       continue;
     }
     const Point2& b = pts[e.first + 1];
     if (p[1] < std::min(a[1], b[1]) || p[1] > std::max(a[1], b[1])) continue;
     if (std::min(a[0], b[0]) <= p[0] && p[0] <= std::max(a[0], b[0]) &&
-        orientation(a, b, p) == Orientation::collinear) {
-      hit = true;  // on the edge
-      break;
-    }
-    if (e.polygon != kNotRing && ray_crosses(a, b, p)) {
-      if (!parity_[e.polygon]) touched_.push_back(e.polygon);
-      parity_[e.polygon] ^= 1;
-      parity_[e.polygon] |= 2;
-    }
+        orientation(a, b, p) == Orientation::collinear)
+      return Location::boundary;
+    if (e.kind == kRing) odd ^= ray_crosses(a, b, p);
   }
-  for (const std::uint32_t q : touched_) {
-    hit = hit || parity_[q] == 3;
-    parity_[q] = 0;
-  }
-  return hit;
+  return odd ? Location::inside : Location::outside;
 }
 
 std::size_t PreparedGeometry::memory_bytes() const {
-  return edges_.capacity() * sizeof(Edge) + bands_.memory_bytes() + parity_.capacity();
+  return edges_.capacity() * sizeof(Edge) + bands_.memory_bytes();
 }
 
 double distance(const FlatGeometry& g, const Point2& p) {

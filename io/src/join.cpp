@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <span>
 
 #include "gdal_layer.hpp"
@@ -20,6 +21,14 @@ struct Features {
   std::vector<std::int64_t> fids;
   std::vector<FlatGeometry> geoms;
   std::vector<Box2> boxes;
+  // Prepared on first use, once per feature however many pairs it takes part in.
+  mutable std::vector<std::unique_ptr<PreparedGeometry>> prepared;
+
+  const PreparedGeometry& at(std::size_t i) const {
+    if (prepared.size() != geoms.size()) prepared.resize(geoms.size());
+    if (!prepared[i]) prepared[i] = std::make_unique<PreparedGeometry>(geoms[i]);
+    return *prepared[i];
+  }
 };
 
 Features read_features(const std::string& path, const std::string& name) {
@@ -73,14 +82,14 @@ double box_distance(const Box2& a, const Box2& b) {
   return std::hypot(dx, dy);
 }
 
-// The exact distance of two geometries: within the distance of their first points, which
-// bounds it from above.
-double exact_distance(const FlatGeometry& a, const FlatGeometry& b) {
-  const Point2& p = a.points[0];
-  const Point2& q = b.points[0];
+// The exact distance of two geometries, bounded from above by the distance of their first
+// points.
+double exact_distance(const PreparedGeometry& a, const PreparedGeometry& b) {
+  const Point2& p = a.geometry().points[0];
+  const Point2& q = b.geometry().points[0];
   const double bound =
       std::nextafter(std::hypot(p[0] - q[0], p[1] - q[1]), std::numeric_limits<double>::infinity());
-  return distance_within(a, b, bound).value_or(bound);
+  return distance(a, b, bound);
 }
 
 std::vector<JoinRow> closest_pair(const Features& left, const Features& right, bool self,
@@ -104,7 +113,7 @@ std::vector<JoinRow> closest_pair(const Features& left, const Features& right, b
     const Point2 c{(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2};
     tree.browse(c, [&](Id j, const Box2&, double) {
       if (self && j == i) return true;
-      offer(i, j, exact_distance(left.geoms[i], right.geoms[j]));
+      offer(i, j, exact_distance(left.at(i), right.at(j)));
       return false;
     });
   }
@@ -124,7 +133,7 @@ std::vector<JoinRow> closest_pair(const Features& left, const Features& right, b
   for (const auto& [box_distance, ij] : candidates) {
     if (box_distance > bound) break;
     const auto [i, j] = ij;
-    if (auto d = distance_within(left.geoms[i], right.geoms[j], bound)) offer(i, j, *d);
+    if (auto d = distance_within(left.at(i), right.at(j), bound)) offer(i, j, *d);
     ticker.tick(double(++done));
   }
   rows.push_back(best);
@@ -155,11 +164,11 @@ std::vector<JoinRow> join_layers(const JoinOptions& o) {
   std::size_t done = 0;
   for (const auto& [i, j] : candidates) {
     if (dwithin) {
-      if (auto d = distance_within(left.geoms[i], right.geoms[j], o.distance))
+      if (auto d = distance_within(left.at(i), right.at(j), o.distance))
         rows.push_back({left.fids[i], right.fids[j], *d});
     } else {
-      const FlatGeometry& a = left.geoms[i];
-      const FlatGeometry& b = right.geoms[j];
+      const PreparedGeometry& a = left.at(i);
+      const PreparedGeometry& b = right.at(j);
       const bool yes = o.predicate == JoinPredicate::contains ? covers(a, b)
                        : o.predicate == JoinPredicate::within ? covers(b, a)
                                                               : meets(a, b);

@@ -95,16 +95,42 @@ LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
   return x;
 }
 
+namespace {
+// Drivers that read features by FID in place; the others (GeoJSON, CSV, GML, KML...) parse
+// from the start of the file for each lookup.
+bool fast_random_read(GDALDataset& ds) {
+  const std::string driver = ds.GetDriver() ? ds.GetDriver()->GetDescription() : "";
+  for (const char* fast : {"ESRI Shapefile", "GPKG", "SQLite", "FlatGeobuf", "OpenFileGDB",
+                           "MapInfo File", "PostgreSQL", "Memory"})
+    if (driver == fast) return true;
+  return false;
+}
+}  // namespace
+
 struct LayerQuery::Geometries {
   std::string path;
   std::string name;
   std::optional<detail::OpenLayer> layer;
   std::unordered_map<std::int64_t, FlatGeometry> cache;
 
+  bool preloaded = false;
+
   const FlatGeometry& get(std::int64_t fid) {
     if (auto it = cache.find(fid); it != cache.end()) return it->second;
-    if (!layer) layer = detail::open_layer(path, name);
-    OGRFeatureUniquePtr f(layer->layer->GetFeature(fid));
+    if (!layer) {
+      layer = detail::open_layer(path, name);
+      preloaded = !fast_random_read(*layer->dataset);
+      if (preloaded) {
+        // Text formats find a feature by FID by parsing the file from its start: one pass
+        // that keeps every geometry costs what the first lookup would.
+        layer->layer->ResetReading();
+        for (auto& f : *layer->layer)
+          cache.emplace(f->GetFID(),
+                        detail::flatten(f->GetGeometryRef(), detail::where(path, f->GetFID())));
+        if (auto it = cache.find(fid); it != cache.end()) return it->second;
+      }
+    }
+    OGRFeatureUniquePtr f(preloaded ? nullptr : layer->layer->GetFeature(fid));
     if (!f)
       throw Error(detail::where(path, fid) + " is not in the layer: the index does not match it");
     return cache.emplace(fid, detail::flatten(f->GetGeometryRef(), detail::where(path, fid)))

@@ -152,6 +152,15 @@ int main(int argc, char** argv) {
     const double build = seconds_since(t0);
     loci::io::LayerQuery query(index, layer, index.layer_name());
     std::vector<loci::io::Answer> answers;
+    {
+      // The layer's geometries are read before the clock starts, as GEOS's are: a text layer
+      // is read whole on the first lookup.
+      loci::io::Query q;
+      q.kind = loci::io::Query::Kind::point;
+      q.point = points[0];
+      query.run(q, 1, false, answers);
+      answers.clear();
+    }
     t0 = Clock::now();
     for (std::size_t i = 0; i < n; ++i) {
       loci::io::Query q;
@@ -166,7 +175,15 @@ int main(int argc, char** argv) {
     std::size_t differ = 0;
     for (std::size_t i = 0; i < n; ++i) {
       std::sort(got[i].begin(), got[i].end());
-      differ += got[i] != geos_answers[i];
+      if (got[i] != geos_answers[i] && differ++ < 3) {
+        std::printf("  differs at %.17g,%.17g: loci", points[i][0], points[i][1]);
+        for (long long f : got[i])
+          std::printf(" %lld", f);
+        std::printf("; GEOS");
+        for (long long f : geos_answers[i])
+          std::printf(" %lld", f);
+        std::printf("\n");
+      }
     }
     const std::string name = std::string("loci per ") + loci::io::to_string(per);
     std::printf("%-38s %10.3f %10.3f %12.0f %10.2f   (%zu points answered differently)\n",

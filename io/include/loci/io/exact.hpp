@@ -10,7 +10,10 @@
 // Predicates are exact: a geometry meets a box, a segment or a point when one of its points
 // lies in it, one of its edges meets it (loci's exact box/segment and segment/segment tests),
 // or one of its polygons contains a point of it (crossing parity decided with the exact
-// orientation predicate; a point on a ring is caught by the edge test, not by parity).
+// orientation predicate; a point on a ring is caught by the edge test, not by parity). The
+// rings of a feature are taken together (the even-odd rule, as GEOS and the per-segment index
+// count them): for valid geometries that is polygon by polygon, and where polygons of one
+// invalid multi-polygon overlap, their overlap is outside.
 // Touching counts. Distances are computed in floating point and are 0 inside a polygon.
 // Thread-safety: plain values; the functions are pure.
 #pragma once
@@ -74,30 +77,48 @@ std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry&
 // middle of a piece is rounded, which can matter only for pieces shorter than the rounding.
 bool covers(const FlatGeometry& a, const FlatGeometry& b);
 
+// Where a point lies with respect to a geometry: outside it, on its boundary (a point, an
+// edge of a line or ring), or strictly inside one of its polygons.
+enum class Location : std::uint8_t { outside, boundary, inside };
+
 // A geometry prepared for many point tests: its edges bucketed by y (index/detail/
 // y_bands.hpp), so that a test costs the edges near the point's y instead of all of them (what
-// GEOS's prepared polygons do for point-in-polygon). It refers to `g`, which must outlive it;
-// one test at a time (it keeps scratch parity state).
+// GEOS's prepared polygons do for point-in-polygon). The pair tests below take prepared
+// geometries so that a feature met by many others (a joined layer) is prepared once and each
+// pair costs the edges near the other's envelope, not the product of the sizes. It refers to
+// `g`, which must outlive it. Thread-safety: const member functions may run concurrently.
 class PreparedGeometry {
  public:
   explicit PreparedGeometry(const FlatGeometry& g);
+  const FlatGeometry& geometry() const { return *g_; }
+  const Box2& envelope() const { return envelope_; }
+  // Exact.
+  Location locate(const Point2& p) const;
   // The answer of meets(g, Box2::of_point(p)).
-  bool meets(const Point2& p) const;
+  bool meets(const Point2& p) const { return locate(p) != Location::outside; }
   std::size_t memory_bytes() const;
 
  private:
   struct Edge {
-    std::uint32_t first;    // the edge runs from points[first] to points[first + 1]
-    std::uint32_t polygon;  // rings: the polygon it bounds; kNotRing otherwise
+    std::uint32_t first;  // the edge runs from points[first] to points[first + 1]
+    std::uint32_t kind;   // kRing, kLine, or kPoint (an isolated point: first only)
   };
-  static constexpr std::uint32_t kNotRing = 0xffffffffu;
-  static constexpr std::uint32_t kPoint = 0xfffffffeu;  // an isolated point: first only
+  static constexpr std::uint32_t kRing = 0, kLine = 1, kPoint = 2;
   const FlatGeometry* g_;
+  Box2 envelope_;
   std::vector<Edge> edges_;
   detail::YBands bands_;
-  mutable std::vector<std::uint8_t> parity_;
-  mutable std::vector<std::uint32_t> touched_;
 };
+
+// The pair tests above on prepared geometries (the same answers).
+bool meets(const PreparedGeometry& a, const PreparedGeometry& b);
+bool covers(const PreparedGeometry& a, const PreparedGeometry& b);
+std::optional<double> distance_within(const PreparedGeometry& a, const PreparedGeometry& b,
+                                      double d);
+// The distance between a and b, given an upper bound of it (for example the distance between
+// a point of each): searched within bound / 4^k for k = 8, 7, ..., 0, so that two geometries
+// far apart relative to their sizes cost the edge pairs near their closest approach.
+double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bound);
 
 // Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
 // exactly; half-open in y so that a ray through a vertex counts once.

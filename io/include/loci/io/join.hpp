@@ -10,9 +10,10 @@
 //   closest      the pair at the smallest distance (--closest)
 //
 // Candidates come from a sort-and-sweep join of the features' envelopes (index/sweep_join.hpp),
-// the left ones grown by D for dwithin; each candidate is refined on the flattened geometries
-// (exact.hpp: their edges joined the same way, so that two big polygons cost what their close
-// edges cost, not the product of their sizes). Rows are sorted by (left, right). The closest
+// the left ones grown by D for dwithin; each candidate is refined on the flattened geometries,
+// each prepared once (exact.hpp: the edges of both near the other's envelope joined the same
+// way, point tests on edges bucketed by y), so that two big polygons cost what their close
+// edges cost, not the product of their sizes. Rows are sorted by (left, right). The closest
 // pair starts from an upper bound (each left feature against the right feature whose envelope
 // is nearest its envelope's centre), joins the envelopes within that bound and refines them
 // nearest envelope first, tightening the bound, until the next envelope distance exceeds it.
