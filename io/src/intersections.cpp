@@ -12,43 +12,6 @@ namespace loci::io {
 
 namespace {
 
-// The segments of a layer in reading order, and for each the first and last segment of its
-// line or ring, which is what adjacency needs.
-struct Linework {
-  std::vector<Segment2> segs;
-  std::vector<std::int64_t> fid;
-  std::vector<std::uint32_t> first, last;
-
-  Linework(const std::string& path, const std::string& layer) {
-    const std::vector<SegmentRecord> recs = read_segments(path, layer);
-    segs.reserve(recs.size());
-    fid.reserve(recs.size());
-    for (const SegmentRecord& r : recs) {
-      segs.push_back(r.segment);
-      fid.push_back(r.fid);
-    }
-    first.resize(recs.size());
-    last.resize(recs.size());
-    for (std::size_t i = 0; i < recs.size();) {
-      std::size_t j = i;
-      while (j + 1 < recs.size() && recs[j + 1].fid == recs[i].fid &&
-             recs[j + 1].part == recs[i].part)
-        ++j;
-      for (std::size_t k = i; k <= j; ++k)
-        first[k] = std::uint32_t(i), last[k] = std::uint32_t(j);
-      i = j + 1;
-    }
-  }
-
-  // Consecutive segments of one line or ring, the closing pair of a closed one included.
-  bool adjacent(Id i, Id j) const {
-    if (first[i] != first[j]) return false;
-    if (i + 1 == j || j + 1 == i) return true;
-    const Id lo = std::min(i, j), hi = std::max(i, j);
-    return lo == first[i] && hi == last[i] && segs[lo].a == segs[hi].b;
-  }
-};
-
 void add_rows(std::int64_t a, std::int64_t b, const SegmentIntersection& x,
               std::vector<IntersectionRow>& rows) {
   rows.push_back({a, b, x.a});
@@ -57,10 +20,37 @@ void add_rows(std::int64_t a, std::int64_t b, const SegmentIntersection& x,
 
 }  // namespace
 
+Linework::Linework(const std::vector<SegmentRecord>& recs) {
+  segs.reserve(recs.size());
+  fid.reserve(recs.size());
+  for (const SegmentRecord& r : recs) {
+    segs.push_back(r.segment);
+    fid.push_back(r.fid);
+  }
+  first.resize(recs.size());
+  last.resize(recs.size());
+  for (std::size_t i = 0; i < recs.size();) {
+    std::size_t j = i;
+    while (j + 1 < recs.size() && recs[j + 1].fid == recs[i].fid &&
+           recs[j + 1].part == recs[i].part)
+      ++j;
+    for (std::size_t k = i; k <= j; ++k)
+      first[k] = std::uint32_t(i), last[k] = std::uint32_t(j);
+    i = j + 1;
+  }
+}
+
 std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
+  const Linework left(read_segments(o.layer_path, o.layer_name));
+  if (o.other_path.empty()) return intersection_rows(left, nullptr, o.pairs_only);
+  const Linework right(read_segments(o.other_path, o.other_name));
+  return intersection_rows(left, &right, o.pairs_only);
+}
+
+std::vector<IntersectionRow> intersection_rows(const Linework& left, const Linework* other,
+                                               bool pairs_only) {
   std::vector<IntersectionRow> rows;
-  const Linework left(o.layer_path, o.layer_name);
-  if (o.other_path.empty()) {
+  if (!other) {
     segment_intersections(
         std::span<const Segment2>(left.segs), [&](Id i, Id j) { return left.adjacent(i, j); },
         [&](Id i, Id j, const SegmentIntersection& x) {
@@ -68,7 +58,7 @@ std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
           return true;
         });
   } else {
-    const Linework right(o.other_path, o.other_name);
+    const Linework& right = *other;
     segment_intersections(std::span<const Segment2>(left.segs),
                           std::span<const Segment2>(right.segs),
                           [&](Id i, Id j, const SegmentIntersection& x) {
@@ -76,7 +66,7 @@ std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
                             return true;
                           });
   }
-  if (o.pairs_only)
+  if (pairs_only)
     for (auto& r : rows)
       r.p = {0, 0};
   std::sort(rows.begin(), rows.end());

@@ -15,24 +15,18 @@
 #include "loci/io/exact.hpp"
 
 namespace loci::io {
-namespace {
 
-struct Features {
-  std::vector<std::int64_t> fids;
-  std::vector<FlatGeometry> geoms;
-  std::vector<Box2> boxes;
-  // Prepared on first use, once per feature however many pairs it takes part in.
-  mutable std::vector<std::unique_ptr<PreparedGeometry>> prepared;
+JoinLayer::JoinLayer(JoinLayer&&) noexcept = default;
+JoinLayer::~JoinLayer() = default;
 
-  const PreparedGeometry& at(std::size_t i) const {
-    if (prepared.size() != geoms.size()) prepared.resize(geoms.size());
-    if (!prepared[i]) prepared[i] = std::make_unique<PreparedGeometry>(geoms[i]);
-    return *prepared[i];
-  }
-};
+const PreparedGeometry& JoinLayer::prepared(std::size_t i) const {
+  if (prepared_.size() != geoms.size()) prepared_.resize(geoms.size());
+  if (!prepared_[i]) prepared_[i] = std::make_unique<PreparedGeometry>(geoms[i]);
+  return *prepared_[i];
+}
 
-Features read_features(const std::string& path, const std::string& name) {
-  Features out;
+JoinLayer read_join_layer(const std::string& path, const std::string& name) {
+  JoinLayer out;
   auto ol = detail::open_layer(path, name);
   const detail::ReadCheck check(path);
   ol.layer->ResetReading();
@@ -48,8 +42,6 @@ Features read_features(const std::string& path, const std::string& name) {
   check.finish();
   return out;
 }
-
-}  // namespace
 
 void parse_join_predicate(const std::string& text, JoinOptions& o) {
   if (text == "intersects" || text == "contains" || text == "within") {
@@ -92,7 +84,7 @@ double exact_distance(const PreparedGeometry& a, const PreparedGeometry& b) {
   return distance(a, b, bound);
 }
 
-std::vector<JoinRow> closest_pair(const Features& left, const Features& right, bool self,
+std::vector<JoinRow> closest_pair(const JoinLayer& left, const JoinLayer& right, bool self,
                                   const Progress& progress) {
   std::vector<JoinRow> rows;
   if (left.fids.empty() || right.fids.empty() || (self && left.fids.size() < 2)) return rows;
@@ -113,7 +105,7 @@ std::vector<JoinRow> closest_pair(const Features& left, const Features& right, b
     const Point2 c{(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2};
     tree.browse(c, [&](Id j, const Box2&, double) {
       if (self && j == i) return true;
-      offer(i, j, exact_distance(left.at(i), right.at(j)));
+      offer(i, j, exact_distance(left.prepared(i), right.prepared(j)));
       return false;
     });
   }
@@ -133,7 +125,7 @@ std::vector<JoinRow> closest_pair(const Features& left, const Features& right, b
   for (const auto& [box_distance, ij] : candidates) {
     if (box_distance > bound) break;
     const auto [i, j] = ij;
-    if (auto d = distance_within(left.at(i), right.at(j), bound)) offer(i, j, *d);
+    if (auto d = distance_within(left.prepared(i), right.prepared(j), bound)) offer(i, j, *d);
     ticker.tick(double(++done));
   }
   rows.push_back(best);
@@ -145,33 +137,41 @@ std::vector<JoinRow> closest_pair(const Features& left, const Features& right, b
 std::vector<JoinRow> join_layers(const JoinOptions& o) {
   // A layer joined with itself is read once.
   const bool self = o.left_path == o.right_path && o.left_name == o.right_name;
-  const Features left = read_features(o.left_path, o.left_name);
-  const Features other = self ? Features{} : read_features(o.right_path, o.right_name);
-  const Features& right = self ? left : other;
-  if (o.predicate == JoinPredicate::closest) return closest_pair(left, right, self, o.progress);
-  const bool dwithin = o.predicate == JoinPredicate::dwithin;
+  const JoinLayer left = read_join_layer(o.left_path, o.left_name);
+  if (self) return join_layers(left, nullptr, o.predicate, o.distance, o.progress);
+  const JoinLayer right = read_join_layer(o.right_path, o.right_name);
+  return join_layers(left, &right, o.predicate, o.distance, o.progress);
+}
+
+std::vector<JoinRow> join_layers(const JoinLayer& left, const JoinLayer* other,
+                                 JoinPredicate predicate, double distance,
+                                 const Progress& progress) {
+  const bool self = other == nullptr;
+  const JoinLayer& right = self ? left : *other;
+  if (predicate == JoinPredicate::closest) return closest_pair(left, right, self, progress);
+  const bool dwithin = predicate == JoinPredicate::dwithin;
   std::vector<Box2> grown = left.boxes;
   if (dwithin)
     for (Box2& b : grown)
-      b = outset(b, o.distance);
+      b = outset(b, distance);
   std::vector<std::pair<Id, Id>> candidates;
   join(std::span<const Box2>(grown), std::span<const Box2>(right.boxes), [&](Id i, Id j) {
     candidates.emplace_back(i, j);
     return true;
   });
   std::vector<JoinRow> rows;
-  ProgressTicker ticker(o.progress, double(candidates.size()));
+  ProgressTicker ticker(progress, double(candidates.size()));
   std::size_t done = 0;
   for (const auto& [i, j] : candidates) {
     if (dwithin) {
-      if (auto d = distance_within(left.at(i), right.at(j), o.distance))
+      if (auto d = distance_within(left.prepared(i), right.prepared(j), distance))
         rows.push_back({left.fids[i], right.fids[j], *d});
     } else {
-      const PreparedGeometry& a = left.at(i);
-      const PreparedGeometry& b = right.at(j);
-      const bool yes = o.predicate == JoinPredicate::contains ? covers(a, b)
-                       : o.predicate == JoinPredicate::within ? covers(b, a)
-                                                              : meets(a, b);
+      const PreparedGeometry& a = left.prepared(i);
+      const PreparedGeometry& b = right.prepared(j);
+      const bool yes = predicate == JoinPredicate::contains ? covers(a, b)
+                       : predicate == JoinPredicate::within ? covers(b, a)
+                                                            : meets(a, b);
       if (yes) rows.push_back({left.fids[i], right.fids[j], 0});
     }
     ticker.tick(double(++done));

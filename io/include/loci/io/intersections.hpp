@@ -13,6 +13,7 @@
 // are the true points rounded to the nearest double.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -20,6 +21,8 @@
 #include <vector>
 
 #include "loci/geom/point.hpp"
+#include "loci/geom/segment.hpp"
+#include "loci/io/layer_reader.hpp"
 #include "loci/io/output.hpp"
 #include "loci/io/progress.hpp"
 
@@ -47,6 +50,27 @@ struct IntersectionRow {
     return r.key() == s.key();
   }
 };
+
+// A layer's linework as read (read_segments), with which segments are consecutive in one line
+// or ring: the pairs a self-intersection search does not report for their shared vertex.
+struct Linework {
+  std::vector<Segment2> segs;
+  std::vector<std::int64_t> fid;
+  std::vector<std::uint32_t> first, last;  // the first and last segment of each one's line
+
+  explicit Linework(const std::vector<SegmentRecord>& records);
+  // Consecutive segments of one line or ring, the closing pair of a closed one included.
+  bool adjacent(std::size_t i, std::size_t j) const {
+    if (first[i] != first[j]) return false;
+    if (i + 1 == j || j + 1 == i) return true;
+    const std::size_t lo = std::min(i, j), hi = std::max(i, j);
+    return lo == first[i] && hi == last[i] && segs[lo].a == segs[hi].b;
+  }
+};
+
+// The rows of find_intersections on linework already read (other null: a against itself).
+std::vector<IntersectionRow> intersection_rows(const Linework& a, const Linework* other,
+                                               bool pairs_only);
 
 // The rows described above (with pairs_only, one row per pair and p unset). Throws loci::Error
 // for a layer that cannot be read or holds a NaN or infinite coordinate.

@@ -21,9 +21,11 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "loci/io/exact.hpp"
 #include "loci/io/output.hpp"
 #include "loci/io/progress.hpp"
 
@@ -57,6 +59,31 @@ struct JoinRow {
 void parse_join_predicate(const std::string& text, JoinOptions& options);
 
 std::vector<JoinRow> join_layers(const JoinOptions& options);
+
+// A layer's features as a join reads them: FIDs, flattened geometries and envelopes (features
+// with an empty geometry skipped), each geometry prepared for the pair tests on first use.
+struct JoinLayer {
+  std::vector<std::int64_t> fids;
+  std::vector<FlatGeometry> geoms;
+  std::vector<Box2> boxes;
+
+  JoinLayer() = default;
+  JoinLayer(JoinLayer&&) noexcept;
+  ~JoinLayer();
+  const PreparedGeometry& prepared(std::size_t i) const;
+
+ private:
+  mutable std::vector<std::unique_ptr<PreparedGeometry>> prepared_;
+};
+
+// Throws loci::Error for a layer that cannot be read or holds a NaN or infinite coordinate.
+JoinLayer read_join_layer(const std::string& path, const std::string& name = {});
+
+// join_layers on layers already read; `right` null joins `left` with itself (a feature is not
+// its own closest).
+std::vector<JoinRow> join_layers(const JoinLayer& left, const JoinLayer* right,
+                                 JoinPredicate predicate, double distance = 0,
+                                 const Progress& progress = {});
 
 // join_layers written as CSV (header `fid_left,fid_right`, plus `distance` for dwithin and
 // closest) or as
