@@ -238,6 +238,8 @@ int run_intersections(const Args& a) {
   o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
   o.pairs_only = a.has("--pairs-only");
   o.out_path = a.get("--output");
+  if (a.has("--jobs"))
+    o.jobs = static_cast<unsigned>(parse_count("--jobs", a.get("--jobs"), 1, 1024));
   const std::size_t n = write_intersections(o, stdout);
   if (!a.has("--quiet") && !o.out_path.empty())
     std::fprintf(stderr, "loci: %zu rows written into %s\n", n, o.out_path.c_str());
@@ -536,6 +538,7 @@ const std::vector<Command>& commands() {
          "CSV `fid_a,fid_b,x,y` (default) or GeoJSON points with both FIDs"},
         {"--pairs-only", nullptr, nullptr, "only the feature pairs (`fid_a,fid_b`)"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        {"--jobs", "-j", "N", "threads (default: one per core; the rows do not depend on it)"},
         kLayer,
         {"--layer2", nullptr, "NAME", "layer of LAYER2 (default: its first)"},
         kQuiet},

@@ -5,20 +5,11 @@
 #include <span>
 
 #include "loci/geom/error.hpp"
+#include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/segment_intersections.hpp"
 #include "loci/io/layer_reader.hpp"
 
 namespace loci::io {
-
-namespace {
-
-void add_rows(std::int64_t a, std::int64_t b, const SegmentIntersection& x,
-              std::vector<IntersectionRow>& rows) {
-  rows.push_back({a, b, x.a});
-  if (x.kind == SegmentMeet::overlap) rows.push_back({a, b, x.b});
-}
-
-}  // namespace
 
 Linework::Linework(const std::vector<SegmentRecord>& recs) {
   segs.reserve(recs.size());
@@ -42,35 +33,59 @@ Linework::Linework(const std::vector<SegmentRecord>& recs) {
 
 std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
   const Linework left(read_segments(o.layer_path, o.layer_name));
-  if (o.other_path.empty()) return intersection_rows(left, nullptr, o.pairs_only);
+  if (o.other_path.empty()) return intersection_rows(left, nullptr, o.pairs_only, o.jobs);
   const Linework right(read_segments(o.other_path, o.other_name));
-  return intersection_rows(left, &right, o.pairs_only);
+  return intersection_rows(left, &right, o.pairs_only, o.jobs);
 }
 
 std::vector<IntersectionRow> intersection_rows(const Linework& left, const Linework* other,
-                                               bool pairs_only) {
-  std::vector<IntersectionRow> rows;
+                                               bool pairs_only, unsigned jobs) {
+  // Each thread keeps its own rows, sorted and made unique on that thread, then merged.
+  using Rows = detail::LargeVector<IntersectionRow>;
+  const unsigned threads = detail::thread_count(jobs);
+  std::vector<Rows> parts(threads);
+  auto add = [&parts, pairs_only](unsigned k, std::int64_t a, std::int64_t b,
+                                  const SegmentIntersection& x) {
+    Rows& rows = parts[k];
+    if (pairs_only) {
+      rows.push_back({a, b, {0, 0}});
+      return;
+    }
+    rows.push_back({a, b, x.a});
+    if (x.kind == SegmentMeet::overlap) rows.push_back({a, b, x.b});
+  };
   if (!other) {
-    segment_intersections(
+    segment_intersections_parallel(
         std::span<const Segment2>(left.segs), [&](Id i, Id j) { return left.adjacent(i, j); },
-        [&](Id i, Id j, const SegmentIntersection& x) {
-          add_rows(std::min(left.fid[i], left.fid[j]), std::max(left.fid[i], left.fid[j]), x, rows);
-          return true;
+        threads,
+        [&](unsigned k) {
+          return [&, k](Id i, Id j, const SegmentIntersection& x) {
+            add(k, std::min(left.fid[i], left.fid[j]), std::max(left.fid[i], left.fid[j]), x);
+            return true;
+          };
         });
   } else {
     const Linework& right = *other;
-    segment_intersections(std::span<const Segment2>(left.segs),
-                          std::span<const Segment2>(right.segs),
-                          [&](Id i, Id j, const SegmentIntersection& x) {
-                            add_rows(left.fid[i], right.fid[j], x, rows);
-                            return true;
-                          });
+    segment_intersections_parallel(std::span<const Segment2>(left.segs),
+                                   std::span<const Segment2>(right.segs), threads, [&](unsigned k) {
+                                     return [&, k](Id i, Id j, const SegmentIntersection& x) {
+                                       add(k, left.fid[i], right.fid[j], x);
+                                       return true;
+                                     };
+                                   });
   }
-  if (pairs_only)
-    for (auto& r : rows)
-      r.p = {0, 0};
-  std::sort(rows.begin(), rows.end());
-  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  detail::for_rows(threads, threads, [&](std::uint32_t k, unsigned) {
+    std::sort(parts[k].begin(), parts[k].end());
+    parts[k].erase(std::unique(parts[k].begin(), parts[k].end()), parts[k].end());
+    return true;
+  });
+  std::vector<IntersectionRow> rows(parts[0].begin(), parts[0].end());
+  for (unsigned k = 1; k < threads; ++k) {
+    std::vector<IntersectionRow> merged(rows.size() + parts[k].size());
+    std::merge(rows.begin(), rows.end(), parts[k].begin(), parts[k].end(), merged.begin());
+    merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
+    rows.swap(merged);
+  }
   return rows;
 }
 

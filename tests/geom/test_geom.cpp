@@ -108,6 +108,33 @@ TEST(Orientation, MatchesExactOnRandomInput) {
   }
 }
 
+TEST(Orientation, ExactAtEveryScale) {
+  // Points on (or a few ulps off) a line at scales from 1e-300 to 1e140, where the floating
+  // filter gives up and the exact path decides (by expansions, or the exact kernel for inputs
+  // so small that products underflow).
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uniform_int_distribution<int> ulps(-3, 3);
+  int collinear = 0;
+  for (const double scale : {1e-300, 1e-150, 1e-6, 1.0, 1e6, 1e140}) {
+    for (int i = 0; i < 4000; ++i) {
+      const double ox = u(rng) * 1e3 * scale, oy = u(rng) * 1e3 * scale;
+      const Point2 a{ox + u(rng) * scale, oy + u(rng) * scale};
+      const Point2 b{ox + u(rng) * scale, oy + u(rng) * scale};
+      const double t = u(rng) * 4;
+      Point2 c{a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])};
+      for (int k = ulps(rng); k != 0; k += k > 0 ? -1 : 1)
+        c[k & 1] = std::nextafter(c[k & 1], k > 0 ? 1e300 : -1e300);
+      if (i % 7 == 0) c = i % 2 ? a : b;  // a repeated point
+      const int want = exact_orientation(a, b, c);
+      collinear += want == 0;
+      ASSERT_EQ(sign(orientation(a, b, c)), want) << scale << " " << i;
+      ASSERT_EQ(sign(orientation(c, a, b)), want) << scale << " " << i;
+    }
+  }
+  EXPECT_GT(collinear, 1000);
+}
+
 TEST(Segment, BoxIntersectionIsExact2D) {
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> u(0, 10);

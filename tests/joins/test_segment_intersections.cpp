@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <random>
 #include <tuple>
 #include <vector>
@@ -104,6 +105,91 @@ TEST(SegmentIntersections, SpikeAlongItselfIsReportedAndNaNRefused) {
                    std::span<const Segment2>(bad), [](Id, Id) { return false; },
                    [](Id, Id, const SegmentIntersection&) { return true; }),
                InvalidGeometry);
+}
+
+TEST(SegmentIntersections, ThreadsGiveTheSameAnswersOnManyTiles) {
+  // Enough segments for many tiles, with long ones crossing several, searched on 1 to 3
+  // threads: the same pairs as brute force each time; a stop from one thread stops all.
+  // Random walks of short integer steps (shared vertices, overlaps and T-junctions occur) over
+  // [0, 400]^2, plus a few long segments.
+  auto walks = [](std::size_t lines, std::size_t len, std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_int_distribution<int> start(0, 400), step(-6, 6);
+    Linework w;
+    for (std::size_t l = 0; l < lines; ++l) {
+      Point2 p{double(start(rng)), double(start(rng))};
+      for (std::size_t k = 0; k < len; ++k) {
+        const Point2 q{std::clamp(p[0] + step(rng), 0.0, 400.0),
+                       std::clamp(p[1] + step(rng), 0.0, 400.0)};
+        w.segs.push_back({p, q});
+        w.chain.push_back(l);
+        p = q;
+      }
+    }
+    return w;
+  };
+  Linework w = walks(300, 10, 21);
+  std::mt19937_64 rng(22);
+  std::uniform_int_distribution<int> c(0, 400);
+  for (int k = 0; k < 20; ++k) {
+    w.segs.push_back({{double(c(rng)), double(c(rng))}, {double(c(rng)), double(c(rng))}});
+    w.chain.push_back(1000 + k);
+  }
+  auto adjacent = [&](Id i, Id j) {
+    return w.chain[i] == w.chain[j] && (j == i + 1 || i == j + 1);
+  };
+  std::vector<Found> ref;
+  for (std::size_t i = 0; i < w.segs.size(); ++i)
+    for (std::size_t j = i + 1; j < w.segs.size(); ++j) {
+      const SegmentIntersection x = intersection(w.segs[i], w.segs[j]);
+      if (x.kind == SegmentMeet::none) continue;
+      const bool shared_only = x.kind == SegmentMeet::point && j == i + 1 &&
+                               w.chain[i] == w.chain[j] && x.a == w.segs[i].b;
+      if (!shared_only) ref.push_back({i, j, x});
+    }
+  ASSERT_GT(ref.size(), 500u);
+  const Linework b = walks(200, 8, 23);
+  std::vector<Found> ref2;
+  for (std::size_t i = 0; i < w.segs.size(); ++i)
+    for (std::size_t j = 0; j < b.segs.size(); ++j) {
+      const SegmentIntersection x = intersection(w.segs[i], b.segs[j]);
+      if (x.kind != SegmentMeet::none) ref2.push_back({i, j, x});
+    }
+  for (unsigned threads : {1u, 2u, 3u}) {
+    std::vector<std::vector<Found>> parts(threads);
+    const QueryStats s = segment_intersections_parallel(
+        std::span<const Segment2>(w.segs), adjacent, threads, [&](unsigned k) {
+          return [&, k](Id i, Id j, const SegmentIntersection& x) {
+            return parts[k].push_back({i, j, x}), true;
+          };
+        });
+    std::vector<Found> got;
+    for (const auto& p : parts)
+      got.insert(got.end(), p.begin(), p.end());
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, ref) << threads << " threads";
+    EXPECT_EQ(s.results, ref.size());
+
+    for (auto& p : parts)
+      p.clear();
+    segment_intersections_parallel(std::span<const Segment2>(w.segs),
+                                   std::span<const Segment2>(b.segs), threads, [&](unsigned k) {
+                                     return [&, k](Id i, Id j, const SegmentIntersection& x) {
+                                       return parts[k].push_back({i, j, x}), true;
+                                     };
+                                   });
+    got.clear();
+    for (const auto& p : parts)
+      got.insert(got.end(), p.begin(), p.end());
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, ref2) << threads << " threads, two sets";
+
+    std::atomic<std::size_t> calls{0};
+    segment_intersections_parallel(
+        std::span<const Segment2>(w.segs), adjacent, threads,
+        [&](unsigned) { return [&](Id, Id, const SegmentIntersection&) { return ++calls < 3; }; });
+    EXPECT_LE(calls.load(), 3u + 2 * threads) << threads << " threads";
+  }
 }
 
 }  // namespace

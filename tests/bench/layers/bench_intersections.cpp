@@ -6,7 +6,7 @@
 // same rows.
 //
 // Layer: countries-coastline-1m when it has been fetched (datasets/fetch.sh), else the bundled
-// sample. Usage: bench_intersections [--layer PATH] [--no-geos]
+// sample. Usage: bench_intersections [--layer PATH] [--no-geos | --loci-only]
 #include <CGAL/Bbox_2.h>
 #include <CGAL/box_intersection_d.h>
 #include <geos_c.h>
@@ -59,13 +59,17 @@ int main(int argc, char** argv) {
   std::string layer = std::string(LOCI_DATASETS_DIR) + "/cache/countries-coastline-1m/map.geo.json";
   if (!std::filesystem::exists(layer))
     layer = std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson";
-  bool with_geos = true;
+  bool with_geos = true, with_cgal = true;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--layer" && i + 1 < argc)
       layer = argv[++i];
     else if (a == "--no-geos")
       with_geos = false;
+    else if (a == "--loci-only")
+      with_geos = with_cgal = false;
+    else if (a == "--loci-only")
+      with_geos = with_cgal = false;
   }
   auto t0 = Clock::now();
   const Linework lw(loci::io::read_segments(layer));
@@ -86,7 +90,7 @@ int main(int argc, char** argv) {
     if (!same) status = 1;
   };
 
-  {
+  if (with_cgal) {
     // CGAL: boxes carrying their segment index, closed (touching boxes meet, as loci's do),
     // sequential as loci's pipeline is.
     using CBox = CGAL::Box_intersection_d::Box_with_info_d<double, 2, std::uint32_t,

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "loci/geom/box.hpp"
+#include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/detail/radix_sort.hpp"
 #include "loci/index/query.hpp"
 
@@ -36,11 +37,11 @@ namespace detail {
 
 // Boxes in sweep order, structure of arrays, with their input indices.
 struct SweepBoxes {
-  std::vector<double> min_x, max_x, min_y, max_y;
-  std::vector<std::uint32_t> index;
+  LargeVector<double> min_x, max_x, min_y, max_y;
+  LargeVector<std::uint32_t> index;
 
   explicit SweepBoxes(std::span<const Box<2>> boxes) {
-    std::vector<KeyedIndex> order(boxes.size());
+    LargeVector<KeyedIndex> order(boxes.size());
     for (std::size_t i = 0; i < boxes.size(); ++i)
       order[i] = {ordered_key(boxes[i].min[0]), std::uint32_t(i)};
     radix_sort(order, 64);

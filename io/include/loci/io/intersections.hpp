@@ -36,6 +36,7 @@ struct IntersectionsOptions {
   Format format = Format::csv;  // csv or geojson
   bool pairs_only = false;      // feature pairs without points
   std::string out_path;         // empty: the fallback stream
+  unsigned jobs = 0;            // threads; 0: one per core
 };
 
 struct IntersectionRow {
@@ -68,9 +69,10 @@ struct Linework {
   }
 };
 
-// The rows of find_intersections on linework already read (other null: a against itself).
+// The rows of find_intersections on linework already read (other null: a against itself), on
+// `jobs` threads (0: one per core); the rows do not depend on the number of threads.
 std::vector<IntersectionRow> intersection_rows(const Linework& a, const Linework* other,
-                                               bool pairs_only);
+                                               bool pairs_only, unsigned jobs = 0);
 
 // The rows described above (with pairs_only, one row per pair and p unset). Throws loci::Error
 // for a layer that cannot be read or holds a NaN or infinite coordinate.

@@ -18,15 +18,17 @@ struct KeyedIndex {
 };
 
 // Sorts v by bits [first_bit, first_bit + bits) of key_of(element).
-template <class T, class KeyOf>
-void radix_sort(std::vector<T>& v, int first_bit, int bits, KeyOf key_of) {
+template <class T, class A, class KeyOf>
+void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of) {
   constexpr int kDigit = 11;
   constexpr std::size_t kBuckets = std::size_t(1) << kDigit;
-  std::vector<T> tmp(v.size());
+  std::vector<T, A> tmp(v.size());
   for (int shift = first_bit; shift < first_bit + bits; shift += kDigit) {
     std::array<std::size_t, kBuckets> count{};
     for (const auto& x : v)
       ++count[(key_of(x) >> shift) & (kBuckets - 1)];
+    // A digit every key shares orders nothing: skip its pass.
+    if (!v.empty() && count[(key_of(v[0]) >> shift) & (kBuckets - 1)] == v.size()) continue;
     std::size_t sum = 0;
     for (auto& c : count) {
       const std::size_t n = c;
@@ -46,7 +48,8 @@ inline std::uint64_t ordered_key(double x) {
   return bits >> 63 ? ~bits : bits | (std::uint64_t(1) << 63);
 }
 
-inline void radix_sort(std::vector<KeyedIndex>& v, int bits) {
+template <class A>
+void radix_sort(std::vector<KeyedIndex, A>& v, int bits) {
   radix_sort(v, 0, bits, [](const KeyedIndex& k) { return k.key; });
 }
 
