@@ -276,6 +276,18 @@ double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bou
   return distance_within(a, b, bound).value_or(bound);
 }
 
+// The grid. A ray from p towards +x crosses the ring edges of p's cell (tested exactly) and
+// ring edges lying entirely right of the cell: those whose leftmost cell column is greater
+// than p's. For such an edge e the crossing only depends on y: it happens exactly when
+// ylo(e) <= p.y < yhi(e), whose parity is [ylo(e) <= p.y] xor [yhi(e) <= p.y]. Over the set S
+// of those edges in p's row, the parity is that of the number of end values (ylo and yhi of
+// every edge of S) at most p.y. A value below the row counts for every p of the row (it goes
+// into the cell's base parity), a value above it never, and two equal values cancel: a vertex
+// between two edges of S appears twice. What is left per cell is a handful of values (where
+// the boundary passes from the cell's side of the row to its right), sorted for a binary
+// search. Rows and columns are compared through the same monotone functions row() and col()
+// that list the edges, so "below the row" and "right of the cell" are exact statements about
+// the coordinates.
 PreparedGeometry::PreparedGeometry(const FlatGeometry& g) : g_(&g), envelope_(g.envelope()) {
   for (const Part& part : g.parts) {
     if (part.end - part.begin == 1 || part.kind == PartKind::point) {
@@ -287,24 +299,131 @@ PreparedGeometry::PreparedGeometry(const FlatGeometry& g) : g_(&g), envelope_(g.
     for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
       edges_.push_back({i, kind});
   }
-  const Box2& env = envelope_;
-  bands_ = detail::YBands(
-      edges_.size(),
-      [&](std::size_t k) {
-        const Edge& e = edges_[k];
-        const double ya = g.points[e.first][1];
-        const double yb = e.kind == kPoint ? ya : g.points[e.first + 1][1];
-        return std::pair{std::min(ya, yb), std::max(ya, yb)};
-      },
-      env.min[1], env.max[1], std::clamp<std::size_t>(edges_.size() / 8, 1, 1 << 16));
+  build(std::clamp<std::size_t>(edges_.size() / 2, 1, std::size_t(1) << 22));
+}
+
+std::uint32_t PreparedGeometry::col(double x) const {
+  const double f = (x - envelope_.min[0]) * sx_;
+  return f > 0 ? std::min<std::uint32_t>(nx_ - 1, std::uint32_t(std::min(f, 4.0e9))) : 0;
+}
+
+std::uint32_t PreparedGeometry::row(double y) const {
+  const double f = (y - envelope_.min[1]) * sy_;
+  return f > 0 ? std::min<std::uint32_t>(ny_ - 1, std::uint32_t(std::min(f, 4.0e9))) : 0;
+}
+
+void PreparedGeometry::build(std::size_t cells) {
+  const std::vector<Point2>& pts = g_->points;
+  const double w = envelope_.max[0] - envelope_.min[0], h = envelope_.max[1] - envelope_.min[1];
+  auto box_of = [&](const Edge& e) {
+    const Point2& a = pts[e.first];
+    const Point2& b = e.kind == kPoint ? a : pts[e.first + 1];
+    return Box2{{std::min(a[0], b[0]), std::min(a[1], b[1])},
+                {std::max(a[0], b[0]), std::max(a[1], b[1])}};
+  };
+  for (;;) {
+    nx_ = ny_ = 1;
+    if (w > 0 && h > 0) {
+      const double nx = std::clamp(std::round(std::sqrt(double(cells) * w / h)), 1.0, 65536.0);
+      nx_ = std::uint32_t(nx);
+      ny_ = std::uint32_t(std::clamp(std::round(double(cells) / nx), 1.0, 65536.0));
+    } else if (w > 0) {
+      nx_ = std::uint32_t(std::min<std::size_t>(cells, 65536));
+    } else if (h > 0) {
+      ny_ = std::uint32_t(std::min<std::size_t>(cells, 65536));
+    }
+    sx_ = w > 0 ? nx_ / w : 0;
+    sy_ = h > 0 ? ny_ / h : 0;
+    // Each edge is listed in every cell of its box; long diagonal edges make that quadratic in
+    // their length, so a grid listing too much is made coarser.
+    const std::size_t n = std::size_t(nx_) * ny_;
+    cell_start_.assign(n + 1, 0);
+    std::size_t listed = 0;
+    bool too_many = false;
+    for (const Edge& e : edges_) {
+      const Box2 b = box_of(e);
+      const std::uint32_t c0 = col(b.min[0]), c1 = col(b.max[0]);
+      const std::uint32_t r0 = row(b.min[1]), r1 = row(b.max[1]);
+      listed += std::size_t(c1 - c0 + 1) * (r1 - r0 + 1);
+      if (listed > 8 * edges_.size() + n) {
+        too_many = true;
+        break;
+      }
+      for (std::uint32_t r = r0; r <= r1; ++r)
+        for (std::uint32_t c = c0; c <= c1; ++c)
+          ++cell_start_[std::size_t(r) * nx_ + c + 1];
+    }
+    if (too_many && cells > 1) {
+      cells /= 4;
+      continue;
+    }
+    for (std::size_t k = 0; k < n; ++k)
+      cell_start_[k + 1] += cell_start_[k];
+    cell_edges_.resize(cell_start_[n]);
+    std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+    for (std::uint32_t k = 0; k < edges_.size(); ++k) {
+      const Box2 b = box_of(edges_[k]);
+      for (std::uint32_t r = row(b.min[1]), r1 = row(b.max[1]); r <= r1; ++r)
+        for (std::uint32_t c = col(b.min[0]), c1 = col(b.max[0]); c <= c1; ++c)
+          cell_edges_[fill[std::size_t(r) * nx_ + c]++] = k;
+    }
+    break;
+  }
+  // Per row, right to left: the ring edges whose leftmost column is right of the cell, as
+  // their end values that neither cancel nor lie outside the row.
+  const std::size_t n = std::size_t(nx_) * ny_;
+  base_.assign(n, 0);
+  std::vector<std::vector<double>> per_cell(nx_);
+  value_start_.assign(n + 1, 0);
+  values_.clear();
+  std::vector<double> open;  // the values, each present an odd number of times
+  for (std::uint32_t r = 0; r < ny_; ++r) {
+    open.clear();
+    std::uint8_t base = 0;
+    for (std::uint32_t c = nx_; c-- > 0;) {
+      const std::size_t cell = std::size_t(r) * nx_ + c;
+      base_[cell] = base;
+      per_cell[c] = open;
+      std::sort(per_cell[c].begin(), per_cell[c].end());
+      // Then the edges starting in this cell join the set for the cells to its left.
+      for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
+        const Edge& e = edges_[cell_edges_[i]];
+        if (e.kind != kRing) continue;
+        const Box2 b = box_of(e);
+        if (col(b.min[0]) != c) continue;  // listed here, but starts in a cell to the left
+        for (const double v : {b.min[1], b.max[1]}) {
+          const std::uint32_t vr = row(v);
+          if (vr < r) {
+            base ^= 1;
+          } else if (vr == r) {
+            const auto it = std::find(open.begin(), open.end(), v);
+            if (it != open.end()) {
+              *it = open.back();
+              open.pop_back();
+            } else {
+              open.push_back(v);
+            }
+          }
+        }
+      }
+    }
+    for (std::uint32_t c = 0; c < nx_; ++c) {
+      values_.insert(values_.end(), per_cell[c].begin(), per_cell[c].end());
+      value_start_[std::size_t(r) * nx_ + c + 1] = std::uint32_t(values_.size());
+    }
+  }
 }
 
 Location PreparedGeometry::locate(const Point2& p) const {
   if (!intersects(envelope_, p)) return Location::outside;
   const std::vector<Point2>& pts = g_->points;
-  bool odd = false;
-  for (const std::uint32_t k : bands_.at(p[1])) {
-    const Edge& e = edges_[k];
+  const std::size_t cell = std::size_t(row(p[1])) * nx_ + col(p[0]);
+  // The edges right of the cell: values at most p.y, plus the base.
+  const double* v0 = values_.data() + value_start_[cell];
+  const double* v1 = values_.data() + value_start_[cell + 1];
+  bool odd = (base_[cell] ^ (std::upper_bound(v0, v1, p[1]) - v0)) & 1;
+  for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
+    const Edge& e = edges_[cell_edges_[i]];
     const Point2& a = pts[e.first];
     if (e.kind == kPoint) {
       if (a == p) return Location::boundary;
@@ -321,7 +440,10 @@ Location PreparedGeometry::locate(const Point2& p) const {
 }
 
 std::size_t PreparedGeometry::memory_bytes() const {
-  return edges_.capacity() * sizeof(Edge) + bands_.memory_bytes();
+  return edges_.capacity() * sizeof(Edge) +
+         (cell_start_.capacity() + cell_edges_.capacity() + value_start_.capacity()) *
+             sizeof(std::uint32_t) +
+         values_.capacity() * sizeof(double) + base_.capacity();
 }
 
 double distance(const FlatGeometry& g, const Point2& p) {

@@ -24,7 +24,6 @@
 
 #include "loci/geom/box.hpp"
 #include "loci/geom/segment.hpp"
-#include "loci/index/detail/y_bands.hpp"
 
 namespace loci::io {
 
@@ -81,12 +80,16 @@ bool covers(const FlatGeometry& a, const FlatGeometry& b);
 // edge of a line or ring), or strictly inside one of its polygons.
 enum class Location : std::uint8_t { outside, boundary, inside };
 
-// A geometry prepared for many point tests: its edges bucketed by y (index/detail/
-// y_bands.hpp), so that a test costs the edges near the point's y instead of all of them (what
-// GEOS's prepared polygons do for point-in-polygon). The pair tests below take prepared
-// geometries so that a feature met by many others (a joined layer) is prepared once and each
-// pair costs the edges near the other's envelope, not the product of the sizes. It refers to
-// `g`, which must outlive it. Thread-safety: const member functions may run concurrently.
+// A geometry prepared for many point tests: a grid of cells over its envelope, each listing
+// the edges whose boxes overlap it, and for each cell what the edges entirely to its right
+// contribute to the crossing parity of a ray from any point of the cell (a few y values; see
+// exact.cpp). A test reads one cell: its edges decide exactly (boundary, crossings within the
+// cell) and a binary search in its values gives the rest of the parity, so that the cost is
+// the edges near the point, not those along its whole row (what GEOS's prepared polygons scan,
+// through an interval tree on y). The pair tests below take prepared geometries so that a
+// feature met by many others (a joined layer) is prepared once and each pair costs the edges
+// near the other's envelope, not the product of the sizes. It refers to `g`, which must
+// outlive it. Thread-safety: const member functions may run concurrently.
 class PreparedGeometry {
  public:
   explicit PreparedGeometry(const FlatGeometry& g);
@@ -104,10 +107,19 @@ class PreparedGeometry {
     std::uint32_t kind;   // kRing, kLine, or kPoint (an isolated point: first only)
   };
   static constexpr std::uint32_t kRing = 0, kLine = 1, kPoint = 2;
+  std::uint32_t col(double x) const;
+  std::uint32_t row(double y) const;
+  void build(std::size_t cells);
+
   const FlatGeometry* g_;
   Box2 envelope_;
   std::vector<Edge> edges_;
-  detail::YBands bands_;
+  double sx_ = 0, sy_ = 0;  // cells per unit
+  std::uint32_t nx_ = 1, ny_ = 1;
+  std::vector<std::uint32_t> cell_start_, cell_edges_;  // CSR: the edges meeting each cell
+  std::vector<std::uint32_t> value_start_;              // CSR into values_, per cell
+  std::vector<double> values_;
+  std::vector<std::uint8_t> base_;  // per cell: the parity the values do not carry
 };
 
 // The pair tests above on prepared geometries (the same answers).

@@ -1,0 +1,183 @@
+// PreparedGeometry::locate (the grid of cells with per-cell parity values) against brute force
+// (every edge through the exact predicates) on random polygons with holes, multi-polygons,
+// overlapping polygons, lines and isolated points, with integer coordinates so that points fall
+// on vertices, on edges and on the grid's cell borders; long diagonal edges that force a
+// coarser grid; flat envelopes. Also the pair tests on prepared geometries against their
+// definitions through brute-force point tests on lattice points.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "loci/geom/predicates.hpp"
+#include "loci/io/exact.hpp"
+
+namespace loci::io {
+namespace {
+
+// Brute force: on an edge or isolated point, else the parity of all ring crossings.
+Location brute(const FlatGeometry& g, const Point2& p) {
+  bool odd = false;
+  for (const Part& part : g.parts) {
+    if (part.kind == PartKind::point || part.end - part.begin == 1) {
+      for (std::uint32_t i = part.begin; i < part.end; ++i)
+        if (g.points[i] == p) return Location::boundary;
+      continue;
+    }
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i) {
+      const Point2& a = g.points[i];
+      const Point2& b = g.points[i + 1];
+      if (orientation(a, b, p) == Orientation::collinear && std::min(a[0], b[0]) <= p[0] &&
+          p[0] <= std::max(a[0], b[0]) && std::min(a[1], b[1]) <= p[1] &&
+          p[1] <= std::max(a[1], b[1]))
+        return Location::boundary;
+      if (part.kind == PartKind::ring) odd ^= ray_crosses(a, b, p);
+    }
+  }
+  return odd ? Location::inside : Location::outside;
+}
+
+void add_ring(FlatGeometry& g, const std::vector<Point2>& ring, std::uint32_t polygon) {
+  const auto begin = std::uint32_t(g.points.size());
+  g.points.insert(g.points.end(), ring.begin(), ring.end());
+  g.points.push_back(ring.front());
+  g.parts.push_back({begin, std::uint32_t(g.points.size()), PartKind::ring, polygon});
+}
+
+// A star-shaped ring around c with `n` integer vertices within radius r.
+std::vector<Point2> star(std::mt19937_64& rng, Point2 c, double r, int n) {
+  std::uniform_real_distribution<double> radius(r / 4, r);
+  std::vector<Point2> ring;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * M_PI * k / n, q = radius(rng);
+    ring.push_back({std::round(c[0] + q * std::cos(t)), std::round(c[1] + q * std::sin(t))});
+  }
+  return ring;
+}
+
+void expect_same(const FlatGeometry& g, std::mt19937_64& rng, double lo, double hi,
+                 const char* what) {
+  const PreparedGeometry prepared(g);
+  std::size_t counts[3] = {0, 0, 0};
+  auto check = [&](const Point2& p) {
+    const Location want = brute(g, p);
+    ++counts[int(want)];
+    ASSERT_EQ(prepared.locate(p), want) << what << " at " << p[0] << "," << p[1];
+  };
+  for (double x = lo; x <= hi; x += 1)
+    for (double y = lo; y <= hi; y += 1)
+      check({x, y});
+  std::uniform_real_distribution<double> u(lo, hi);
+  for (int k = 0; k < 3000; ++k)
+    check({u(rng), u(rng)});
+  for (const Point2& v : g.points) {
+    check(v);
+    check({v[0] + 0.5, v[1]});
+  }
+  if (g.polygons > 0) {
+    EXPECT_GT(counts[int(Location::inside)], 0u) << what;
+    EXPECT_GT(counts[int(Location::boundary)], 0u) << what;
+  }
+  EXPECT_GT(counts[int(Location::outside)], 0u) << what;
+}
+
+TEST(PreparedGeometry, PolygonsWithHolesAndMultiPolygons) {
+  std::mt19937_64 rng(31);
+  for (int trial = 0; trial < 12; ++trial) {
+    FlatGeometry g;
+    const int polygons = 1 + trial % 4;
+    for (int k = 0; k < polygons; ++k) {
+      const Point2 c{double(20 + 25 * k), double(20 + 10 * (k % 2))};
+      add_ring(g, star(rng, c, 18, 12 + 40 * (trial % 3)), std::uint32_t(k));
+      if (trial % 2) add_ring(g, star(rng, c, 5, 7), std::uint32_t(k));  // a hole
+    }
+    g.polygons = std::uint32_t(polygons);
+    expect_same(g, rng, -2, 110, "stars");
+  }
+}
+
+TEST(PreparedGeometry, OverlappingPolygonsLinesAndPoints) {
+  std::mt19937_64 rng(32);
+  FlatGeometry g;
+  add_ring(g, {{0, 0}, {40, 0}, {40, 40}, {0, 40}}, 0);
+  add_ring(g, {{20, 20}, {60, 20}, {60, 60}, {20, 60}}, 1);  // overlaps the first: even-odd
+  g.polygons = 2;
+  const auto begin = std::uint32_t(g.points.size());
+  for (int k = 0; k <= 30; ++k)
+    g.points.push_back({double(70 + (k % 2) * 5), double(k * 2)});
+  g.parts.push_back({begin, std::uint32_t(g.points.size()), PartKind::line, 0});
+  g.points.push_back({90, 90});
+  g.parts.push_back(
+      {std::uint32_t(g.points.size() - 1), std::uint32_t(g.points.size()), PartKind::point, 0});
+  expect_same(g, rng, -1, 95, "overlap, line, point");
+  const PreparedGeometry prepared(g);
+  EXPECT_EQ(prepared.locate({30, 30}), Location::outside);  // in both squares
+  EXPECT_EQ(prepared.locate({10, 10}), Location::inside);
+}
+
+TEST(PreparedGeometry, LongDiagonalEdgesAndManySmallRings) {
+  // A huge thin triangle across many small squares: listing its edges in every cell of their
+  // boxes would be quadratic, so the grid is made coarser; answers must not change.
+  std::mt19937_64 rng(33);
+  FlatGeometry g;
+  add_ring(g, {{0, 0}, {200, 190}, {199, 200}}, 0);
+  std::uint32_t polygon = 1;
+  for (int x = 0; x < 200; x += 7)
+    for (int y = 0; y < 200; y += 9)
+      add_ring(g, {{double(x), double(y)}, {x + 3.0, double(y)}, {x + 3.0, y + 4.0}}, polygon++);
+  g.polygons = polygon;
+  expect_same(g, rng, -1, 201, "diagonal");
+}
+
+TEST(PreparedGeometry, FlatEnvelopes) {
+  std::mt19937_64 rng(34);
+  FlatGeometry line;
+  for (int k = 0; k <= 20; ++k)
+    line.points.push_back({double(k * 3), 7});
+  line.parts.push_back({0, std::uint32_t(line.points.size()), PartKind::line, 0});
+  expect_same(line, rng, 0, 70, "horizontal line");
+  FlatGeometry column;
+  for (int k = 0; k <= 20; ++k)
+    column.points.push_back({5, double(k * 3)});
+  column.parts.push_back({0, std::uint32_t(column.points.size()), PartKind::line, 0});
+  expect_same(column, rng, 0, 70, "vertical line");
+  FlatGeometry point;
+  point.points.push_back({4, 4});
+  point.parts.push_back({0, 1, PartKind::point, 0});
+  expect_same(point, rng, 0, 8, "point");
+}
+
+TEST(PreparedGeometry, PairTestsAgreeWithPointTests) {
+  // meets and covers on prepared geometries against lattice-point evidence on squares whose
+  // corners are integers (for such shapes lattice and half-lattice points decide the answers).
+  std::mt19937_64 rng(35);
+  std::uniform_int_distribution<int> c(0, 20), s(1, 8);
+  for (int trial = 0; trial < 200; ++trial) {
+    FlatGeometry a, b;
+    const double ax = c(rng), ay = c(rng), as = s(rng), bx = c(rng), by = c(rng), bs = s(rng);
+    add_ring(a, {{ax, ay}, {ax + as, ay}, {ax + as, ay + as}, {ax, ay + as}}, 0);
+    add_ring(b, {{bx, by}, {bx + bs, by}, {bx + bs, by + bs}, {bx, by + bs}}, 0);
+    a.polygons = b.polygons = 1;
+    const PreparedGeometry pa(a), pb(b);
+    bool any_common = false, b_in_a = true;
+    for (double x = 0; x <= 30; x += 0.5)
+      for (double y = 0; y <= 30; y += 0.5) {
+        const bool in_a = brute(a, {x, y}) != Location::outside;
+        const bool in_b = brute(b, {x, y}) != Location::outside;
+        any_common = any_common || (in_a && in_b);
+        b_in_a = b_in_a && (!in_b || in_a);
+      }
+    EXPECT_EQ(meets(pa, pb), any_common) << trial;
+    EXPECT_EQ(covers(pa, pb), b_in_a) << trial;
+    const double gap = std::hypot(std::max({0.0, ax - (bx + bs), bx - (ax + as)}),
+                                  std::max({0.0, ay - (by + bs), by - (ay + as)}));
+    const auto d = distance_within(pa, pb, 100);
+    ASSERT_TRUE(d.has_value());
+    EXPECT_NEAR(*d, gap, 1e-12) << trial;
+    EXPECT_NEAR(distance(pa, pb, gap + 50), gap, 1e-12) << trial;
+  }
+}
+
+}  // namespace
+}  // namespace loci::io
