@@ -87,8 +87,7 @@ int main(int argc, char** argv) {
   const double loci_s = seconds_since(t0);
   std::printf("%-44s %10.3f %10.2f %12zu %s\n", "loci (tiled sweep + exact), 1 thread", one_s,
               one_s / loci_s, one.size(), one == mine ? "identical" : "DIFFERENT");
-  std::printf("%-44s %10.3f %10.2f %12zu\n", "loci, one thread per core", loci_s, 1.0,
-              mine.size());
+  std::printf("%-44s %10.3f %10.2f %12zu\n", "loci, one thread per core", loci_s, 1.0, mine.size());
   int status = one == mine ? 0 : 1;
   auto report = [&](const char* name, double secs, const std::vector<IntersectionRow>& rows) {
     const bool same = rows == mine;
