@@ -285,8 +285,11 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t jobs =
       std::min<std::size_t>(options.jobs ? options.jobs : cores, (n + kChunk - 1) / kChunk);
+  // A text layer is read whole once, for every thread.
+  const auto geometries =
+      std::make_shared<LayerGeometries>(options.load.layer_path, index.layer_name());
   if (jobs <= 1) {
-    LayerQuery lq(index, options.load.layer_path, index.layer_name());
+    LayerQuery lq(index, options.load.layer_path, index.layer_name(), geometries);
     std::size_t done = 0;
     for (const auto& [number, q] : options.queries) {
       lq.run(q, number, options.candidates, answers);
@@ -302,7 +305,7 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
     // Every thread takes chunks; this one also reports progress between its chunks.
     auto work = [&](bool reporting) {
       try {
-        LayerQuery lq(index, options.load.layer_path, index.layer_name());
+        LayerQuery lq(index, options.load.layer_path, index.layer_name(), geometries);
         for (std::size_t c; !failed && (c = next++) < chunks;) {
           const std::size_t end = std::min(n, (c + 1) * kChunk);
           for (std::size_t i = c * kChunk; i < end; ++i) {

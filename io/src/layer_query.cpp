@@ -107,30 +107,42 @@ bool fast_random_read(GDALDataset& ds) {
 }
 }  // namespace
 
+LayerGeometries::LayerGeometries(std::string path, std::string name)
+    : path_(std::move(path)), name_(std::move(name)) {}
+
+LayerGeometries::~LayerGeometries() = default;
+
+const FlatGeometry* LayerGeometries::find(std::int64_t fid) {
+  std::call_once(once_, [&] {
+    const detail::OpenLayer ol = detail::open_layer(path_, name_);
+    whole_ = !fast_random_read(*ol.dataset);
+    if (!whole_) return;
+    // Text formats find a feature by FID by parsing the file from its start: one pass that
+    // keeps every geometry costs what the first lookup would.
+    ol.layer->ResetReading();
+    for (auto& f : *ol.layer)
+      all_.emplace(f->GetFID(),
+                   detail::flatten(f->GetGeometryRef(), detail::where(path_, f->GetFID())));
+  });
+  if (!whole_) return nullptr;
+  const auto it = all_.find(fid);
+  if (it == all_.end())
+    throw Error(detail::where(path_, fid) + " is not in the layer: the index does not match it");
+  return &it->second;
+}
+
 struct LayerQuery::Geometries {
   std::string path;
   std::string name;
+  std::shared_ptr<LayerGeometries> shared;
   std::optional<detail::OpenLayer> layer;
   std::unordered_map<std::int64_t, FlatGeometry> cache;
 
-  bool preloaded = false;
-
   const FlatGeometry& get(std::int64_t fid) {
+    if (const FlatGeometry* g = shared->find(fid)) return *g;
     if (auto it = cache.find(fid); it != cache.end()) return it->second;
-    if (!layer) {
-      layer = detail::open_layer(path, name);
-      preloaded = !fast_random_read(*layer->dataset);
-      if (preloaded) {
-        // Text formats find a feature by FID by parsing the file from its start: one pass
-        // that keeps every geometry costs what the first lookup would.
-        layer->layer->ResetReading();
-        for (auto& f : *layer->layer)
-          cache.emplace(f->GetFID(),
-                        detail::flatten(f->GetGeometryRef(), detail::where(path, f->GetFID())));
-        if (auto it = cache.find(fid); it != cache.end()) return it->second;
-      }
-    }
-    OGRFeatureUniquePtr f(preloaded ? nullptr : layer->layer->GetFeature(fid));
+    if (!layer) layer = detail::open_layer(path, name);
+    OGRFeatureUniquePtr f(layer->layer->GetFeature(fid));
     if (!f)
       throw Error(detail::where(path, fid) + " is not in the layer: the index does not match it");
     return cache.emplace(fid, detail::flatten(f->GetGeometryRef(), detail::where(path, fid)))
@@ -145,9 +157,13 @@ struct LayerQuery::Geometries {
   }
 };
 
-LayerQuery::LayerQuery(const LayerIndex& index, std::string layer_path, std::string layer_name)
-    : index_(index),
-      geometries_(new Geometries{std::move(layer_path), std::move(layer_name), {}, {}}) {}
+LayerQuery::LayerQuery(const LayerIndex& index, std::string layer_path, std::string layer_name,
+                       std::shared_ptr<LayerGeometries> shared)
+    : index_(index) {
+  if (!shared) shared = std::make_shared<LayerGeometries>(layer_path, layer_name);
+  geometries_.reset(
+      new Geometries{std::move(layer_path), std::move(layer_name), std::move(shared), {}, {}});
+}
 
 LayerQuery::~LayerQuery() = default;
 

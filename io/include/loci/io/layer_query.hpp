@@ -34,14 +34,17 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <variant>
 #include <vector>
 
 #include "loci/index/packed_rtree.hpp"
 #include "loci/index/rstar_tree.hpp"
 #include "loci/index/rtree.hpp"
+#include "loci/io/exact.hpp"
 #include "loci/io/layer_reader.hpp"
 #include "loci/io/sidecar.hpp"
 
@@ -184,10 +187,31 @@ struct Answer {
   // segment: the first point of the segment in the feature; NaN otherwise
 };
 
+// A layer's geometries read whole, once, for all the LayerQuery objects of a batch that share
+// it: for text formats (GeoJSON, CSV, GML, KML...), where GDAL finds a feature by FID by
+// parsing the file from its start. Layers read by FID in place (shapefile, GeoPackage,
+// FlatGeobuf...) are not read whole. Thread-safe.
+class LayerGeometries {
+ public:
+  LayerGeometries(std::string path, std::string name);
+  ~LayerGeometries();
+  // The feature's flattened geometry, the layer read whole on the first call; null when the
+  // layer is one read by FID in place. Throws loci::Error for a FID not in the layer.
+  const FlatGeometry* find(std::int64_t fid);
+
+ private:
+  std::string path_, name_;
+  std::once_flag once_;
+  bool whole_ = false;
+  std::unordered_map<std::int64_t, FlatGeometry> all_;
+};
+
 class LayerQuery {
  public:
-  // `layer_path`/`layer_name` are opened only when a per-feature refinement needs geometry.
-  LayerQuery(const LayerIndex& index, std::string layer_path, std::string layer_name);
+  // `layer_path`/`layer_name` are opened only when a per-feature refinement needs geometry;
+  // `shared` (made here when null) lets the queries of several threads read a text layer once.
+  LayerQuery(const LayerIndex& index, std::string layer_path, std::string layer_name,
+             std::shared_ptr<LayerGeometries> shared = {});
   ~LayerQuery();
   LayerQuery(const LayerQuery&) = delete;
   LayerQuery& operator=(const LayerQuery&) = delete;
