@@ -219,7 +219,7 @@ IndexReport index_layer(const IndexOptions& options) {
   return r;
 }
 
-LayerIndex load_index(const LoadOptions& o, std::string* origin) {
+LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries* geometries) {
   const bool dynamic =
       o.structure && (*o.structure == Structure::rstar || *o.structure == Structure::rtree);
   const std::string path = o.index_path.empty() ? default_sidecar_path(o.layer_path) : o.index_path;
@@ -261,15 +261,20 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin) {
     }
   }
   if (origin) *origin = "built in memory";
-  return LayerIndex::build(
-      read_items(o.layer_path, o.layer_name, o.per.value_or(Per::feature), o.progress),
-      o.structure.value_or(Structure::packed_hilbert));
+  LayerItems items = read_items(o.layer_path, o.layer_name, o.per.value_or(Per::feature),
+                                o.progress, geometries != nullptr);
+  if (geometries && !items.geometries.empty()) geometries->adopt(std::move(items.geometries));
+  return LayerIndex::build(std::move(items), o.structure.value_or(Structure::packed_hilbert));
 }
 
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   refuse_overwriting(options.out_path, options.load.layer_path);
   QueryReport report;
-  const LayerIndex index = load_index(options.load, &report.index_origin);
+  // A text layer is read whole once, for every thread; an index built in memory hands over
+  // the geometries it read.
+  const auto geometries =
+      std::make_shared<LayerGeometries>(options.load.layer_path, options.load.layer_name);
+  const LayerIndex index = load_index(options.load, &report.index_origin, geometries.get());
   std::vector<Answer> answers;
   bool with_distance = false, with_point = false;
   for (const auto& [number, q] : options.queries) {
@@ -285,9 +290,6 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t jobs =
       std::min<std::size_t>(options.jobs ? options.jobs : cores, (n + kChunk - 1) / kChunk);
-  // A text layer is read whole once, for every thread.
-  const auto geometries =
-      std::make_shared<LayerGeometries>(options.load.layer_path, index.layer_name());
   if (jobs <= 1) {
     LayerQuery lq(index, options.load.layer_path, index.layer_name(), geometries);
     std::size_t done = 0;

@@ -35,6 +35,14 @@ void silence_gdal_messages() {
 }
 namespace detail {
 
+bool fast_random_read(GDALDataset& ds) {
+  const std::string driver = ds.GetDriver() ? ds.GetDriver()->GetDescription() : "";
+  for (const char* fast : {"ESRI Shapefile", "GPKG", "SQLite", "FlatGeobuf", "OpenFileGDB",
+                           "MapInfo File", "PostgreSQL", "Memory"})
+    if (driver == fast) return true;
+  return false;
+}
+
 OpenLayer open_layer(const std::string& path, const std::string& name) {
   GDALAllRegister();
   if (!CPLGetConfigOption("OGR_GEOJSON_MAX_OBJ_SIZE", nullptr))

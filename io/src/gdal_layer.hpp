@@ -24,6 +24,11 @@ OpenLayer open_layer(const std::string& path, const std::string& name);
 
 std::string where(const std::string& path, std::int64_t fid);
 
+// Whether the dataset's driver reads a feature by FID in place (shapefile, GeoPackage,
+// FlatGeobuf...); the others (GeoJSON, CSV, GML, KML...) parse from the start of the file for
+// each lookup.
+bool fast_random_read(GDALDataset& ds);
+
 // Throws InvalidGeometry naming `what` for a NaN or infinite coordinate, or one beyond
 // +-kMaxCoordinate (1e150), which loci's distance arithmetic cannot carry.
 void check_layer_point(const Point2& p, const std::string& what);

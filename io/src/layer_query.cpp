@@ -95,27 +95,22 @@ LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
   return x;
 }
 
-namespace {
-// Drivers that read features by FID in place; the others (GeoJSON, CSV, GML, KML...) parse
-// from the start of the file for each lookup.
-bool fast_random_read(GDALDataset& ds) {
-  const std::string driver = ds.GetDriver() ? ds.GetDriver()->GetDescription() : "";
-  for (const char* fast : {"ESRI Shapefile", "GPKG", "SQLite", "FlatGeobuf", "OpenFileGDB",
-                           "MapInfo File", "PostgreSQL", "Memory"})
-    if (driver == fast) return true;
-  return false;
-}
-}  // namespace
-
 LayerGeometries::LayerGeometries(std::string path, std::string name)
     : path_(std::move(path)), name_(std::move(name)) {}
 
 LayerGeometries::~LayerGeometries() = default;
 
+void LayerGeometries::adopt(std::unordered_map<std::int64_t, FlatGeometry>&& all) {
+  std::call_once(once_, [&] {
+    all_ = std::move(all);
+    whole_ = true;
+  });
+}
+
 const FlatGeometry* LayerGeometries::find(std::int64_t fid) {
   std::call_once(once_, [&] {
     const detail::OpenLayer ol = detail::open_layer(path_, name_);
-    whole_ = !fast_random_read(*ol.dataset);
+    whole_ = !detail::fast_random_read(*ol.dataset);
     if (!whole_) return;
     // Text formats find a feature by FID by parsing the file from its start: one pass that
     // keeps every geometry costs what the first lookup would.

@@ -99,8 +99,10 @@ void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& pat
 }  // namespace
 
 LayerItems read_items(const std::string& path, const std::string& layer, Per per,
-                      const Progress& progress) {
+                      const Progress& progress, bool keep_geometries) {
   auto ol = open_layer(path, layer);
+  const bool keep =
+      keep_geometries && per == Per::feature && !detail::fast_random_read(*ol.dataset);
   LayerItems out;
   out.per = per;
   out.layer_name = ol.layer->GetName();
@@ -110,12 +112,16 @@ LayerItems read_items(const std::string& path, const std::string& layer, Per per
   for (auto& feature : *ol.layer) {
     ticker.tick(double(++seen));
     const OGRGeometry* g = feature->GetGeometryRef();
-    if (!g || g->IsEmpty()) continue;
     const std::int64_t fid = feature->GetFID();
+    if (!g || g->IsEmpty()) {
+      if (keep) out.geometries.emplace(fid, FlatGeometry{});
+      continue;
+    }
     if (is_polygonal(g)) out.has_polygons = true;
     if (per == Per::feature) {
       // The envelope skips NaN coordinates; the feature must be refused, not half indexed.
-      detail::flatten(g, where(path, fid));
+      FlatGeometry flat = detail::flatten(g, where(path, fid));
+      if (keep) out.geometries.emplace(fid, std::move(flat));
       OGREnvelope e;
       g->getEnvelope(&e);
       const Box2 box{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}};

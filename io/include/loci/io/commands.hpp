@@ -74,7 +74,10 @@ struct LoadOptions {
 };
 
 // `origin` receives a short description ("sidecar FILE" or "built in memory").
-LayerIndex load_index(const LoadOptions& options, std::string* origin = nullptr);
+// With `geometries`, an index built in memory per feature from a text layer hands over the
+// geometries it read (LayerGeometries::adopt).
+LayerIndex load_index(const LoadOptions& options, std::string* origin = nullptr,
+                      LayerGeometries* geometries = nullptr);
 
 struct QueryOptions {
   LoadOptions load;

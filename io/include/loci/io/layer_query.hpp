@@ -198,6 +198,9 @@ class LayerGeometries {
   // The feature's flattened geometry, the layer read whole on the first call; null when the
   // layer is one read by FID in place. Throws loci::Error for a FID not in the layer.
   const FlatGeometry* find(std::int64_t fid);
+  // Takes the layer's geometries as already read (by the index build); a no-op after the
+  // first find() or adopt().
+  void adopt(std::unordered_map<std::int64_t, FlatGeometry>&& all);
 
  private:
   std::string path_, name_;

@@ -12,11 +12,13 @@
 
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
 #include "loci/geom/segment.hpp"
+#include "loci/io/exact.hpp"
 #include "loci/io/progress.hpp"
 #include "loci/io/sidecar.hpp"
 
@@ -44,11 +46,14 @@ struct LayerItems {
   bool has_polygons = false;
   std::vector<Box2> boxes;
   std::vector<ItemRecord> records;  // records[i] describes boxes[i]
+  // With keep_geometries, per feature, for a text layer (one GDAL cannot read by FID in
+  // place): every feature's flattened geometry, so that queries need not read it again.
+  std::unordered_map<std::int64_t, FlatGeometry> geometries;
 };
 
 // Throws like read_segments; features with an empty or missing geometry are skipped.
 LayerItems read_items(const std::string& path, const std::string& layer, Per per,
-                      const Progress& progress = {});
+                      const Progress& progress = {}, bool keep_geometries = false);
 
 struct LayerSummary {
   std::string path;
