@@ -11,28 +11,13 @@
 #include <vector>
 
 #include "loci/index/grid_join.hpp"
+#include "support/brute_force.hpp"
 #include "support/random_data.hpp"
 
 namespace loci::test {
 namespace {
 
-using Pairs = std::vector<std::pair<Id, Id>>;
-
-Pairs brute_self(const std::vector<Box<2>>& b) {
-  Pairs out;
-  for (std::size_t i = 0; i < b.size(); ++i)
-    for (std::size_t j = i + 1; j < b.size(); ++j)
-      if (intersects(b[i], b[j])) out.push_back({Id(i), Id(j)});
-  return out;
-}
-
-Pairs brute_join(const std::vector<Box<2>>& a, const std::vector<Box<2>>& b) {
-  Pairs out;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (std::size_t j = 0; j < b.size(); ++j)
-      if (intersects(a[i], b[j])) out.push_back({Id(i), Id(j)});
-  return out;
-}
+using Pairs = BoxPairs;
 
 Pairs self_pairs(const std::vector<Box<2>>& boxes) {
   Pairs got;
@@ -83,7 +68,7 @@ class GridJoin : public ::testing::TestWithParam<Shape> {};
 TEST_P(GridJoin, SelfJoinMatchesBruteForce) {
   for (std::size_t n : {0, 1, 2, 17, 3000}) {
     const auto boxes = make_boxes<2>(GetParam(), n, 100 + n);
-    EXPECT_EQ(self_pairs(boxes), brute_self(boxes)) << n << " boxes";
+    EXPECT_EQ(self_pairs(boxes), brute_self_pairs(boxes)) << n << " boxes";
   }
 }
 
@@ -93,7 +78,7 @@ TEST_P(GridJoin, TwoSetJoinMatchesBruteForce) {
     auto b = make_boxes<2>(GetParam(), nb, 300 + nb);
     for (std::size_t i = 0; i < std::min(a.size(), b.size()); i += 7)
       b[i] = a[i];
-    EXPECT_EQ(join_pairs(a, b), brute_join(a, b)) << na << " x " << nb;
+    EXPECT_EQ(join_pairs(a, b), brute_join_pairs(a, b)) << na << " x " << nb;
   }
 }
 
@@ -103,8 +88,8 @@ INSTANTIATE_TEST_SUITE_P(Shapes, GridJoin, ::testing::ValuesIn(kAllShapes),
 TEST(GridJoinEdges, LongBoxesAcrossTiles) {
   for (std::uint64_t seed : {1, 2, 3}) {
     const auto a = with_long_boxes(4000, seed), b = with_long_boxes(2500, seed + 10);
-    EXPECT_EQ(self_pairs(a), brute_self(a)) << seed;
-    EXPECT_EQ(join_pairs(a, b), brute_join(a, b)) << seed;
+    EXPECT_EQ(self_pairs(a), brute_self_pairs(a)) << seed;
+    EXPECT_EQ(join_pairs(a, b), brute_join_pairs(a, b)) << seed;
     // Fewer box pairs compared than the plain sweep, which is the point of the tiles.
     std::size_t plain = self_join(a, [](Id, Id) { return true; }).entries_tested;
     std::size_t tiled = grid_self_join(a, [](Id, Id) { return true; }).entries_tested;
@@ -119,13 +104,13 @@ TEST(GridJoinEdges, BoxesMeetingOnTileBorders) {
   for (int x = 0; x < 64; ++x)
     for (int y = 0; y < 64; ++y)
       boxes.push_back({{double(x), double(y)}, {x + 1.0, y + 1.0}});
-  EXPECT_EQ(self_pairs(boxes), brute_self(boxes));
+  EXPECT_EQ(self_pairs(boxes), brute_self_pairs(boxes));
   std::vector<Box<2>> points;
   for (int x = 0; x <= 64; x += 2)
     for (int y = 0; y <= 64; y += 2)
       points.push_back(Box<2>::of_point({double(x), double(y)}));
-  EXPECT_EQ(join_pairs(points, boxes), brute_join(points, boxes));
-  EXPECT_EQ(join_pairs(boxes, points), brute_join(boxes, points));
+  EXPECT_EQ(join_pairs(points, boxes), brute_join_pairs(points, boxes));
+  EXPECT_EQ(join_pairs(boxes, points), brute_join_pairs(boxes, points));
 }
 
 TEST(GridJoinEdges, FlatExtentsAndBoxesSpanningEverything) {
@@ -138,12 +123,12 @@ TEST(GridJoinEdges, FlatExtentsAndBoxesSpanningEverything) {
     column.push_back({{-0.0, x}, {0.0, x + 0.5}});
     wide.push_back({{-100 + u(rng) / 100, -100}, {100, 100 + u(rng) / 100}});
   }
-  EXPECT_EQ(self_pairs(row), brute_self(row));
-  EXPECT_EQ(self_pairs(column), brute_self(column));
-  EXPECT_EQ(join_pairs(row, column), brute_join(row, column));
+  EXPECT_EQ(self_pairs(row), brute_self_pairs(row));
+  EXPECT_EQ(self_pairs(column), brute_self_pairs(column));
+  EXPECT_EQ(join_pairs(row, column), brute_join_pairs(row, column));
   // Every box covers the extent: listing them per tile would multiply them, so the plain
   // sweep answers (still correctly).
-  EXPECT_EQ(self_pairs(wide), brute_self(wide));
+  EXPECT_EQ(self_pairs(wide), brute_self_pairs(wide));
 }
 
 TEST(GridJoinEdges, StopsEarlyAndRefusesBadBoxes) {

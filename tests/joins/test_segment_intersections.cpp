@@ -47,6 +47,21 @@ Linework polylines(std::size_t lines, std::size_t len, int cells, std::uint64_t 
   return w;
 }
 
+// Every pair through the exact test, consecutive segments of a chain meeting only at their
+// shared vertex left out.
+std::vector<Found> brute_one_set(const Linework& w) {
+  std::vector<Found> ref;
+  for (std::size_t i = 0; i < w.segs.size(); ++i)
+    for (std::size_t j = i + 1; j < w.segs.size(); ++j) {
+      const SegmentIntersection x = intersection(w.segs[i], w.segs[j]);
+      if (x.kind == SegmentMeet::none) continue;
+      const bool shared_only = x.kind == SegmentMeet::point && j == i + 1 &&
+                               w.chain[i] == w.chain[j] && x.a == w.segs[i].b;
+      if (!shared_only) ref.push_back({i, j, x});
+    }
+  return ref;
+}
+
 TEST(SegmentIntersections, OneSetMatchesBruteForce) {
   for (auto [lines, len, cells] :
        {std::tuple{40, 6, 6}, std::tuple{30, 10, 50}, std::tuple{1, 1, 3}}) {
@@ -60,14 +75,7 @@ TEST(SegmentIntersections, OneSetMatchesBruteForce) {
                             EXPECT_LT(i, j);
                             return got.push_back({i, j, x}), true;
                           });
-    for (std::size_t i = 0; i < w.segs.size(); ++i)
-      for (std::size_t j = i + 1; j < w.segs.size(); ++j) {
-        const SegmentIntersection x = intersection(w.segs[i], w.segs[j]);
-        if (x.kind == SegmentMeet::none) continue;
-        const bool shared_only = x.kind == SegmentMeet::point && j == i + 1 &&
-                                 w.chain[i] == w.chain[j] && x.a == w.segs[i].b;
-        if (!shared_only) ref.push_back({i, j, x});
-      }
+    ref = brute_one_set(w);
     std::sort(got.begin(), got.end());
     EXPECT_EQ(got, ref) << lines << " lines of " << len;
   }
@@ -138,15 +146,7 @@ TEST(SegmentIntersections, ThreadsGiveTheSameAnswersOnManyTiles) {
   auto adjacent = [&](Id i, Id j) {
     return w.chain[i] == w.chain[j] && (j == i + 1 || i == j + 1);
   };
-  std::vector<Found> ref;
-  for (std::size_t i = 0; i < w.segs.size(); ++i)
-    for (std::size_t j = i + 1; j < w.segs.size(); ++j) {
-      const SegmentIntersection x = intersection(w.segs[i], w.segs[j]);
-      if (x.kind == SegmentMeet::none) continue;
-      const bool shared_only = x.kind == SegmentMeet::point && j == i + 1 &&
-                               w.chain[i] == w.chain[j] && x.a == w.segs[i].b;
-      if (!shared_only) ref.push_back({i, j, x});
-    }
+  const std::vector<Found> ref = brute_one_set(w);
   ASSERT_GT(ref.size(), 500u);
   const Linework b = walks(200, 8, 23);
   std::vector<Found> ref2;

@@ -9,28 +9,13 @@
 #include <vector>
 
 #include "loci/index/sweep_join.hpp"
+#include "support/brute_force.hpp"
 #include "support/random_data.hpp"
 
 namespace loci::test {
 namespace {
 
-using Pairs = std::vector<std::pair<Id, Id>>;
-
-Pairs brute_self(const std::vector<Box<2>>& b) {
-  Pairs out;
-  for (std::size_t i = 0; i < b.size(); ++i)
-    for (std::size_t j = i + 1; j < b.size(); ++j)
-      if (intersects(b[i], b[j])) out.push_back({Id(i), Id(j)});
-  return out;
-}
-
-Pairs brute_join(const std::vector<Box<2>>& a, const std::vector<Box<2>>& b) {
-  Pairs out;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (std::size_t j = 0; j < b.size(); ++j)
-      if (intersects(a[i], b[j])) out.push_back({Id(i), Id(j)});
-  return out;
-}
+using Pairs = BoxPairs;
 
 Pairs sorted(Pairs p) {
   std::sort(p.begin(), p.end());
@@ -47,7 +32,7 @@ TEST_P(SweepJoin, SelfJoinMatchesBruteForce) {
       EXPECT_LT(i, j);
       return got.push_back({i, j}), true;
     });
-    EXPECT_EQ(sorted(got), brute_self(boxes)) << n << " boxes";
+    EXPECT_EQ(sorted(got), brute_self_pairs(boxes)) << n << " boxes";
     EXPECT_EQ(s.results, got.size());
   }
 }
@@ -61,7 +46,7 @@ TEST_P(SweepJoin, TwoSetJoinMatchesBruteForce) {
       b[i] = a[i];
     Pairs got;
     join(a, b, [&](Id i, Id j) { return got.push_back({i, j}), true; });
-    EXPECT_EQ(sorted(got), brute_join(a, b)) << na << " x " << nb;
+    EXPECT_EQ(sorted(got), brute_join_pairs(a, b)) << na << " x " << nb;
   }
 }
 

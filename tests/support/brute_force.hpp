@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 #include "loci/index/query.hpp"
@@ -50,6 +51,25 @@ void expect_nearest(const std::vector<Neighbor>& got, const std::vector<Box<D>>&
   }
   std::sort(seen.begin(), seen.end());
   EXPECT_TRUE(std::adjacent_find(seen.begin(), seen.end()) == seen.end()) << "duplicate id";
+}
+
+// Every intersecting pair i < j of one set of boxes, and every (i of a, j of b), in order.
+using BoxPairs = std::vector<std::pair<Id, Id>>;
+
+inline BoxPairs brute_self_pairs(const std::vector<Box<2>>& b) {
+  BoxPairs out;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    for (std::size_t j = i + 1; j < b.size(); ++j)
+      if (intersects(b[i], b[j])) out.push_back({Id(i), Id(j)});
+  return out;
+}
+
+inline BoxPairs brute_join_pairs(const std::vector<Box<2>>& a, const std::vector<Box<2>>& b) {
+  BoxPairs out;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = 0; j < b.size(); ++j)
+      if (intersects(a[i], b[j])) out.push_back({Id(i), Id(j)});
+  return out;
 }
 
 }  // namespace loci::test

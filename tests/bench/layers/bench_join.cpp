@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "loci/io/join.hpp"
+#include "support/geos_from_ogr.hpp"
 
 namespace {
 
@@ -52,9 +53,7 @@ GeosLayer read_geos(GEOSContextHandle_t geos, const std::string& path) {
   for (auto& f : *ds->GetLayer(0)) {
     const OGRGeometry* g = f->GetGeometryRef();
     if (!g || g->IsEmpty()) continue;
-    std::vector<unsigned char> wkb(static_cast<std::size_t>(g->WkbSize()));
-    g->exportToWkb(wkbNDR, wkb.data());
-    out.geoms.push_back(GEOSWKBReader_read_r(geos, reader, wkb.data(), wkb.size()));
+    out.geoms.push_back(loci::test::to_geos(geos, reader, *g));
     out.fids.push_back(f->GetFID());
   }
   GEOSWKBReader_destroy_r(geos, reader);

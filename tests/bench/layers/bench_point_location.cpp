@@ -21,6 +21,7 @@
 
 #include "loci/io/commands.hpp"
 #include "loci/io/layer_query.hpp"
+#include "support/geos_from_ogr.hpp"
 #include "support/layer_polygons.hpp"
 
 namespace {
@@ -69,9 +70,7 @@ int main(int argc, char** argv) {
     for (auto& f : *ds->GetLayer(0)) {
       const OGRGeometry* g = f->GetGeometryRef();
       if (!g || g->IsEmpty()) continue;
-      std::vector<unsigned char> wkb(static_cast<std::size_t>(g->WkbSize()));
-      g->exportToWkb(wkbNDR, wkb.data());
-      geoms.push_back(GEOSWKBReader_read_r(geos, reader, wkb.data(), wkb.size()));
+      geoms.push_back(loci::test::to_geos(geos, reader, *g));
       fids.push_back(f->GetFID());
       std::vector<loci::BspPolygon> polys;
       if (wkbFlatten(g->getGeometryType()) == wkbPolygon)
