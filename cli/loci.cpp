@@ -240,6 +240,7 @@ int run_intersections(const Args& a) {
   o.out_path = a.get("--output");
   if (a.has("--jobs"))
     o.jobs = static_cast<unsigned>(parse_count("--jobs", a.get("--jobs"), 1, 1024));
+  o.progress = progress_bar(a, "reading");
   const std::size_t n = write_intersections(o, stdout);
   if (!a.has("--quiet") && !o.out_path.empty())
     std::fprintf(stderr, "loci: %zu rows written into %s\n", n, o.out_path.c_str());

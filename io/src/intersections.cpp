@@ -32,9 +32,9 @@ Linework::Linework(const std::vector<SegmentRecord>& recs) {
 }
 
 std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
-  const Linework left(read_segments(o.layer_path, o.layer_name));
+  const Linework left(read_segments(o.layer_path, o.layer_name, o.progress));
   if (o.other_path.empty()) return intersection_rows(left, nullptr, o.pairs_only, o.jobs);
-  const Linework right(read_segments(o.other_path, o.other_name));
+  const Linework right(read_segments(o.other_path, o.other_name, o.progress));
   return intersection_rows(left, &right, o.pairs_only, o.jobs);
 }
 

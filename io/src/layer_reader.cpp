@@ -14,11 +14,15 @@ namespace loci::io {
 using detail::open_layer;
 using detail::where;
 
-std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer) {
+std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer,
+                                         const Progress& progress) {
   auto ol = open_layer(path, layer);
   std::vector<SegmentRecord> out;
+  ProgressTicker ticker(progress, double(ol.layer->GetFeatureCount(FALSE)));
+  std::size_t seen = 0;
   const detail::ReadCheck read_check(path);
   for (auto& feature : *ol.layer) {
+    ticker.tick(double(++seen));
     const std::int64_t fid = feature->GetFID();
     std::int32_t part = 0;
     detail::for_each_curve(

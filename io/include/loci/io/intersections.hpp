@@ -37,6 +37,7 @@ struct IntersectionsOptions {
   bool pairs_only = false;      // feature pairs without points
   std::string out_path;         // empty: the fallback stream
   unsigned jobs = 0;            // threads; 0: one per core
+  Progress progress;            // over the features read
 };
 
 struct IntersectionRow {

@@ -37,7 +37,8 @@ struct FeatureRecord {
 
 // Throws loci::Error when the path cannot be opened, the layer does not exist or has no
 // geometry column, or a coordinate is NaN or infinite (naming the feature).
-std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer = {});
+std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer = {},
+                                         const Progress& progress = {});
 std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::string& layer = {});
 
 struct LayerItems {
