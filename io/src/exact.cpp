@@ -8,6 +8,7 @@
 
 #include "loci/geom/predicates.hpp"
 #include "loci/geom/segment_intersection.hpp"
+#include "loci/index/packed_rtree.hpp"
 #include "loci/index/sweep_join.hpp"
 
 namespace loci::io {
@@ -267,13 +268,29 @@ std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry&
 }
 
 double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bound) {
-  const double gap = box_gap(a.envelope(), b.envelope());
-  for (int k = 8; k > 0; --k) {
-    const double d = std::ldexp(bound, -2 * k);
-    if (d < gap) continue;
-    if (auto found = distance_within(a, b, d)) return *found;
-  }
-  return distance_within(a, b, bound).value_or(bound);
+  if (a.geometry().empty() || b.geometry().empty()) return bound;
+  if (meets(a, b)) return 0;
+  // Apart: the distance is reached at a vertex of one and a point of the other's edges (or
+  // isolated points). Each vertex browses the other's edges, in a packed R-tree, nearest box
+  // first, until the boxes are farther than the best distance so far.
+  double best = bound;
+  const Box2 everywhere{{-kMaxCoordinate, -kMaxCoordinate}, {kMaxCoordinate, kMaxCoordinate}};
+  auto side = [&](const FlatGeometry& from, const FlatGeometry& to) {
+    const Edges edges(to, 0, everywhere);
+    PackedRTree2::Builder builder(edges.boxes.size());
+    for (const Box2& box : edges.boxes)
+      builder.add(box);
+    const PackedRTree2 tree = std::move(builder).finish();
+    for (const Point2& p : from.points)
+      tree.browse(p, [&](Id k, const Box2&, double box_distance) {
+        if (box_distance >= best) return false;
+        best = std::min(best, std::sqrt(squared_distance(p, edges.segs[k])));
+        return true;
+      });
+  };
+  side(a.geometry(), b.geometry());
+  side(b.geometry(), a.geometry());
+  return best;
 }
 
 // The grid. A ray from p towards +x crosses the ring edges of p's cell (tested exactly) and

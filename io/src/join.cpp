@@ -113,19 +113,29 @@ std::vector<JoinRow> closest_pair(const JoinLayer& left, const JoinLayer& right,
   std::vector<Box2> grown(left.boxes.size());
   for (std::size_t i = 0; i < grown.size(); ++i)
     grown[i] = outset(left.boxes[i], bound);
-  std::vector<std::pair<double, std::pair<Id, Id>>> candidates;
+  // In order of envelope distance, then of the pair's FIDs: a candidate no nearer than the
+  // best so far can only tie it, and a tie goes to the smaller pair, which came first.
+  struct Candidate {
+    double box_distance;
+    JoinRow pair;
+    Id i, j;
+  };
+  std::vector<Candidate> candidates;
   join(std::span<const Box2>(grown), std::span<const Box2>(right.boxes), [&](Id i, Id j) {
     if (!(self && i == j))
-      candidates.push_back({box_distance(left.boxes[i], right.boxes[j]), {i, j}});
+      candidates.push_back(
+          {box_distance(left.boxes[i], right.boxes[j]), {left.fids[i], right.fids[j], 0}, i, j});
     return true;
   });
-  std::sort(candidates.begin(), candidates.end());
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.box_distance != b.box_distance ? a.box_distance < b.box_distance : a.pair < b.pair;
+  });
   ProgressTicker ticker(progress, double(candidates.size()));
   std::size_t done = 0;
-  for (const auto& [box_distance, ij] : candidates) {
-    if (box_distance > bound) break;
-    const auto [i, j] = ij;
-    if (auto d = distance_within(left.prepared(i), right.prepared(j), bound)) offer(i, j, *d);
+  for (const Candidate& c : candidates) {
+    if (c.box_distance > bound || (c.box_distance == bound && !(c.pair < best))) break;
+    if (auto d = distance_within(left.prepared(c.i), right.prepared(c.j), bound))
+      offer(c.i, c.j, *d);
     ticker.tick(double(++done));
   }
   rows.push_back(best);

@@ -127,9 +127,10 @@ bool meets(const PreparedGeometry& a, const PreparedGeometry& b);
 bool covers(const PreparedGeometry& a, const PreparedGeometry& b);
 std::optional<double> distance_within(const PreparedGeometry& a, const PreparedGeometry& b,
                                       double d);
-// The distance between a and b, given an upper bound of it (for example the distance between
-// a point of each): searched within bound / 4^k for k = 8, 7, ..., 0, so that two geometries
-// far apart relative to their sizes cost the edge pairs near their closest approach.
+// The distance between a and b, at most `bound` (returned when they are farther apart): 0
+// when they meet, else every vertex of each browses the other's edges in a packed R-tree,
+// nearest first, so that two geometries far apart relative to their sizes cost
+// O((n + m) log) rather than every pair of edges.
 double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bound);
 
 // Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
