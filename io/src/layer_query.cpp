@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <queue>
 #include <unordered_map>
@@ -78,6 +79,7 @@ LayerIndex LayerIndex::build(LayerItems&& items, Structure structure) {
   }
   x.own_records_ = std::move(items.records);
   x.records_ = x.own_records_;
+  x.features_ = std::make_shared<LazyFeatures>();
   return x;
 }
 
@@ -92,6 +94,7 @@ LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
   x.records_ = sidecar.records();
   x.keep_alive_ = sidecar.keep_alive();
   x.tree_ = std::move(sidecar).take_tree();
+  x.features_ = std::make_shared<LazyFeatures>();
   return x;
 }
 
@@ -288,22 +291,43 @@ void check_query(const Query& q) {
 
 }  // namespace
 
-LayerIndex::FeatureRuns LayerIndex::feature_runs() const {
-  FeatureRuns runs;
-  const PackedRTree2* t = packed();
-  if (!t || t->size() == 0) return runs;
-  const std::size_t n = t->size();
-  runs.end.resize(n);
-  runs.fid.resize(n);
-  for (std::size_t pos = 0; pos < n; ++pos) {
-    const Id id = t->item_at(pos);
-    runs.fid[pos] = id < records_.size() ? records_[id].fid : -1;
-  }
-  runs.end[n - 1] = static_cast<std::uint32_t>(n);
-  for (std::size_t pos = n - 1; pos-- > 0;)
-    runs.end[pos] = runs.fid[pos] == runs.fid[pos + 1] ? runs.end[pos + 1]
-                                                       : static_cast<std::uint32_t>(pos + 1);
-  return runs;
+struct LayerIndex::LazyFeatures {
+  std::once_flag once;
+  Features value;
+};
+
+const LayerIndex::Features& LayerIndex::features() const {
+  std::call_once(features_->once, [&] {
+    Features& f = features_->value;
+    f.of_item.resize(records_.size());
+    std::unordered_map<std::int64_t, std::uint32_t> number;
+    std::int64_t last_fid = 0;
+    std::uint32_t last = Features::none;
+    for (std::size_t id = 0; id < records_.size(); ++id) {
+      const std::int64_t fid = records_[id].fid;
+      if (last == Features::none || fid != last_fid) {
+        const auto [it, fresh] = number.try_emplace(fid, std::uint32_t(f.fid.size()));
+        if (fresh) f.fid.push_back(fid);
+        last = it->second;
+        last_fid = fid;
+      }
+      f.of_item[id] = last;
+    }
+    const PackedRTree2* t = packed();
+    if (!t || t->size() == 0) return;
+    const std::size_t n = t->size();
+    f.at.resize(n);
+    f.end.resize(n);
+    for (std::size_t pos = 0; pos < n; ++pos) {
+      const Id id = t->item_at(pos);
+      f.at[pos] = id < f.of_item.size() ? f.of_item[id] : Features::none;
+    }
+    f.end[n - 1] = static_cast<std::uint32_t>(n);
+    for (std::size_t pos = n - 1; pos-- > 0;)
+      f.end[pos] =
+          f.at[pos] == f.at[pos + 1] ? f.end[pos + 1] : static_cast<std::uint32_t>(pos + 1);
+  });
+  return features_->value;
 }
 
 // The ring segments crossing the ray from p towards +x, counted per feature.
@@ -331,57 +355,81 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
 
   if (q.kind == Query::Kind::nearest) {
     const Point2 p = q.point;
-    std::unordered_map<std::int64_t, double> best;
-    std::unordered_set<std::int64_t> done;
-    using Pending = std::pair<double, std::int64_t>;
+    const LayerIndex::Features& features = index_.features();
+    if (state_.size() != features.fid.size()) {
+      state_.assign(features.fid.size(), FeatureState{});
+      generation_ = 0;
+    }
+    if (++generation_ == 0) {  // wrapped: forget every stamp
+      std::fill(state_.begin(), state_.end(), FeatureState{});
+      generation_ = 1;
+    }
+    // The state of feature f in this query (fresh: not seen, best infinite).
+    auto state = [&](std::uint32_t f) -> FeatureState& {
+      FeatureState& s = state_[f];
+      if (s.stamp != generation_) s = {generation_, false, std::numeric_limits<double>::infinity()};
+      return s;
+    };
+    using Pending = std::pair<double, std::uint32_t>;
     std::priority_queue<Pending, std::vector<Pending>, std::greater<>> pending;
     std::size_t found = 0;
-    auto offer = [&](std::int64_t fid, double d) {
-      auto [it, fresh] = best.try_emplace(fid, d);
-      if (!fresh && d >= it->second) return;
-      it->second = d;
-      pending.push({d, fid});
+    auto offer = [&](std::uint32_t f, double d) {
+      FeatureState& s = state(f);
+      if (d >= s.best) return;
+      s.best = d;
+      pending.push({d, f});
     };
     // Everything pending at most `limit` away is final: every entry not yet browsed is at
     // least `limit` away.
     auto settle = [&](double limit) {
       while (!pending.empty() && found < q.k && pending.top().first <= limit) {
-        const auto [d, fid] = pending.top();
+        const auto [d, f] = pending.top();
         pending.pop();
-        if (done.count(fid) || best[fid] != d) continue;
-        done.insert(fid);
-        out.push_back({number, fid, d});
+        FeatureState& s = state(f);
+        if (s.done || s.best != d) continue;
+        s.done = true;
+        out.push_back({number, features.fid[f], d});
         ++found;
       }
     };
-    if (per_segment && !candidates_only)
-      for (const auto fid : containing_polygons(index_, p))
-        offer(fid, 0.0);
+    const ItemRecord* records = index_.records().data();
+    if (per_segment && !candidates_only) {
+      std::unordered_map<std::int64_t, std::uint32_t> number_of;
+      for (const auto fid : containing_polygons(index_, p)) {
+        // Rare (the point is inside polygons): find the features' numbers by a scan.
+        if (number_of.empty())
+          for (std::uint32_t f = 0; f < features.fid.size(); ++f)
+            number_of.emplace(features.fid[f], f);
+        offer(number_of.at(fid), 0.0);
+      }
+    }
     auto visit = [&](const ItemRecord& r, const Box2& b, double box_distance) {
       settle(box_distance);
       if (found >= q.k) return false;
-      if (done.count(r.fid)) return true;
+      const std::uint32_t f = features.of_item[std::size_t(&r - records)];
+      if (state(f).done) return true;
       if (candidates_only)
-        offer(r.fid, box_distance);
+        offer(f, box_distance);
       else if (per_segment)
-        offer(r.fid, std::sqrt(squared_distance(p, segment_of(b, r.flags))));
+        offer(f, std::sqrt(squared_distance(p, segment_of(b, r.flags))));
       else
-        offer(r.fid, distance(geometries_->get(r.fid), p));
+        offer(f, distance(geometries_->get(r.fid), p));
       return true;
     };
-    if (per_segment) {
-      if (!have_runs_) {
-        runs_ = index_.feature_runs();
-        have_runs_ = true;
-      }
-      // A run of one feature's segments cannot change the answer when that feature is final
-      // or already known at most as far as the run's box.
+    if (per_segment && !features.end.empty()) {
+      // Positions [first, last) cannot change the answer when each of the features of their
+      // first few runs is final or already known at most as far as their box; more runs than
+      // that are kept without looking further.
       index_.browse(p, visit, [&](std::size_t first, std::size_t last, double box_distance) {
-        if (first >= runs_.end.size() || runs_.end[first] < last) return true;
-        const std::int64_t fid = runs_.fid[first];
-        if (done.count(fid)) return false;
-        const auto it = best.find(fid);
-        return it == best.end() || it->second > box_distance;
+        int runs = 16;
+        for (std::size_t pos = first; pos < last; pos = features.end[pos]) {
+          if (--runs < 0 || pos >= features.at.size()) return true;
+          const std::uint32_t f = features.at[pos];
+          if (f == LayerIndex::Features::none) return true;
+          const FeatureState& s = state(f);
+          if (!s.done && s.best > box_distance) return true;
+        }
+        return false;
       });
     } else {
       index_.browse(p, visit);

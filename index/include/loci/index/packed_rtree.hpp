@@ -482,7 +482,14 @@ QueryStats PackedRTree<D, NodeSize>::walk_nearest(const Point<D>& p, Visit& visi
     block(level, b).squared_distances(p, d2);
     if constexpr (!kAll) {
       // Entries the caller does not keep are pushed as nothing: each kept one separately.
+      // The node itself is asked again first: what the caller learnt since it was queued can
+      // rule it out now, and nothing under it is nearer than its nearest entry.
       const std::size_t span = this->level(level).span;
+      double nearest = d2[0];
+      for (int i = 1; i < used; ++i)
+        nearest = std::min(nearest, d2[i]);
+      if (!keep(base * span, std::min((base + NodeSize) * span, size_), std::sqrt(nearest)))
+        return std::size_t(used);
       for (int i = 0; i < used; ++i) {
         const std::size_t first = (base + i) * span;
         if (!keep(first, std::min(first + span, size_), std::sqrt(d2[i]))) continue;

@@ -24,10 +24,10 @@
 // distance of the next entry, since every entry not yet seen is at least that far, and the
 // walk stops there. Per segment, a feature's many segments would all come out of the walk
 // before the next feature's; instead a subtree holding segments of one feature only (runs of
-// packed positions, found once per LayerQuery) is dropped unseen when that feature is final
-// or already known nearer than the subtree. --candidates answers from boxes alone.
-// Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry and belongs to one
-// thread.
+// packed positions, found once per index) is dropped unseen when that feature is final or
+// already known nearer than the subtree; so is a subtree whose few runs all are. --candidates
+// answers from boxes alone. Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry
+// and belongs to one thread.
 #pragma once
 
 #include <algorithm>
@@ -142,14 +142,19 @@ class LayerIndex {
     for (const Hit& h : hits)
       if (!visit(*h.record, h.box, h.key)) return;
   }
-  // For a packed tree, per packed position: one past the last position of the run of
-  // entries of one feature that starts there, and that feature (-1 for a corrupt item
-  // index). Empty for the other structures.
-  struct FeatureRuns {
-    std::vector<std::uint32_t> end;
+  // The features of the index numbered densely (0, 1, ... in order of first appearance), so
+  // that per-query state is a flat array: the feature of every item (`none` for a corrupt
+  // record), the FID of every feature, and for a packed tree, per packed position, that
+  // position's feature and one past the last position of the run of entries of one feature
+  // that starts there. Built on first use, once for all threads.
+  struct Features {
+    static constexpr std::uint32_t none = 0xffffffffu;
+    std::vector<std::uint32_t> of_item;
     std::vector<std::int64_t> fid;
+    std::vector<std::uint32_t> at;   // packed trees: per position
+    std::vector<std::uint32_t> end;  // packed trees: per position
   };
-  FeatureRuns feature_runs() const;
+  const Features& features() const;
 
  private:
   std::variant<PackedRTree2, RStarTree2, RTree2> tree_;
@@ -161,6 +166,8 @@ class LayerIndex {
   std::vector<ItemRecord> own_records_;
   std::span<const ItemRecord> records_;
   std::shared_ptr<const void> keep_alive_;
+  struct LazyFeatures;
+  std::shared_ptr<LazyFeatures> features_;
 };
 
 // Features of a per-segment index whose polygons contain p by the even-odd rule over all rings
@@ -227,8 +234,14 @@ class LayerQuery {
   struct Geometries;
   const LayerIndex& index_;
   std::unique_ptr<Geometries> geometries_;
-  LayerIndex::FeatureRuns runs_;  // per segment, on the first nearest-n query
-  bool have_runs_ = false;
+  // Nearest-n state per feature of index_.features(), valid where stamp == generation_.
+  struct FeatureState {
+    std::uint32_t stamp = 0;
+    bool done = false;
+    double best = 0;
+  };
+  std::vector<FeatureState> state_;
+  std::uint32_t generation_ = 0;
 };
 
 }  // namespace loci::io

@@ -1,0 +1,153 @@
+// Layer nearest-n per segment (LayerQuery on a LayerIndex built in memory and on a mapped
+// sidecar) against brute force over every segment of every feature, on layers whose features
+// interleave: long random walks crossing one region, so that tree nodes hold segments of many
+// features and the walk must not drop a subtree while one of its features can still be nearer.
+// Duplicated features give ties; a feature of one zero-length segment and points far outside
+// the layer are included.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "loci/geom/predicates.hpp"
+#include "loci/io/layer_query.hpp"
+#include "loci/io/sidecar.hpp"
+
+namespace loci::io {
+namespace {
+
+struct Layer {
+  LayerItems items;
+  std::vector<std::pair<std::int64_t, Segment2>> segments;  // (fid, segment), brute force
+};
+
+void add_segment(Layer& l, std::int64_t fid, const Point2& a, const Point2& b) {
+  const bool anti = (a[0] < b[0]) != (a[1] < b[1]) && a[0] != b[0] && a[1] != b[1];
+  const Segment2 s{a, b};
+  l.items.boxes.push_back(s.box());
+  l.items.records.push_back({fid, 0, anti ? std::uint32_t(item_antidiagonal) : 0u});
+  l.segments.emplace_back(fid, s);
+}
+
+// `features` random walks of `steps` segments over [0, 100]^2; every fifth feature repeats the
+// one before it (same geometry, another FID).
+Layer interleaved(int features, int steps, std::uint64_t seed) {
+  Layer l;
+  l.items.per = Per::segment;
+  l.items.layer_name = "walks";
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> pos(0, 100), step(-6, 6);
+  std::vector<Segment2> previous;
+  for (int f = 0; f < features; ++f) {
+    const std::int64_t fid = 10 * f + 3;
+    if (f % 5 == 4) {
+      for (const Segment2& s : previous)
+        add_segment(l, fid, s.a, s.b);
+      continue;
+    }
+    previous.clear();
+    Point2 p{pos(rng), pos(rng)};
+    for (int i = 0; i < steps; ++i) {
+      Point2 q{std::clamp(p[0] + step(rng), 0.0, 100.0), std::clamp(p[1] + step(rng), 0.0, 100.0)};
+      if (i % 7 == 3) q[1] = p[1];   // horizontal
+      if (i % 11 == 5) q[0] = p[0];  // vertical
+      add_segment(l, fid, p, q);
+      previous.push_back({p, q});
+      p = q;
+    }
+  }
+  add_segment(l, 7777, {50.5, 50.5}, {50.5, 50.5});  // a point
+  return l;
+}
+
+std::vector<std::pair<double, std::int64_t>> brute(const Layer& l, const Point2& p) {
+  std::map<std::int64_t, double> best;
+  for (const auto& [fid, s] : l.segments) {
+    const double d = std::sqrt(squared_distance(p, s));
+    const auto [it, fresh] = best.try_emplace(fid, d);
+    if (!fresh) it->second = std::min(it->second, d);
+  }
+  std::vector<std::pair<double, std::int64_t>> out;
+  for (const auto& [fid, d] : best)
+    out.emplace_back(d, fid);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Every answer of k-nearest at each point: distances in rank order equal to brute force's,
+// each feature reported once with its own distance.
+void check(const LayerIndex& index, const Layer& l, std::uint64_t seed) {
+  LayerQuery query(index, "", "");
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> near(-5, 105), far(-400, 400);
+  std::size_t compared = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Point2 p = i % 10 == 9 ? Point2{far(rng), far(rng)} : Point2{near(rng), near(rng)};
+    const auto expected = brute(l, p);
+    std::map<std::int64_t, double> of;
+    for (const auto& [d, fid] : expected)
+      of[fid] = d;
+    for (const std::size_t k : {std::size_t(1), std::size_t(4), std::size_t(17), of.size() + 3}) {
+      std::vector<Answer> got;
+      Query q;
+      q.kind = Query::Kind::nearest;
+      q.point = p;
+      q.k = k;
+      query.run(q, 1, false, got);
+      ASSERT_EQ(got.size(), std::min(k, expected.size())) << "k " << k;
+      std::vector<std::int64_t> seen;
+      for (std::size_t r = 0; r < got.size(); ++r) {
+        // A segment comes back from its box in canonical direction: the last bit may differ.
+        const double tol = 1e-13 * (1 + expected[r].first);
+        EXPECT_NEAR(got[r].distance, expected[r].first, tol)
+            << "point " << p[0] << ',' << p[1] << " k " << k << " rank " << r;
+        ASSERT_TRUE(of.count(got[r].fid));
+        EXPECT_NEAR(got[r].distance, of[got[r].fid], tol);
+        seen.push_back(got[r].fid);
+        ++compared;
+      }
+      std::sort(seen.begin(), seen.end());
+      EXPECT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end()) << "a feature twice";
+    }
+  }
+  EXPECT_GT(compared, 3000u);
+}
+
+TEST(LayerNearest, InterleavedFeaturesInMemory) {
+  for (const Structure s : {Structure::packed_hilbert, Structure::packed_str, Structure::rstar}) {
+    Layer l = interleaved(60, 120, 5);
+    Layer copy = l;
+    const LayerIndex index = LayerIndex::build(std::move(copy.items), s);
+    check(index, l, 11);
+  }
+}
+
+TEST(LayerNearest, ManySmallFeatures) {
+  Layer l = interleaved(2000, 3, 8);
+  Layer copy = l;
+  const LayerIndex index = LayerIndex::build(std::move(copy.items), Structure::packed_hilbert);
+  check(index, l, 12);
+}
+
+TEST(LayerNearest, InterleavedFeaturesFromASidecar) {
+  Layer l = interleaved(40, 200, 6);
+  const PackedRTree2 tree = PackedRTree2::build(l.items.boxes);
+  SidecarInfo info;
+  info.per = Per::segment;
+  info.layer_name = "walks";
+  info.items = l.items.boxes.size();
+  info.bounds = tree.bounds();
+  const std::string path = "/tmp/loci-nearest-" + std::to_string(::getpid()) + ".loci";
+  write_sidecar(path, tree, l.items.records, info);
+  LayerIndex index = LayerIndex::adopt(Sidecar::open(path));
+  ::unlink(path.c_str());
+  check(index, l, 13);
+}
+
+}  // namespace
+}  // namespace loci::io
