@@ -81,9 +81,9 @@ Progress progress_bar(const Args& a, const char* what) {
   };
 }
 
-const std::string& layer_arg(const Args& a, const char* command) {
+const std::string& layer_arg(const Args& a, const char* command, const char* what = "LAYER") {
   if (a.positional.size() != 1)
-    throw UsageError(std::string("loci ") + command + " needs exactly one LAYER (see loci " +
+    throw UsageError(std::string("loci ") + command + " needs exactly one " + what + " (see loci " +
                      command + " --help)");
   return a.positional[0];
 }
@@ -147,6 +147,12 @@ int run_index(const Args& a) {
     std::fprintf(stderr, "loci: indexed %zu %s of layer '%s' into %s (%llu bytes, %.2f s)\n",
                  r.items, o.per == Per::segment ? "segments" : "features", r.layer_name.c_str(),
                  r.path.c_str(), static_cast<unsigned long long>(r.bytes), r.seconds);
+  return 0;
+}
+
+int run_check(const Args& a) {
+  const std::string out = check_sidecar(layer_arg(a, "check", "FILE.loci"));
+  std::printf("%s\n", out.c_str());
   return 0;
 }
 
@@ -481,6 +487,12 @@ const std::vector<Command>& commands() {
         kQuiet},
        "  loci index countries.shp\n  loci index coastline.geojson --per segment -o coast.loci\n",
        run_index},
+      {"check",
+       "loci check FILE.loci",
+       "verifies a sidecar index completely: every checksum and the tree's invariants",
+       {},
+       "  loci check countries.shp.loci\n",
+       run_check},
       {"query",
        "loci query LAYER (--bbox ... | --bbox-file F | --nearest X,Y [-k N] | ...) [-f FMT] [-o "
        "OUT]",

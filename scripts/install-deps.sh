@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git ca-certificates
   libboost-dev libcgal-dev libgmp-dev libmpfr-dev
   libgdal-dev gdal-bin
-  libsqlite3-dev sqlite3 libsqlite3-mod-spatialite
+  libsqlite3-dev sqlite3 libsqlite3-mod-spatialite libxxhash-dev
   libgtest-dev googletest
   libspatialindex-dev libgeos-dev libnanoflann-dev
   libbullet-dev libbox2d-dev

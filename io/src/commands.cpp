@@ -176,10 +176,10 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   try {
     const Sidecar sc = Sidecar::open(sidecar);
     const auto& i = sc.info();
-    const Fingerprint now = fingerprint_of(layer_path);
-    o << sidecar << ": "
-      << (now == i.source ? "fresh" : "stale (" + stale_reason(i.source, now) + ")") << ", "
-      << (i.packing == Packing::str ? "packed-str" : "packed-hilbert") << " per "
+    Fingerprint now;
+    const bool fresh = still_fresh(layer_path, i.source, &now);
+    o << sidecar << ": " << (fresh ? "fresh" : "stale (" + stale_reason(i.source, now) + ")")
+      << ", " << (i.packing == Packing::str ? "packed-str" : "packed-hilbert") << " per "
       << to_string(i.per) << ", layer " << i.layer_name << ", " << i.items << " entries, "
       << i.file_size << " bytes\n";
   } catch (const Error& e) {
@@ -219,6 +219,22 @@ IndexReport index_layer(const IndexOptions& options) {
   return r;
 }
 
+std::string check_sidecar(const std::string& path) {
+  const Sidecar sc = Sidecar::open(path);
+  try {
+    sc.verify();
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    if (what.rfind(path, 0) == 0) throw;
+    throw Error(path + ": corrupt index file (" + what + "); run 'loci index' to rebuild it");
+  }
+  const auto& i = sc.info();
+  return path + ": ok, " + (i.packing == Packing::str ? "packed-str" : "packed-hilbert") + " per " +
+         to_string(i.per) + ", layer " + i.layer_name + ", " + std::to_string(i.items) +
+         " entries, " + std::to_string(sc.check().chunks()) + " chunks verified, " +
+         std::to_string(i.file_size) + " bytes";
+}
+
 LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries* geometries) {
   const bool dynamic =
       o.structure && (*o.structure == Structure::rstar || *o.structure == Structure::rtree);
@@ -226,8 +242,8 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
   if (!o.index_path.empty() && !file_exists(path)) throw Error(path + ": no such index file");
   if (!dynamic && file_exists(path)) {
     Sidecar sc = Sidecar::open(path);
-    const Fingerprint now = fingerprint_of(o.layer_path);
-    if (!(now == sc.info().source)) {
+    Fingerprint now;
+    if (!still_fresh(o.layer_path, sc.info().source, &now)) {
       // A sidecar of another layer altogether says so, rather than "stale".
       std::string actual;
       try {

@@ -91,8 +91,9 @@ LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
   x.has_polygons_ = info.has_polygons;
   x.bounds_ = info.bounds;
   x.layer_name_ = info.layer_name;
-  x.records_ = sidecar.records();
+  x.records_ = sidecar.mapped_records();
   x.keep_alive_ = sidecar.keep_alive();
+  x.check_ = &sidecar.check();
   x.tree_ = std::move(sidecar).take_tree();
   x.features_ = std::make_shared<LazyFeatures>();
   return x;
@@ -299,12 +300,13 @@ struct LayerIndex::LazyFeatures {
 const LayerIndex::Features& LayerIndex::features() const {
   std::call_once(features_->once, [&] {
     Features& f = features_->value;
-    f.of_item.resize(records_.size());
+    const auto records = this->records();
+    f.of_item.resize(records.size());
     std::unordered_map<std::int64_t, std::uint32_t> number;
     std::int64_t last_fid = 0;
     std::uint32_t last = Features::none;
-    for (std::size_t id = 0; id < records_.size(); ++id) {
-      const std::int64_t fid = records_[id].fid;
+    for (std::size_t id = 0; id < records.size(); ++id) {
+      const std::int64_t fid = records[id].fid;
       if (last == Features::none || fid != last_fid) {
         const auto [it, fresh] = number.try_emplace(fid, std::uint32_t(f.fid.size()));
         if (fresh) f.fid.push_back(fid);

@@ -10,21 +10,26 @@
 #include <bit>
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "loci/geom/error.hpp"
 #include "loci/io/atomic_file.hpp"
 
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
 namespace loci::io {
 namespace {
 
 constexpr char kMagic[8] = {'\x89', 'L', 'O', 'C', 'I', '\r', '\n', '\x1a'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;
 constexpr std::uint32_t kByteOrder = 0x01020304;
 constexpr std::uint8_t kStructurePackedRTree = 1;
 constexpr std::uint8_t kCoordFloat64 = 1;
 constexpr std::uint32_t kFlagPolygons = 1;
 constexpr std::size_t kAlign = 64;
+constexpr unsigned kChunkShift = 16;  // 64 KiB checked at a time
 
 struct SidecarHeader {
   char magic[8];
@@ -51,32 +56,21 @@ struct SidecarHeader {
   std::uint64_t source_size;
   std::int64_t source_mtime_ns;
   std::uint64_t source_hash;
-  std::uint64_t payload_checksum;  // hash of bytes [sizeof(SidecarHeader), file_size)
-  std::uint8_t reserved[80];
-  std::uint64_t header_checksum;  // hash of the bytes before this field
+  std::uint64_t source_inode;
+  std::uint64_t checks_offset;  // chunk_count XXH3-64 values, one per chunk of the data
+  std::uint64_t chunk_count;
+  std::uint64_t data_offset;  // = blocks_offset; chunks cover [data_offset, file_size)
+  std::uint32_t chunk_shift;  // a chunk is 2^chunk_shift bytes (the last may be shorter)
+  std::uint32_t reserved1;
+  std::uint64_t front_checksum;  // XXH3-64 of bytes [sizeof(SidecarHeader), data_offset)
+  std::uint8_t reserved[40];
+  std::uint64_t header_checksum;  // XXH3-64 of the bytes before this field
 };
 static_assert(sizeof(SidecarHeader) == 256);
 static_assert(std::endian::native == std::endian::little, "sidecars are little-endian");
 
 std::size_t align_up(std::size_t n) {
   return (n + kAlign - 1) / kAlign * kAlign;
-}
-
-constexpr std::uint64_t kP1 = 0x9E3779B185EBCA87ull;
-constexpr std::uint64_t kP2 = 0xC2B2AE3D27D4EB4Full;
-constexpr std::uint64_t kP3 = 0x165667B19E3779F9ull;
-
-std::uint64_t mix(std::uint64_t lane, std::uint64_t word) {
-  return std::rotl(lane + word * kP2, 31) * kP1;
-}
-
-std::uint64_t avalanche(std::uint64_t h) {
-  h ^= h >> 33;
-  h *= kP2;
-  h ^= h >> 29;
-  h *= kP3;
-  h ^= h >> 32;
-  return h;
 }
 
 struct Mapping {
@@ -111,6 +105,31 @@ std::shared_ptr<const Mapping> map_file(const std::string& path) {
   return m;
 }
 
+// Verifies a mapped sidecar's data chunk by chunk against the file's checksum table.
+class ChunkCheck final : public loci::detail::LazyCheck {
+ public:
+  ChunkCheck(std::shared_ptr<const Mapping> m, std::string path, std::uint64_t data_offset,
+             std::uint64_t checks_offset)
+      : LazyCheck(m->data + data_offset, m->size - data_offset, kChunkShift),
+        mapping_(std::move(m)),
+        path_(std::move(path)),
+        checks_(mapping_->data + checks_offset) {}
+
+ protected:
+  void verify(std::size_t c, const std::byte* data, std::size_t bytes) const override {
+    std::uint64_t expected;
+    std::memcpy(&expected, checks_ + 8 * c, 8);
+    if (hash_bytes(data, bytes) != expected)
+      throw Error(path_ + ": corrupt index file (checksum mismatch in chunk " + std::to_string(c) +
+                  "); run 'loci index' to rebuild it");
+  }
+
+ private:
+  std::shared_ptr<const Mapping> mapping_;
+  std::string path_;
+  const std::byte* checks_;
+};
+
 bool stat_file(const std::string& path, struct stat& st) {
   return ::stat(path.c_str(), &st) == 0;
 }
@@ -139,41 +158,13 @@ void write_all(int fd, const void* data, std::size_t size, const std::string& pa
 }  // namespace
 
 std::uint64_t hash_bytes(const void* data, std::size_t size, std::uint64_t seed) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  std::uint64_t lane[4] = {seed + kP1 + kP2, seed + kP2, seed, seed - kP1};
-  std::size_t i = 0;
-  for (; i + 32 <= size; i += 32) {
-    for (int l = 0; l < 4; ++l) {
-      std::uint64_t w;
-      std::memcpy(&w, p + i + 8 * l, 8);
-      lane[l] = mix(lane[l], w);
-    }
-  }
-  std::uint64_t h = std::rotl(lane[0], 1) + std::rotl(lane[1], 7) + std::rotl(lane[2], 12) +
-                    std::rotl(lane[3], 18) + std::uint64_t(size);
-  for (; i + 8 <= size; i += 8) {
-    std::uint64_t w;
-    std::memcpy(&w, p + i, 8);
-    h = std::rotl(h ^ mix(0, w), 27) * kP1 + kP3;
-  }
-  for (; i < size; ++i)
-    h = std::rotl(h ^ (p[i] * kP3), 11) * kP1;
-  return avalanche(h);
+  return XXH3_64bits_withSeed(data, size, seed);
 }
 
-Fingerprint fingerprint_of(const std::string& layer_path) {
-  struct stat st {};
-  if (!stat_file(layer_path, st)) {
-    // GDAL paths that are not files (virtual file systems, connection strings) cannot be
-    // fingerprinted here; GDAL itself reports whether they open.
-    if (layer_path.rfind("/vsi", 0) == 0 || layer_path.find(':') != std::string::npos) return {};
-    throw Error(layer_path + ": no such file");
-  }
-  Fingerprint f;
-  if (!S_ISREG(st.st_mode)) {
-    f.mtime_ns = mtime_ns(st);
-    return f;
-  }
+namespace {
+
+// The files a layer's geometry lives in: the path itself, and a shapefile's index (.shx).
+std::vector<std::string> layer_files(const std::string& layer_path) {
   std::vector<std::string> files{layer_path};
   const std::string ext = layer_path.size() > 4 ? layer_path.substr(layer_path.size() - 4) : "";
   if (lower(ext) == ".shp") {
@@ -186,15 +177,68 @@ Fingerprint fingerprint_of(const std::string& layer_path) {
       }
     }
   }
-  for (const auto& file : files) {
-    const auto m = map_file(file);
-    f.size += m->size;
+  return files;
+}
+
+// Size, modification time and inode of the layer's files, nothing read; `regular` tells
+// whether there is content to hash. Nullopt for a GDAL path that is not a file.
+std::optional<Fingerprint> stat_fingerprint(const std::string& layer_path, bool& regular) {
+  struct stat st {};
+  if (!stat_file(layer_path, st)) {
+    // GDAL paths that are not files (virtual file systems, connection strings) cannot be
+    // fingerprinted here; GDAL itself reports whether they open.
+    if (layer_path.rfind("/vsi", 0) == 0 || layer_path.find(':') != std::string::npos)
+      return std::nullopt;
+    throw Error(layer_path + ": no such file");
+  }
+  Fingerprint f;
+  regular = S_ISREG(st.st_mode);
+  if (!regular) {
+    f.mtime_ns = mtime_ns(st);
+    f.inode = st.st_ino;
+    return f;
+  }
+  for (const auto& file : layer_files(layer_path)) {
     struct stat s {};
-    stat_file(file, s);
+    if (!stat_file(file, s)) throw Error(file + ": cannot read");
+    f.size += std::uint64_t(s.st_size);
     f.mtime_ns = std::max(f.mtime_ns, mtime_ns(s));
+    f.inode = f.inode * 0x100000001b3ull ^ std::uint64_t(s.st_ino);
+  }
+  return f;
+}
+
+}  // namespace
+
+Fingerprint fingerprint_of(const std::string& layer_path) {
+  bool regular = false;
+  const auto stat = stat_fingerprint(layer_path, regular);
+  if (!stat) return {};
+  Fingerprint f = *stat;
+  if (!regular) return f;
+  for (const auto& file : layer_files(layer_path)) {
+    const auto m = map_file(file);
     f.hash = hash_bytes(m->data, m->size, f.hash);
   }
   return f;
+}
+
+bool still_fresh(const std::string& layer_path, const Fingerprint& was, Fingerprint* now) {
+  bool regular = false;
+  const auto stat = stat_fingerprint(layer_path, regular);
+  Fingerprint f = stat.value_or(Fingerprint{});
+  if (f.size == was.size && f.mtime_ns == was.mtime_ns && f.inode == was.inode) {
+    if (now) *now = was;
+    return true;
+  }
+  if (!stat || !regular || f.size != was.size) {
+    if (now) *now = f;
+    return false;
+  }
+  // Touched, copied or moved: the content decides.
+  f = fingerprint_of(layer_path);
+  if (now) *now = f;
+  return f.size == was.size && f.hash == was.hash;
 }
 
 std::string default_sidecar_path(const std::string& layer_path) {
@@ -226,7 +270,14 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   h.slot_count = items.size();
   h.name_offset = sizeof(SidecarHeader);
   h.name_size = info.layer_name.size();
-  h.blocks_offset = align_up(h.name_offset + h.name_size);
+  h.checks_offset = align_up(h.name_offset + h.name_size);
+  // The checksum table's length depends on the data's, which starts after the table.
+  const std::size_t data_bytes =
+      align_up(blocks.size_bytes()) + align_up(items.size_bytes()) + records.size_bytes();
+  h.chunk_shift = kChunkShift;
+  h.chunk_count = data_bytes == 0 ? 0 : ((data_bytes - 1) >> kChunkShift) + 1;
+  h.data_offset = align_up(h.checks_offset + 8 * h.chunk_count);
+  h.blocks_offset = h.data_offset;
   h.items_offset = align_up(h.blocks_offset + blocks.size_bytes());
   h.records_offset = align_up(h.items_offset + items.size_bytes());
   h.file_size = h.records_offset + records.size_bytes();
@@ -238,16 +289,24 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   h.source_size = info.source.size;
   h.source_mtime_ns = info.source.mtime_ns;
   h.source_hash = info.source.hash;
+  h.source_inode = info.source.inode;
 
   std::vector<std::byte> payload(h.file_size - sizeof(SidecarHeader));
+  auto at = [&](std::uint64_t offset) { return payload.data() + (offset - sizeof(SidecarHeader)); };
   auto put = [&](std::uint64_t offset, const void* data, std::size_t size) {
-    if (size) std::memcpy(payload.data() + (offset - sizeof(SidecarHeader)), data, size);
+    if (size) std::memcpy(at(offset), data, size);
   };
   put(h.name_offset, info.layer_name.data(), info.layer_name.size());
   put(h.blocks_offset, blocks.data(), blocks.size_bytes());
   put(h.items_offset, items.data(), items.size_bytes());
   put(h.records_offset, records.data(), records.size_bytes());
-  h.payload_checksum = hash_bytes(payload.data(), payload.size());
+  for (std::uint64_t c = 0; c < h.chunk_count; ++c) {
+    const std::uint64_t first = h.data_offset + (c << kChunkShift);
+    const std::uint64_t bytes = std::min<std::uint64_t>(h.file_size - first, 1ull << kChunkShift);
+    const std::uint64_t sum = hash_bytes(at(first), bytes);
+    put(h.checks_offset + 8 * c, &sum, 8);
+  }
+  h.front_checksum = hash_bytes(payload.data(), h.data_offset - sizeof(SidecarHeader));
   h.header_checksum = hash_bytes(&h, offsetof(SidecarHeader, header_checksum));
 
   AtomicFile out(path);
@@ -292,14 +351,23 @@ Sidecar Sidecar::open(const std::string& path) {
     return offset % 8 == 0 && offset >= sizeof(SidecarHeader) && offset <= m->size &&
            count <= (m->size - offset) / size;
   };
+  const bool chunks_fit =
+      h.chunk_shift == kChunkShift && h.data_offset == h.blocks_offset &&
+      h.data_offset <= m->size && h.checks_offset % 8 == 0 &&
+      h.checks_offset >= h.name_offset + h.name_size && fits(h.checks_offset, h.chunk_count, 8) &&
+      h.checks_offset + 8 * h.chunk_count <= h.data_offset &&
+      h.chunk_count ==
+          (m->size == h.data_offset ? 0 : ((m->size - h.data_offset - 1) >> kChunkShift) + 1);
   if (h.item_count >= (1ull << 32) || h.block_count != expect_blocks ||
       h.slot_count != expect_slots || h.blocks_offset % kAlign != 0 ||
       !fits(h.name_offset, h.name_size, 1) ||
       !fits(h.blocks_offset, h.block_count, sizeof(Block)) ||
-      !fits(h.items_offset, h.slot_count, 4) || !fits(h.records_offset, h.item_count, 16))
+      !fits(h.items_offset, h.slot_count, 4) || !fits(h.records_offset, h.item_count, 16) ||
+      !chunks_fit)
     throw refuse("corrupt index file (inconsistent sizes)");
-  if (h.payload_checksum !=
-      hash_bytes(m->data + sizeof(SidecarHeader), m->size - sizeof(SidecarHeader)))
+  // The name and the checksum table are read now; the data only where a query reads it.
+  if (h.front_checksum !=
+      hash_bytes(m->data + sizeof(SidecarHeader), h.data_offset - sizeof(SidecarHeader)))
     throw refuse("corrupt index file (checksum mismatch)");
 
   Sidecar s;
@@ -309,17 +377,28 @@ Sidecar Sidecar::open(const std::string& path) {
   s.info_.has_polygons = (h.flags & kFlagPolygons) != 0;
   s.info_.items = h.item_count;
   s.info_.bounds = {{h.bounds[0], h.bounds[1]}, {h.bounds[2], h.bounds[3]}};
-  s.info_.source = {h.source_size, h.source_mtime_ns, h.source_hash};
+  s.info_.source = {h.source_size, h.source_mtime_ns, h.source_inode, h.source_hash};
   s.info_.file_size = h.file_size;
+  auto check = std::make_shared<ChunkCheck>(m, path, h.data_offset, h.checks_offset);
   const auto* blocks = reinterpret_cast<const Block*>(m->data + h.blocks_offset);
   const auto* items = reinterpret_cast<const std::uint32_t*>(m->data + h.items_offset);
   s.records_ = {reinterpret_cast<const ItemRecord*>(m->data + h.records_offset),
                 std::size_t(h.item_count)};
   s.tree_ = PackedRTree2::adopt(std::size_t(h.item_count), Packing(h.packing),
                                 {blocks, std::size_t(h.block_count)},
-                                {items, std::size_t(h.slot_count)}, m);
-  s.mapping_ = m;
+                                {items, std::size_t(h.slot_count)}, check, check.get());
+  s.check_ = check;
   return s;
+}
+
+std::span<const ItemRecord> Sidecar::records() const {
+  check_->touch(records_.data(), records_.size_bytes());
+  return records_;
+}
+
+void Sidecar::verify() const {
+  check_->touch_all();
+  tree_.validate();
 }
 
 }  // namespace loci::io

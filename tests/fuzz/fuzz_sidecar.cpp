@@ -1,5 +1,6 @@
 // Fuzz target: the sidecar loader. Any bytes handed to Sidecar::open must be refused with a
-// loci::Error or give an index whose queries stay inside the mapping; seeds are real sidecars.
+// loci::Error (at open, when a query first reads a corrupt chunk, or by verify()) or give an
+// index whose queries stay inside the mapping; seeds are real sidecars.
 #include <cstdint>
 #include <string>
 
@@ -19,6 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       return true;
     });
     tree.nearest({0, 0}, 3);
+    sidecar.verify();
   } catch (const loci::Error&) {
   }
   return 0;

@@ -807,19 +807,36 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
     EXPECT_EQ(r.status, 1) << "cut at " << cut << ": " << r.err;
     EXPECT_EQ(r.err.rfind("loci: error: ", 0), 0u) << r.err;
   }
-  for (int i = 0; i < 12; ++i) {  // one flipped byte anywhere: header or payload
+  const std::string answer = run_loci(query).out;
+  // One flipped byte anywhere: header, name, checksum table or data. The query reads the
+  // chunks it needs and is refused when one of them is corrupt, or else answers exactly as
+  // before; loci check reads everything and refuses every one.
+  std::size_t refused = 0;
+  for (int i = 0; i < 24; ++i) {
     std::string bad = good;
     const std::size_t at = i < 4 ? std::size_t(8 + 20 * i) : rng() % bad.size();
     bad[at] = char(bad[at] ^ (1 + rng() % 255));
     put(bad);
     const CliRun r = run_loci(query);
-    EXPECT_EQ(r.status, 1) << "byte " << at;
-    EXPECT_NE(r.err.find(sidecar), std::string::npos) << r.err;
+    if (r.status == 0) {
+      EXPECT_EQ(r.out, answer) << "byte " << at;
+    } else {
+      ++refused;
+      EXPECT_EQ(r.status, 1) << "byte " << at;
+      EXPECT_NE(r.err.find(sidecar), std::string::npos) << r.err;
+    }
+    const CliRun c = run_loci("check " + sidecar);
+    EXPECT_EQ(c.status, 1) << "byte " << at << ": " << c.out;
+    EXPECT_NE(c.err.find(sidecar), std::string::npos) << c.err;
   }
+  EXPECT_GT(refused, 4u);
   put(good + "extra");
   expect_error(query, "damaged index");
   put(good);
   EXPECT_EQ(run_loci(query).status, 0);
+  const CliRun ok = run_loci("check " + sidecar);
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find(": ok,"), std::string::npos) << ok.out;
   fs::remove(sidecar);
 }
 
@@ -831,8 +848,26 @@ TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {
   const std::string layer = path("stale.shp");
   ASSERT_EQ(run_loci("index -q " + layer).status, 0);
   ASSERT_EQ(run_loci("query " + layer + " --bbox 0,0,9,9").status, 0);
-  // Touched only: newer than the index, so the index is refused as make would.
+  // Touched only: the modification time differs, so the content is hashed again; it is the
+  // same, and the index still answers (and says so in loci info).
+  const std::string before = run_loci("query " + layer + " --bbox 0,0,9,9").out;
   fs::last_write_time(layer, fs::last_write_time(layer) + std::chrono::seconds(5));
+  const CliRun touched = run_loci("query " + layer + " --bbox 0,0,9,9");
+  EXPECT_EQ(touched.status, 0) << touched.err;
+  EXPECT_EQ(touched.out, before);
+  EXPECT_NE(run_loci("info " + layer).out.find("fresh"), std::string::npos);
+  // Same size, another byte: a coordinate of the .shp changed in place.
+  {
+    std::fstream f(layer, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(0, std::ios::end);
+    const auto size = f.tellg();
+    f.seekg(size - std::streamoff(8));
+    char c = 0;
+    f.read(&c, 1);
+    f.seekp(size - std::streamoff(8));
+    c = char(c ^ 0x10);
+    f.write(&c, 1);
+  }
   expect_error("query " + layer + " --bbox 0,0,9,9", "stale index");
   // Really changed: a feature added through GDAL.
   ASSERT_EQ(run_loci("index -q " + layer).status, 0);

@@ -38,6 +38,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/best_first.hpp"
 #include "loci/index/detail/hilbert.hpp"
+#include "loci/index/detail/lazy_check.hpp"
 #include "loci/index/detail/radix_sort.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/detail/soa_boxes.hpp"
@@ -93,11 +94,14 @@ class PackedRTree {
   }
 
   // Wraps arrays laid out as blocks() and item_indices() return them (for instance from a
-  // memory-mapped file). `keep_alive` owns the memory. The arrays are trusted to be a valid
-  // tree of `size` items; call validate() when they come from an untrusted source.
+  // memory-mapped file). `keep_alive` owns the memory (and `check`, when given). The arrays
+  // are trusted to be a valid tree of `size` items; call validate() when they come from an
+  // untrusted source. With `check`, every read of the arrays is first handed to
+  // check->touch(), which verifies the bytes the first time they are read.
   static PackedRTree adopt(std::size_t size, Packing packing, std::span<const Block> blocks,
                            std::span<const std::uint32_t> item_indices,
-                           std::shared_ptr<const void> keep_alive) {
+                           std::shared_ptr<const void> keep_alive,
+                           const detail::LazyCheck* check = nullptr) {
     PackedRTree t;
     t.size_ = size;
     t.packing_ = packing;
@@ -108,6 +112,7 @@ class PackedRTree {
     t.blocks_ = blocks.data();
     t.items_ = item_indices.data();
     t.keep_alive_ = std::move(keep_alive);
+    t.check_ = check;
     return t;
   }
 
@@ -191,7 +196,7 @@ class PackedRTree {
   template <class Key, class Visit>
   QueryStats ordered(Key&& key, Visit&& visit) const;
   // The id of the item at packed position pos < size().
-  Id item_at(std::size_t pos) const { return Id(items_[pos]); }
+  Id item_at(std::size_t pos) const { return Id(item_index(pos)); }
 
   // Throws loci::Error describing the first broken invariant.
   void validate() const;
@@ -216,8 +221,18 @@ class PackedRTree {
   std::size_t total_blocks() const {
     return levels_.empty() ? 0 : levels_.back().first_block + levels_.back().blocks;
   }
-  const Block& block(int l, std::size_t b) const { return blocks_[level(l).first_block + b]; }
-  const Block& root_block() const { return blocks_[total_blocks() - 1]; }
+  const Block& block(int l, std::size_t b) const {
+    const Block& node = blocks_[level(l).first_block + b];
+    if (check_) [[unlikely]]
+      check_->touch(&node, sizeof(Block));
+    return node;
+  }
+  const Block& root_block() const { return block(levels() - 1, 0); }
+  std::uint32_t item_index(std::size_t pos) const {
+    if (check_) [[unlikely]]
+      check_->touch(items_ + pos, sizeof(std::uint32_t));
+    return items_[pos];
+  }
   Box<D> leaf_box(std::size_t pos) const {
     return block(0, pos / NodeSize).box(int(pos % NodeSize));
   }
@@ -239,6 +254,7 @@ class PackedRTree {
   std::unique_ptr<Block[]> own_blocks_;
   std::unique_ptr<std::uint32_t[]> own_items_;
   std::shared_ptr<const void> keep_alive_;
+  const detail::LazyCheck* check_ = nullptr;  // owned by keep_alive_
 };
 
 template <int D, int NodeSize>
@@ -341,7 +357,7 @@ void PackedRTree<D, NodeSize>::tile(Item* base, std::size_t first, std::size_t c
 template <int D, int NodeSize>
 Box<D> PackedRTree<D, NodeSize>::item_box(Id id) const {
   for (std::size_t pos = 0; pos < size_; ++pos)
-    if (items_[pos] == id) return leaf_box(pos);
+    if (item_index(pos) == id) return leaf_box(pos);
   throw InvalidArgument("no item with id " + std::to_string(id));
 }
 
@@ -352,7 +368,7 @@ bool PackedRTree<D, NodeSize>::report_run(std::size_t first, std::size_t last, V
   last = std::min(last, size_);
   for (std::size_t pos = first; pos < last; ++pos) {
     ++s.results;
-    if (!visit(Id(items_[pos]), leaf_box(pos))) return false;
+    if (!visit(Id(item_index(pos)), leaf_box(pos))) return false;
   }
   return true;
 }
@@ -383,7 +399,7 @@ QueryStats PackedRTree<D, NodeSize>::query(const Box<D>& window, Visit&& visit,
       while (hits) {
         const int i = detail::pop_lowest(hits);
         ++s.results;
-        if (!visit(Id(items_[base + i]), node.box(i))) return s;
+        if (!visit(Id(item_index(base + i)), node.box(i))) return s;
       }
       continue;
     }
@@ -455,7 +471,7 @@ QueryStats PackedRTree<D, NodeSize>::ordered(Key&& key, Visit&& visit) const {
       if (!(k < kInf)) continue;
       // The walk orders by its first field and hands back its square root.
       if (level == 0)
-        sink.push_entry(k * k, base + i, Id(items_[base + i]));
+        sink.push_entry(k * k, base + i, Id(item_index(base + i)));
       else
         sink.push_subtree(k * k, (std::uint64_t(level - 1) << 32) | (base + i));
     }
@@ -494,7 +510,7 @@ QueryStats PackedRTree<D, NodeSize>::walk_nearest(const Point<D>& p, Visit& visi
         const std::size_t first = (base + i) * span;
         if (!keep(first, std::min(first + span, size_), std::sqrt(d2[i]))) continue;
         if (level == 0)
-          sink.push_entry(d2[i], base + i, Id(items_[base + i]));
+          sink.push_entry(d2[i], base + i, Id(item_index(base + i)));
         else
           sink.push_subtree(d2[i], (std::uint64_t(level - 1) << 32) | (base + i));
       }
@@ -502,7 +518,8 @@ QueryStats PackedRTree<D, NodeSize>::walk_nearest(const Point<D>& p, Visit& visi
     }
     if (level == 0)
       sink.push_entries(
-          d2, used, [&](int i) { return base + i; }, [&](int i) { return Id(items_[base + i]); });
+          d2, used, [&](int i) { return base + i; },
+          [&](int i) { return Id(item_index(base + i)); });
     else
       sink.push_subtrees(d2, used,
                          [&](int i) { return (std::uint64_t(level - 1) << 32) | (base + i); });
@@ -545,7 +562,7 @@ void PackedRTree<D, NodeSize>::validate() const {
   }
   std::vector<bool> seen(size_, false);
   for (std::size_t pos = 0; pos < size_; ++pos) {
-    const std::uint32_t id = items_[pos];
+    const std::uint32_t id = item_index(pos);
     if (id >= size_ || seen[id]) fail("item indices are not a permutation");
     seen[id] = true;
   }

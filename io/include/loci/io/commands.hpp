@@ -4,6 +4,7 @@
 //
 //   describe_layer   `loci info`: the layer's summary and the state of its sidecar
 //   index_layer      `loci index`: reads the layer, packs the tree, writes the sidecar
+//   check_sidecar    `loci check`: verifies every byte and invariant of a sidecar
 //   load_index       how `loci query` finds its index: a fresh sidecar is mapped, a stale or
 //                    corrupt one is refused, no sidecar means building in memory
 //   query_layer      `loci query`: one query or a numbered batch, exact or --candidates
@@ -63,6 +64,11 @@ struct IndexReport {
 
 // Throws InvalidArgument for a structure that cannot be stored (the dynamic trees).
 IndexReport index_layer(const IndexOptions& options);
+
+// Verifies a sidecar whole: header, every chunk's checksum, the tree's invariants (boxes are
+// the unions of their nodes, item indices a permutation). Returns a one-line summary; throws
+// loci::Error naming the file and the first problem found.
+std::string check_sidecar(const std::string& path);
 
 struct LoadOptions {
   std::string layer_path;

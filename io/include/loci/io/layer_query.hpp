@@ -73,7 +73,11 @@ class LayerIndex {
   std::size_t size() const { return records_.size(); }
   Box2 bounds() const { return bounds_; }
   const std::string& layer_name() const { return layer_name_; }
-  std::span<const ItemRecord> records() const { return records_; }
+  // Every record (from a sidecar: verified first, once).
+  std::span<const ItemRecord> records() const {
+    if (check_) check_->touch(records_.data(), records_.size_bytes());
+    return records_;
+  }
   const PackedRTree2* packed() const { return std::get_if<PackedRTree2>(&tree_); }
 
   // visit(record, box) for every entry whose box meets w; returning false stops.
@@ -82,7 +86,7 @@ class LayerIndex {
     std::visit(
         [&]<BoxIndex Tree>(const Tree& t) {
           t.query(w, [&](Id id, const Box2& b) {
-            return id < records_.size() ? visit(records_[id], b) : true;
+            return id < records_.size() ? visit(record(Id(id)), b) : true;
           });
         },
         tree_);
@@ -94,7 +98,7 @@ class LayerIndex {
     std::visit(
         [&]<NearestIndex Tree>(const Tree& t) {
           t.browse(p, [&](Id id, const Box2& b, double d) {
-            return id < records_.size() ? visit(records_[id], b, d) : true;
+            return id < records_.size() ? visit(record(Id(id)), b, d) : true;
           });
         },
         tree_);
@@ -108,7 +112,7 @@ class LayerIndex {
       t->browse(
           p,
           [&](Id id, const Box2& b, double d) {
-            return id < records_.size() ? visit(records_[id], b, d) : true;
+            return id < records_.size() ? visit(record(Id(id)), b, d) : true;
           },
           keep);
       return;
@@ -123,7 +127,7 @@ class LayerIndex {
   void ordered(const Box2& search, Key&& key, Visit&& visit) const {
     if (const PackedRTree2* t = packed()) {
       t->ordered(key, [&](Id id, const Box2& b, double k) {
-        return id < records_.size() ? visit(records_[id], b, k) : true;
+        return id < records_.size() ? visit(record(Id(id)), b, k) : true;
       });
       return;
     }
@@ -166,6 +170,11 @@ class LayerIndex {
   std::vector<ItemRecord> own_records_;
   std::span<const ItemRecord> records_;
   std::shared_ptr<const void> keep_alive_;
+  const loci::detail::LazyCheck* check_ = nullptr;  // a sidecar's, owned by keep_alive_
+  const ItemRecord& record(Id id) const {
+    if (check_) check_->touch(&records_[id], sizeof(ItemRecord));
+    return records_[id];
+  }
   struct LazyFeatures;
   std::shared_ptr<LazyFeatures> features_;
 };

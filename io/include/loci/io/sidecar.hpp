@@ -1,30 +1,40 @@
 // The sidecar index file (`LAYER.loci`, DESIGN.md section 7): a packed R-tree over a layer's
 // features or segments, saved so that later queries map it into memory and search it in place.
 //
-// Layout (little-endian, every offset a multiple of 64 from the start of the file):
+// Layout (little-endian, every offset a multiple of 64 from the start of the file), format 2:
 //
-//   0    header, 256 bytes (SidecarHeader below): magic "\x89LOCI\r\n\x1a", format version,
-//        byte-order mark, structure kind, packing, coordinate type, granularity (per feature or
-//        per segment), dimension, node size, item and block counts, the offsets and sizes of
-//        the sections, the layer's bounds, the source fingerprint, a checksum of the payload
-//        and finally a checksum of the header bytes before it.
+//   0    header, 256 bytes (SidecarHeader in sidecar.cpp): magic "\x89LOCI\r\n\x1a", format
+//        version, byte-order mark, structure kind, packing, coordinate type, granularity (per
+//        feature or per segment), dimension, node size, item and block counts, the offsets and
+//        sizes of the sections, the layer's bounds, the source fingerprint, the chunk size and
+//        count, a checksum of the name and checksum table, and last a checksum of the header
+//        bytes before it
 //   256  the layer name (UTF-8, not terminated)
-//   ...  blocks: the tree's nodes exactly as PackedRTree::blocks() holds them (SoA doubles)
+//   ...  the checksum table: XXH3-64 (seed 0) of each 64 KiB chunk of the data below, the last
+//        chunk shorter; chunk c is [data + c * 65536, min(data + (c + 1) * 65536, file end))
+//   data blocks: the tree's nodes exactly as PackedRTree::blocks() holds them (SoA doubles)
 //   ...  item indices: PackedRTree::item_indices(), 32-bit, one per slot of level 0
 //   ...  records: one 16-byte ItemRecord per item (fid, part, flags), indexed by item id
 //
-// The magic's first byte has the high bit set and it holds CR LF and ^Z, so that text-mode
-// transfers and truncation to 7 bits are caught at once, as PNG does. The file is opened with
-// mmap and handed to PackedRTree::adopt: no parse step, no copy. Before that, every size and
-// offset is checked against the real file size and both checksums are verified, so a
-// truncated, corrupt or foreign file is refused with a message. Item ids read from the file
-// are bounds-checked where they index the records, so even a file forged with a valid
-// checksum cannot make a query read outside the mapping.
+// Every checksum is XXH3-64 with seed 0 (libxxhash), so that others can check a file. The
+// magic's first byte has the high bit set and it holds CR LF and ^Z, so that text-mode
+// transfers and truncation to 7 bits are caught at once, as PNG does.
 //
-// Fingerprint. The index is only valid for the exact bytes it was built from: the source's
-// size, modification time (nanoseconds) and a 64-bit hash of its contents (for a shapefile,
-// of its .shp and .shx, which hold every geometry and the record offsets). Any difference
-// makes the sidecar stale; a touched but unchanged layer is reported stale too, as make would.
+// Opening costs the same whatever the file's size: the file is mapped, the header, name and
+// checksum table are checked (every size and offset against the real file size), and the tree
+// adopts the mapping in place. The data is verified one chunk at a time, the first time a query
+// reads from that chunk (detail::LazyCheck), so a flipped bit is refused with a message when its
+// chunk is read and never answers; `loci check` verifies every chunk and the tree's invariants.
+// Item ids read from the file are bounds-checked where they index the records, so even a file
+// forged with valid checksums cannot make a query read outside the mapping. Format 1 (one
+// checksum over the whole payload, hashed on every open) is refused with the usual message.
+//
+// Fingerprint. The index is valid for the exact bytes it was built from: at index time the
+// source's size, modification time (nanoseconds), inode and a 64-bit XXH3 hash of its contents
+// (for a shapefile, of its .shp and .shx, which hold every geometry and the record offsets).
+// At query time size, modification time and inode are compared, nothing read; only when they
+// differ (a touched, copied or rewritten layer) is the content hashed again, and the index is
+// fresh if size and hash still agree.
 //
 // Writing goes through AtomicFile (atomic_file.hpp): a hidden temporary file in the same
 // directory, synced, then renamed over the target, so readers see either the old file or the
@@ -37,6 +47,7 @@
 #include <string>
 
 #include "loci/geom/segment.hpp"
+#include "loci/index/detail/lazy_check.hpp"
 #include "loci/index/packed_rtree.hpp"
 
 namespace loci::io {
@@ -67,15 +78,22 @@ enum class Per : std::uint8_t { feature = 0, segment = 1 };
 struct Fingerprint {
   std::uint64_t size = 0;     // bytes
   std::int64_t mtime_ns = 0;  // latest modification time of the files hashed
+  std::uint64_t inode = 0;    // the files' inodes, combined
   std::uint64_t hash = 0;
   friend bool operator==(const Fingerprint&, const Fingerprint&) = default;
 };
 
-// Throws loci::Error when the layer's file(s) cannot be read. Paths GDAL understands that are
-// not plain files (for instance a database connection) get an empty fingerprint.
+// The full fingerprint, contents hashed (index time). Throws loci::Error when the layer's
+// file(s) cannot be read. Paths GDAL understands that are not plain files (for instance a
+// database connection) get an empty fingerprint.
 Fingerprint fingerprint_of(const std::string& layer_path);
 
-// 64-bit hash of a byte range; fast enough to run over a layer on every open (several GB/s).
+// Whether the layer still holds what `was` was taken of: size, modification time and inode
+// equal (nothing is read), or else the same size and content hash. `now` receives what was
+// measured (for messages).
+bool still_fresh(const std::string& layer_path, const Fingerprint& was, Fingerprint* now = nullptr);
+
+// XXH3-64 of a byte range.
 std::uint64_t hash_bytes(const void* data, std::size_t size, std::uint64_t seed = 0);
 
 // Where `loci index` writes by default: the layer path with ".loci" appended.
@@ -104,16 +122,24 @@ class Sidecar {
   static Sidecar open(const std::string& path);
 
   const SidecarInfo& info() const { return info_; }
+  // The tree verifies what it reads as it reads it.
   const PackedRTree2& tree() const { return tree_; }
-  std::span<const ItemRecord> records() const { return records_; }
+  // Every record, verified first (throws loci::Error naming the file when corrupt).
+  std::span<const ItemRecord> records() const;
+  // The records as mapped, unverified: read record i only after check().touch() of it.
+  std::span<const ItemRecord> mapped_records() const { return records_; }
+  const loci::detail::LazyCheck& check() const { return *check_; }
+  // Verifies every chunk and the tree's invariants; throws loci::Error naming the problem.
+  void verify() const;
   PackedRTree2 take_tree() && { return std::move(tree_); }
-  std::shared_ptr<const void> keep_alive() const { return mapping_; }
+  // Owns the mapping and the check.
+  std::shared_ptr<const void> keep_alive() const { return check_; }
 
  private:
   SidecarInfo info_;
   PackedRTree2 tree_;
   std::span<const ItemRecord> records_;
-  std::shared_ptr<const void> mapping_;
+  std::shared_ptr<const loci::detail::LazyCheck> check_;
 };
 
 }  // namespace loci::io

@@ -1,0 +1,154 @@
+// The sidecar's data is verified chunk by chunk as queries read it (format 2): opening reads
+// nothing of the data, a small query verifies a few chunks of many, a flipped byte anywhere in
+// the data is refused exactly when its chunk is read and never answers, verify() (loci check)
+// finds every one, and answers from an intact file equal the in-memory tree's.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "loci/io/sidecar.hpp"
+
+namespace loci::io {
+namespace {
+
+struct Fixture {
+  std::vector<Box2> boxes;
+  std::vector<ItemRecord> records;
+  std::string path;
+  std::string bytes;
+  std::size_t data_offset = 0;  // where the blocks start in the file
+};
+
+Fixture make(std::size_t n, std::uint64_t seed) {
+  Fixture f;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> pos(0, 1000), size(0, 3);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point2 a{pos(rng), pos(rng)};
+    f.boxes.push_back({a, {a[0] + size(rng), a[1] + size(rng)}});
+    f.records.push_back({std::int64_t(i * 7 + 1), 0, 0});
+  }
+  const PackedRTree2 tree = PackedRTree2::build(f.boxes);
+  SidecarInfo info;
+  info.layer_name = "boxes";
+  info.items = n;
+  info.bounds = tree.bounds();
+  f.path = "/tmp/loci-chunks-" + std::to_string(::getpid()) + ".loci";
+  write_sidecar(f.path, tree, f.records, info);
+  std::ifstream in(f.path, std::ios::binary);
+  f.bytes.assign(std::istreambuf_iterator<char>(in), {});
+  // The blocks are stored as the tree holds them: find them in the file.
+  const auto blocks = tree.blocks();
+  const std::string head(reinterpret_cast<const char*>(blocks.data()), 256);
+  f.data_offset = f.bytes.find(head);
+  EXPECT_NE(f.data_offset, std::string::npos);
+  return f;
+}
+
+void put(const Fixture& f, const std::string& bytes) {
+  std::ofstream(f.path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+std::vector<std::int64_t> window_fids(const Sidecar& s, const Box2& w) {
+  std::vector<std::int64_t> out;
+  const auto records = s.mapped_records();
+  s.tree().query(w, [&](Id id, const Box2&) {
+    EXPECT_LT(id, records.size());
+    s.check().touch(&records[id], sizeof(ItemRecord));
+    out.push_back(records[id].fid);
+    return true;
+  });
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::int64_t> brute_fids(const Fixture& f, const Box2& w) {
+  std::vector<std::int64_t> out;
+  for (std::size_t i = 0; i < f.boxes.size(); ++i)
+    if (intersects(f.boxes[i], w)) out.push_back(f.records[i].fid);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(SidecarChunks, OpeningReadsNoDataAndASmallQueryAFewChunks) {
+  const Fixture f = make(60000, 1);
+  const Sidecar s = Sidecar::open(f.path);
+  const std::size_t chunks = s.check().chunks();
+  EXPECT_GT(chunks, 40u);
+  EXPECT_EQ(s.check().verified(), 0u);
+  const Box2 w{{500, 500}, {503, 503}};
+  EXPECT_EQ(window_fids(s, w), brute_fids(f, w));
+  EXPECT_GT(s.check().verified(), 0u);
+  EXPECT_LE(s.check().verified(), 12u) << "of " << chunks;
+  s.verify();
+  EXPECT_EQ(s.check().verified(), chunks);
+  ::unlink(f.path.c_str());
+}
+
+TEST(SidecarChunks, AFlippedByteIsRefusedWhenItsChunkIsRead) {
+  const Fixture f = make(20000, 2);
+  std::mt19937_64 rng(3);
+  std::size_t refused_small = 0, refused_whole = 0;
+  for (int i = 0; i < 40; ++i) {
+    std::string bad = f.bytes;
+    const std::size_t at = f.data_offset + rng() % (bad.size() - f.data_offset);
+    bad[at] = char(bad[at] ^ (1 << (rng() % 8)));
+    put(f, bad);
+    const Sidecar s = Sidecar::open(f.path);  // the data is not read: opening succeeds
+    // The chunk holding the byte is refused as soon as it is touched; the others are not.
+    const auto* base = reinterpret_cast<const std::byte*>(s.tree().blocks().data());
+    const std::byte* flipped = base + (at - f.data_offset);
+    EXPECT_THROW(s.check().touch(flipped, 1), Error) << "byte " << at;
+    const std::size_t other = (at - f.data_offset + 70000) % (f.bytes.size() - f.data_offset);
+    if ((other >> 16) != ((at - f.data_offset) >> 16))
+      EXPECT_NO_THROW(s.check().touch(base + other, 1));
+    EXPECT_THROW(s.verify(), Error);
+    // A fresh mapping: queries answer exactly or are refused, never otherwise.
+    const Sidecar t = Sidecar::open(f.path);
+    const Box2 w{{double(rng() % 990), double(rng() % 990)}, {0, 0}};
+    const Box2 window{w.min, {w.min[0] + 10, w.min[1] + 10}};
+    try {
+      EXPECT_EQ(window_fids(t, window), brute_fids(f, window)) << "byte " << at;
+    } catch (const Error& e) {
+      ++refused_small;
+      EXPECT_NE(std::string(e.what()).find(f.path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("corrupt"), std::string::npos) << e.what();
+    }
+    std::size_t whole_refused = 0;
+    try {
+      EXPECT_EQ(window_fids(t, t.tree().bounds()), brute_fids(f, t.tree().bounds()));
+    } catch (const Error&) {
+      ++whole_refused;
+    }
+    refused_whole += whole_refused;
+  }
+  // Small windows read few chunks: most flips are elsewhere and do not stop them.
+  EXPECT_LT(refused_small, 40u);
+  // A whole-layer window reads every leaf, item index and record: nearly all flips stop it.
+  EXPECT_GT(refused_whole, 30u);
+}
+
+TEST(SidecarChunks, CorruptFrontIsRefusedAtOpen) {
+  const Fixture f = make(3000, 4);
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 20; ++i) {
+    std::string bad = f.bytes;
+    const std::size_t at = rng() % f.data_offset;  // header, name, checksum table
+    bad[at] = char(bad[at] ^ (1 << (rng() % 8)));
+    put(f, bad);
+    EXPECT_THROW(Sidecar::open(f.path), Error) << "byte " << at;
+  }
+  put(f, f.bytes);
+  EXPECT_NO_THROW(Sidecar::open(f.path).verify());
+  ::unlink(f.path.c_str());
+}
+
+}  // namespace
+}  // namespace loci::io
