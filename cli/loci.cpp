@@ -140,12 +140,12 @@ int run_index(const Args& a) {
   if (a.has("--structure"))
     o.structure = parse_flag("--structure", a.get("--structure"), parse_structure);
   const LoadOptions lo = load_options(a, o.layer_path);
-  o.per = lo.per.value_or(Per::feature);
+  o.per = lo.per;
   o.progress = progress_bar(a, "indexing");
   const IndexReport r = index_layer(o);
   if (!a.has("--quiet"))
     std::fprintf(stderr, "loci: indexed %zu %s of layer '%s' into %s (%llu bytes, %.2f s)\n",
-                 r.items, o.per == Per::segment ? "segments" : "features", r.layer_name.c_str(),
+                 r.items, r.per == Per::segment ? "segments" : "features", r.layer_name.c_str(),
                  r.path.c_str(), static_cast<unsigned long long>(r.bytes), r.seconds);
   return 0;
 }
@@ -466,7 +466,9 @@ const Flag kStructure{
     "--structure", nullptr, "S",
     "packed-hilbert (default), packed-str, rstar or rtree (the last two in memory)"};
 const Flag kPer{"--per", nullptr, "feature|segment",
-                "index one box per feature (default) or one per segment of the linework"};
+                "one box per feature or one per segment of the linework (loci index: per "
+                "segment when features average 64 segments or more; queries without a "
+                "sidecar: per feature)"};
 const Flag kIndex{"--index", nullptr, "FILE", "sidecar to use (default: LAYER.loci when present)"};
 
 const std::vector<Command>& commands() {

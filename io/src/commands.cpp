@@ -83,6 +83,18 @@ std::string stale_reason(const Fingerprint& was, const Fingerprint& now) {
   return "modified after the index was written";
 }
 
+// Why an index has its granularity, for loci info: " (chosen ...)" or nothing.
+std::string granularity_reason(const SidecarInfo& i) {
+  if (!i.per_chosen || i.features == 0) return "";
+  const std::string limit = std::to_string(kSegmentsPerFeatureForSegments);
+  if (i.per == Per::feature)  // the segments were not kept: only that they were few
+    return " (chosen by loci index: fewer than " + limit + " segments per feature on average)";
+  char mean[32];
+  std::snprintf(mean, sizeof mean, "%.0f", double(i.items) / double(i.features));
+  return std::string(" (chosen by loci index: ") + mean + " segments per feature on average, " +
+         limit + " or more)";
+}
+
 }  // namespace
 
 Box2 parse_bbox(const std::string& text) {
@@ -180,8 +192,8 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
     const bool fresh = still_fresh(layer_path, i.source, &now);
     o << sidecar << ": " << (fresh ? "fresh" : "stale (" + stale_reason(i.source, now) + ")")
       << ", " << (i.packing == Packing::str ? "packed-str" : "packed-hilbert") << " per "
-      << to_string(i.per) << ", layer " << i.layer_name << ", " << i.items << " entries, "
-      << i.file_size << " bytes\n";
+      << to_string(i.per) << granularity_reason(i) << ", layer " << i.layer_name << ", " << i.items
+      << " entries, " << i.file_size << " bytes\n";
   } catch (const Error& e) {
     o << "unusable: " << e.what() << '\n';
   }
@@ -200,12 +212,16 @@ IndexReport index_layer(const IndexOptions& options) {
   const Fingerprint source = fingerprint_of(options.layer_path);
   Progress reading;
   if (options.progress) reading = [&](double f) { options.progress(0.9 * f); };
-  LayerItems items = read_items(options.layer_path, options.layer_name, options.per, reading);
+  LayerItems items = options.per
+                         ? read_items(options.layer_path, options.layer_name, *options.per, reading)
+                         : read_items_choosing(options.layer_path, options.layer_name, reading);
   const Packing packing =
       options.structure == Structure::packed_str ? Packing::str : Packing::hilbert;
   const PackedRTree2 tree = PackedRTree2::build(items.boxes, packing);
   SidecarInfo info;
-  info.per = options.per;
+  info.per = items.per;
+  info.per_chosen = !options.per;
+  info.features = items.features;
   info.packing = packing;
   info.layer_name = items.layer_name;
   info.has_polygons = items.has_polygons;
@@ -213,6 +229,7 @@ IndexReport index_layer(const IndexOptions& options) {
   write_sidecar(r.path, tree, items.records, info);
   if (options.progress) options.progress(1.0);
   r.layer_name = items.layer_name;
+  r.per = items.per;
   r.items = items.records.size();
   r.bytes = Sidecar::open(r.path).info().file_size;
   r.seconds = seconds_since(t0);

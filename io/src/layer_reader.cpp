@@ -102,14 +102,15 @@ void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& pat
 
 }  // namespace
 
-LayerItems read_items(const std::string& path, const std::string& layer, Per per,
-                      const Progress& progress, bool keep_geometries) {
+namespace {
+
+// One pass over the layer filling `by_feature` and/or `by_segment`.
+void read_layer_items(const std::string& path, const std::string& layer, const Progress& progress,
+                      bool keep_geometries, LayerItems* by_feature, LayerItems* by_segment) {
   auto ol = open_layer(path, layer);
-  const bool keep =
-      keep_geometries && per == Per::feature && !detail::fast_random_read(*ol.dataset);
-  LayerItems out;
-  out.per = per;
-  out.layer_name = ol.layer->GetName();
+  const bool keep = keep_geometries && by_feature && !detail::fast_random_read(*ol.dataset);
+  for (LayerItems* out : {by_feature, by_segment})
+    if (out) out->layer_name = ol.layer->GetName();
   ProgressTicker ticker(progress, double(ol.layer->GetFeatureCount(FALSE)));
   std::size_t seen = 0;
   const detail::ReadCheck read_check(path);
@@ -118,26 +119,51 @@ LayerItems read_items(const std::string& path, const std::string& layer, Per per
     const OGRGeometry* g = feature->GetGeometryRef();
     const std::int64_t fid = feature->GetFID();
     if (!g || g->IsEmpty()) {
-      if (keep) out.geometries.emplace(fid, FlatGeometry{});
+      if (keep) by_feature->geometries.emplace(fid, FlatGeometry{});
       continue;
     }
-    if (is_polygonal(g)) out.has_polygons = true;
-    if (per == Per::feature) {
+    for (LayerItems* out : {by_feature, by_segment})
+      if (out) {
+        if (is_polygonal(g)) out->has_polygons = true;
+        ++out->features;
+      }
+    if (by_feature) {
       // The envelope skips NaN coordinates; the feature must be refused, not half indexed.
       FlatGeometry flat = detail::flatten(g, where(path, fid));
-      if (keep) out.geometries.emplace(fid, std::move(flat));
+      if (keep) by_feature->geometries.emplace(fid, std::move(flat));
       OGREnvelope e;
       g->getEnvelope(&e);
       const Box2 box{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}};
       check_box(box, where(path, fid).c_str());
-      out.boxes.push_back(box);
-      out.records.push_back({fid, 0, 0u});
-    } else {
-      add_segments(g, fid, path, out);
+      by_feature->boxes.push_back(box);
+      by_feature->records.push_back({fid, 0, 0u});
     }
+    if (by_segment) add_segments(g, fid, path, *by_segment);
   }
   read_check.finish();
+}
+
+}  // namespace
+
+LayerItems read_items(const std::string& path, const std::string& layer, Per per,
+                      const Progress& progress, bool keep_geometries) {
+  LayerItems out;
+  out.per = per;
+  read_layer_items(path, layer, progress, keep_geometries, per == Per::feature ? &out : nullptr,
+                   per == Per::segment ? &out : nullptr);
   return out;
+}
+
+LayerItems read_items_choosing(const std::string& path, const std::string& layer,
+                               const Progress& progress) {
+  LayerItems by_feature, by_segment;
+  by_feature.per = Per::feature;
+  by_segment.per = Per::segment;
+  read_layer_items(path, layer, progress, false, &by_feature, &by_segment);
+  if (by_segment.records.size() >= kSegmentsPerFeatureForSegments * by_feature.features &&
+      by_feature.features > 0)
+    return by_segment;
+  return by_feature;
 }
 
 std::string default_layer_name(const std::string& path) {

@@ -28,6 +28,7 @@ constexpr std::uint32_t kByteOrder = 0x01020304;
 constexpr std::uint8_t kStructurePackedRTree = 1;
 constexpr std::uint8_t kCoordFloat64 = 1;
 constexpr std::uint32_t kFlagPolygons = 1;
+constexpr std::uint32_t kFlagPerChosen = 2;  // the granularity was chosen by loci index
 constexpr std::size_t kAlign = 64;
 constexpr unsigned kChunkShift = 16;  // 64 KiB checked at a time
 
@@ -63,7 +64,8 @@ struct SidecarHeader {
   std::uint32_t chunk_shift;  // a chunk is 2^chunk_shift bytes (the last may be shorter)
   std::uint32_t reserved1;
   std::uint64_t front_checksum;  // XXH3-64 of bytes [sizeof(SidecarHeader), data_offset)
-  std::uint8_t reserved[40];
+  std::uint64_t feature_count;   // features with a geometry (0: not recorded)
+  std::uint8_t reserved[32];
   std::uint64_t header_checksum;  // XXH3-64 of the bytes before this field
 };
 static_assert(sizeof(SidecarHeader) == 256);
@@ -264,7 +266,8 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   h.per = std::uint8_t(info.per);
   h.dimension = 2;
   h.node_size = PackedRTree2::node_size;
-  h.flags = info.has_polygons ? kFlagPolygons : 0;
+  h.flags = (info.has_polygons ? kFlagPolygons : 0) | (info.per_chosen ? kFlagPerChosen : 0);
+  h.feature_count = info.features;
   h.item_count = tree.size();
   h.block_count = blocks.size();
   h.slot_count = items.size();
@@ -375,6 +378,8 @@ Sidecar Sidecar::open(const std::string& path) {
   s.info_.packing = Packing(h.packing);
   s.info_.layer_name.assign(reinterpret_cast<const char*>(m->data + h.name_offset), h.name_size);
   s.info_.has_polygons = (h.flags & kFlagPolygons) != 0;
+  s.info_.per_chosen = (h.flags & kFlagPerChosen) != 0;
+  s.info_.features = h.feature_count;
   s.info_.items = h.item_count;
   s.info_.bounds = {{h.bounds[0], h.bounds[1]}, {h.bounds[2], h.bounds[3]}};
   s.info_.source = {h.source_size, h.source_mtime_ns, h.source_inode, h.source_hash};

@@ -840,6 +840,36 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
   fs::remove(sidecar);
 }
 
+// Without --per, loci index picks per segment for big features (the bundled sample: a few
+// multipolygons of thousands of segments) and per feature for small ones, and loci info says
+// which and why; an explicit --per is kept and not explained.
+TEST_F(LayersCli, IndexChoosesTheGranularity) {
+  const std::string sample = path("sample.geojson");
+  fs::copy_file(std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson", sample,
+                fs::copy_options::overwrite_existing);
+  CliRun r = run_loci("index " + sample);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find(" segments of layer"), std::string::npos) << r.err;
+  std::string info = run_loci("info " + sample).out;
+  EXPECT_NE(info.find("per segment (chosen by loci index: "), std::string::npos) << info;
+  for (const char* ext : {".shp", ".shx", ".dbf"})  // a copy: other tests use polys.shp
+    fs::copy_file(path(std::string("polys") + ext), path(std::string("chosen") + ext),
+                  fs::copy_options::overwrite_existing);
+  const std::string chosen = path("chosen.shp");
+  ASSERT_EQ(run_loci("index -q " + chosen).status, 0);
+  r = run_loci("query " + chosen + " --bbox 0,0,100,100");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out,
+            run_loci("query " + path("polys.shp") + " --structure rstar --bbox 0,0,100,100").out);
+  info = run_loci("info " + chosen).out;
+  EXPECT_NE(info.find("per feature (chosen by loci index: fewer than"), std::string::npos) << info;
+  ASSERT_EQ(run_loci("index -q --per feature " + sample).status, 0);
+  info = run_loci("info " + sample).out;
+  EXPECT_NE(info.find("per feature, layer"), std::string::npos) << info;
+  fs::remove(chosen + ".loci");
+  fs::remove(sample + ".loci");
+}
+
 TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {
   // A copy, so that other tests keep their layer.
   for (const char* ext : {".shp", ".shx", ".dbf"})

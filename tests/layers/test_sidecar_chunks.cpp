@@ -103,7 +103,10 @@ TEST(SidecarChunks, AFlippedByteIsRefusedWhenItsChunkIsRead) {
     put(f, bad);
     const Sidecar s = Sidecar::open(f.path);  // the data is not read: opening succeeds
     // The chunk holding the byte is refused as soon as it is touched; the others are not.
-    const auto* base = reinterpret_cast<const std::byte*>(s.tree().blocks().data());
+    // The records end the file: from them back to the start of the data.
+    const std::size_t records_offset = f.bytes.size() - f.records.size() * sizeof(ItemRecord);
+    const auto* base = reinterpret_cast<const std::byte*>(s.mapped_records().data()) -
+                       (records_offset - f.data_offset);
     const std::byte* flipped = base + (at - f.data_offset);
     EXPECT_THROW(s.check().touch(flipped, 1), Error) << "byte " << at;
     const std::size_t other = (at - f.data_offset + 70000) % (f.bytes.size() - f.data_offset);

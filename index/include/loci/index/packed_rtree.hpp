@@ -154,9 +154,16 @@ class PackedRTree {
   }
   const Level& level(int l) const { return levels_[std::size_t(l)]; }
 
-  std::span<const Block> blocks() const { return {blocks_, total_blocks()}; }
+  // The whole arrays (for an adopted tree with a check, verified first).
+  std::span<const Block> blocks() const {
+    const std::span<const Block> all{blocks_, total_blocks()};
+    if (check_) check_->touch(all.data(), all.size_bytes());
+    return all;
+  }
   std::span<const std::uint32_t> item_indices() const {
-    return {items_, empty() ? 0 : level_blocks(0) * NodeSize};
+    const std::span<const std::uint32_t> all{items_, empty() ? 0 : level_blocks(0) * NodeSize};
+    if (check_) check_->touch(all.data(), all.size_bytes());
+    return all;
   }
   std::size_t memory_bytes() const {
     return total_blocks() * sizeof(Block) + item_indices().size() * sizeof(std::uint32_t);

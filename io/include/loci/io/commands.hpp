@@ -50,13 +50,16 @@ struct IndexOptions {
   std::string layer_name;
   std::string out_path;  // empty: default_sidecar_path(layer_path)
   Structure structure = Structure::packed_hilbert;
-  Per per = Per::feature;
+  // Unset: per segment when the features average at least kSegmentsPerFeatureForSegments
+  // segments (big polygons and long lines), else per feature.
+  std::optional<Per> per;
   Progress progress;
 };
 
 struct IndexReport {
   std::string path;
   std::string layer_name;
+  Per per = Per::feature;
   std::size_t items = 0;
   std::uint64_t bytes = 0;
   double seconds = 0;

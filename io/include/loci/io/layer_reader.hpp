@@ -50,11 +50,21 @@ struct LayerItems {
   // With keep_geometries, per feature, for a text layer (one GDAL cannot read by FID in
   // place): every feature's flattened geometry, so that queries need not read it again.
   std::unordered_map<std::int64_t, FlatGeometry> geometries;
+  std::uint64_t features = 0;  // features with a geometry
 };
 
 // Throws like read_segments; features with an empty or missing geometry are skipped.
 LayerItems read_items(const std::string& path, const std::string& layer, Per per,
                       const Progress& progress = {}, bool keep_geometries = false);
+
+// A layer's features average at least this many segments: per segment serves it better (a
+// query then never tests, nor fetches from GDAL, a huge geometry whole).
+inline constexpr std::uint64_t kSegmentsPerFeatureForSegments = 64;
+
+// read_items() choosing the granularity in the same pass: per segment when the features
+// average at least kSegmentsPerFeatureForSegments segments, else per feature.
+LayerItems read_items_choosing(const std::string& path, const std::string& layer,
+                               const Progress& progress = {});
 
 struct LayerSummary {
   std::string path;

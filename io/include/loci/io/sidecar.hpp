@@ -104,6 +104,8 @@ struct SidecarInfo {
   Packing packing = Packing::hilbert;
   std::string layer_name;
   bool has_polygons = false;
+  bool per_chosen = false;     // `per` was chosen by loci index from the layer's shape
+  std::uint64_t features = 0;  // features with a geometry (0: not recorded)
   std::uint64_t items = 0;
   Box2 bounds = Box2::empty();
   Fingerprint source;
