@@ -68,6 +68,17 @@ bool is_polygonal(const OGRGeometry* g) {
          t == wkbGeometryCollection;
 }
 
+// Refuses a line or polygon feature with a coordinate out of range (NaN, infinite), without
+// copying its points.
+void check_curves(const OGRGeometry* g, const std::string& path, std::int64_t fid) {
+  detail::for_each_curve(g, [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
+    for (int i = 0, n = c.getNumPoints(); i < n; ++i) {
+      const Point2 a{c.getX(i), c.getY(i)};
+      if (!within_coordinate_range(a)) detail::check_layer_point(a, where(path, fid));
+    }
+  });
+}
+
 void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& path,
                   LayerItems& out) {
   std::int32_t part = 0;
@@ -129,8 +140,13 @@ void read_layer_items(const std::string& path, const std::string& layer, const P
       }
     if (by_feature) {
       // The envelope skips NaN coordinates; the feature must be refused, not half indexed.
-      FlatGeometry flat = detail::flatten(g, where(path, fid));
-      if (keep) by_feature->geometries.emplace(fid, std::move(flat));
+      const auto type = wkbFlatten(g->getGeometryType());
+      if (keep || type == wkbPoint || type == wkbMultiPoint || type == wkbGeometryCollection) {
+        FlatGeometry flat = detail::flatten(g, where(path, fid));
+        if (keep) by_feature->geometries.emplace(fid, std::move(flat));
+      } else {
+        check_curves(g, path, fid);
+      }
       OGREnvelope e;
       g->getEnvelope(&e);
       const Box2 box{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}};

@@ -92,8 +92,8 @@ TEST_F(BadInput, NaNCoordinatesAreRefusedNamingTheFeature) {
   const std::string l = write("nan.geojson", R"({"type":"FeatureCollection","features":[
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}},
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[NaN,1],[2,2]]}}]})");
-  for (const char* per : {"feature", "segment"}) {
-    const CliRun r = run_loci("index " + shell_quote(l) + " --per " + per);
+  for (const std::string per : {" --per feature", " --per segment", ""}) {  // "": chosen
+    const CliRun r = run_loci("index " + shell_quote(l) + per);
     expect_one_line_error(r);
     EXPECT_NE(r.err.find("feature 1"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(l + ".loci"));
@@ -341,8 +341,8 @@ TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {
   const std::string l = write("huge.geojson", R"({"type":"FeatureCollection","features":[
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}},
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1e300,1],[2,2]]}}]})");
-  for (const char* per : {"feature", "segment"}) {
-    const CliRun r = run_loci("index " + shell_quote(l) + " --per " + per);
+  for (const std::string per : {" --per feature", " --per segment", ""}) {  // "": chosen
+    const CliRun r = run_loci("index " + shell_quote(l) + per);
     expect_one_line_error(r);
     EXPECT_NE(r.err.find("feature 1"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("1e150"), std::string::npos) << r.err;
