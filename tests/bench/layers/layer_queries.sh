@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# The `loci query` path on a big sidecar against a small one, and nearest-n in batch:
+#   1. opening: one window query on the fetched coastline's per-segment sidecar (4.8 M
+#      segments, about 260 MB) against the same query on the bundled sample's (19 k segments,
+#      1 MB): median wall time of 7 runs, resident memory, and instructions (valgrind) when
+#      valgrind is installed. Opening must not grow with the file.
+#   2. a --nearest-file batch of N nearest-10 queries (default 10000, fixed seed) on one core
+#      (-j 1) on the coastline sidecar: queries per second, start-up and opening included.
+# Usage: layer_queries.sh [LOCI_EXE] [N]; LOCI_BENCH_DIR is the working directory. Needs
+# datasets/fetch.sh to have filled the cache.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../../.." && pwd)
+loci=${1:-$root/build/cli/loci}
+n=${2:-10000}
+work=${LOCI_BENCH_DIR:-$root/build/bench-layers}
+mkdir -p "$work"
+export OGR_GEOJSON_MAX_OBJ_SIZE=0
+src="$root/datasets/cache/countries-coastline-1m/map.geo.json"
+[ -s "$src" ] || { echo "skip: run datasets/fetch.sh"; exit 0; }
+ln -sf "$src" "$work/coast.geojson"
+cp "$root/datasets/samples/coastline-denmark.geojson" "$work/sample.geojson"
+[ "$work/coast.geojson.loci" -nt "$src" ] || "$loci" index -q --per segment "$work/coast.geojson"
+"$loci" index -q --per segment "$work/sample.geojson"
+
+median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
+one_query() {  # LAYER WINDOW: median seconds and resident KB of 7 runs
+  local t=() m=()
+  for _ in 1 2 3 4 5 6 7; do
+    /usr/bin/time -f "%e %M" -o "$work/time.txt" "$loci" query "$1" --bbox "$2" -f ids > /dev/null
+    read -r s k < "$work/time.txt"; t+=("$s"); m+=("$k")
+  done
+  echo "$(printf '%s\n' "${t[@]}" | median) $(printf '%s\n' "${m[@]}" | median)"
+}
+instructions() {
+  command -v valgrind > /dev/null || { echo "n/a"; return; }
+  valgrind --tool=callgrind --callgrind-out-file=/dev/null "$loci" query "$1" --bbox "$2" -f ids \
+    2>&1 >/dev/null | sed -n 's/.*Collected : \([0-9]*\).*/\1/p'
+}
+window=10.2,55.3,10.3,55.4  # in both layers' extents (Funen)
+read -r big_s big_kb <<< "$(one_query "$work/coast.geojson" "$window")"
+read -r small_s small_kb <<< "$(one_query "$work/sample.geojson" "$window")"
+big_i=$(instructions "$work/coast.geojson" "$window")
+small_i=$(instructions "$work/sample.geojson" "$window")
+echo "one window: coastline sidecar $(stat -c %s "$work/coast.geojson.loci") B: ${big_s}s ${big_kb}KB" \
+  "${big_i} instructions; sample sidecar $(stat -c %s "$work/sample.geojson.loci") B: ${small_s}s" \
+  "${small_kb}KB ${small_i} instructions; ratio $(awk -v a="$big_s" -v b="$small_s" 'BEGIN { printf "%.2f", a / b }')x time," \
+  "$(awk -v a="$big_i" -v b="$small_i" 'BEGIN { if (b > 0) printf "%.3f", a / b; else print "n/a" }')x instructions"
+
+awk -v n="$n" 'BEGIN { srand(7); for (i = 0; i < n; i++)
+  printf "%.6f,%.6f\n", -180 + 360 * rand(), -80 + 160 * rand() }' > "$work/nearest.txt"
+t0=$(date +%s.%N)
+"$loci" query "$work/coast.geojson" --nearest-file "$work/nearest.txt" -k 10 -f ids -j 1 > "$work/nearest.out"
+t1=$(date +%s.%N)
+echo "$n nearest-10 on one core: $(awk -v a="$t0" -v b="$t1" -v n="$n" 'BEGIN { printf "%.2f s, %.0f queries/s", b - a, n / (b - a) }')" \
+  "($(wc -l < "$work/nearest.out") rows)"
