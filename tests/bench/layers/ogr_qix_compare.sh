@@ -42,7 +42,7 @@ compare() {
   index_ogr=$(elapsed "$t0" "$t1"); index_loci=$(elapsed "$t1" "$t2")
   t0=$(now); "$loci" index -q --per feature "$file" -o "$work/$name.$format.feature.loci"; t1=$(now)
   index_feature=$(elapsed "$t0" "$t1")
-  per=$("$loci" info "$file" | sed -n 's/.* per \(feature\|segment\).*/\1/p')
+  per=$("$loci" info "$file" | sed -n 's/.*packed-[a-z]* per \(feature\|segment\).*/\1/p')
 
   t0=$(now); "$loci" query -q "$file" --bbox-file "$work/windows.txt" > "$work/$name.$format.loci.txt"; t1=$(now)
   : > "$work/$name.$format.ogr.txt"
