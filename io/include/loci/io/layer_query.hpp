@@ -41,6 +41,7 @@
 #include <variant>
 #include <vector>
 
+#include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/packed_rtree.hpp"
 #include "loci/index/rstar_tree.hpp"
 #include "loci/index/rtree.hpp"
@@ -153,10 +154,10 @@ class LayerIndex {
   // that starts there. Built on first use, once for all threads.
   struct Features {
     static constexpr std::uint32_t none = 0xffffffffu;
-    std::vector<std::uint32_t> of_item;
+    loci::detail::LargeVector<std::uint32_t> of_item;
     std::vector<std::int64_t> fid;
-    std::vector<std::uint32_t> at;   // packed trees: per position
-    std::vector<std::uint32_t> end;  // packed trees: per position
+    loci::detail::LargeVector<std::uint32_t> at;   // packed trees: per position
+    loci::detail::LargeVector<std::uint32_t> end;  // packed trees: per position
   };
   const Features& features() const;
 
