@@ -302,7 +302,7 @@ const LayerIndex::Features& LayerIndex::features() const {
     Features& f = features_->value;
     const auto records = this->records();
     f.of_item.resize(records.size());
-    std::unordered_map<std::int64_t, std::uint32_t> number;
+    auto& number = f.number;
     std::int64_t last_fid = 0;
     std::uint32_t last = Features::none;
     for (std::size_t id = 0; id < records.size(); ++id) {
@@ -396,14 +396,8 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     };
     const ItemRecord* records = index_.records().data();
     if (per_segment && !candidates_only) {
-      std::unordered_map<std::int64_t, std::uint32_t> number_of;
-      for (const auto fid : containing_polygons(index_, p)) {
-        // Rare (the point is inside polygons): find the features' numbers by a scan.
-        if (number_of.empty())
-          for (std::uint32_t f = 0; f < features.fid.size(); ++f)
-            number_of.emplace(features.fid[f], f);
-        offer(number_of.at(fid), 0.0);
-      }
+      for (const auto fid : containing_polygons(index_, p))
+        offer(features.number.at(fid), 0.0);
     }
     auto visit = [&](const ItemRecord& r, const Box2& b, double box_distance) {
       settle(box_distance);

@@ -156,8 +156,9 @@ class LayerIndex {
     static constexpr std::uint32_t none = 0xffffffffu;
     loci::detail::LargeVector<std::uint32_t> of_item;
     std::vector<std::int64_t> fid;
-    loci::detail::LargeVector<std::uint32_t> at;   // packed trees: per position
-    loci::detail::LargeVector<std::uint32_t> end;  // packed trees: per position
+    std::unordered_map<std::int64_t, std::uint32_t> number;  // fid -> feature
+    loci::detail::LargeVector<std::uint32_t> at;             // packed trees: per position
+    loci::detail::LargeVector<std::uint32_t> end;            // packed trees: per position
   };
   const Features& features() const;
 
