@@ -159,8 +159,26 @@ class RTreeIndex {
   std::size_t base_size() const { return base_.size(); }
   std::size_t delta_size() const { return delta_.size(); }
   std::size_t dead_size() const { return dead_.size(); }
-  RowId max_id() const { return max_id_; }
   bool any_row() const { return size() != 0; }
+
+  // The largest live id, or nothing when the table is empty: SQLite gives a NULL id one more,
+  // as in a rowid table (an erased top id is not remembered).
+  std::optional<RowId> max_id() {
+    if (!any_row()) return std::nullopt;
+    if (!max_known_) {
+      std::optional<RowId> top;
+      for (std::size_t j = by_id_.size(); j-- > 0;)
+        if (const RowId id = id_at(j); !dead_.count(id)) {
+          top = id;
+          break;
+        }
+      for (const auto& [id, b] : delta_)
+        if (!top || id > *top) top = id;
+      max_id_ = *top;
+      max_known_ = true;
+    }
+    return max_id_;
+  }
 
   // The row's box, if the row exists.
   std::optional<Box2> find(RowId id) const {
@@ -172,6 +190,7 @@ class RTreeIndex {
 
   // Inserts the row or replaces its box. The box is valid (finite, min <= max).
   void put(RowId id, const Box2& b) {
+    if (max_known_) max_id_ = any_row() ? std::max(max_id_, id) : id;
     if (auto it = delta_.find(id); it != delta_.end()) {
       if (tree_current()) delta_tree_.update(it->second, b, Id(id));
       it->second = b;
@@ -180,12 +199,12 @@ class RTreeIndex {
       delta_.emplace(id, b);
       if (tree_current()) delta_tree_.insert(b, Id(id));
     }
-    max_id_ = std::max(max_id_, id);
     touched_.push_back(id);
   }
 
   // Removes the row; false when there is none.
   bool erase(RowId id) {
+    if (id == max_id_) max_known_ = false;
     if (auto it = delta_.find(id); it != delta_.end()) {
       if (tree_current()) delta_tree_.erase(it->second, Id(id));
       delta_.erase(it);
@@ -374,7 +393,7 @@ class RTreeIndex {
       if (j > 0 && !(x.id_at(j - 1) < x.id_at(j)))
         throw Error("the %_node ids are not unique and sorted");
     }
-    x.max_id_ = n ? x.id_at(n - 1) : 0;
+    x.max_known_ = false;
     for (RowId id : dead) {
       if (x.base_position(id) == kAbsent)
         throw Error("%_dead names id " + std::to_string(id) + ", which the %_node tree lacks");
@@ -387,7 +406,6 @@ class RTreeIndex {
       if (x.base_position(r.id) != kAbsent && !x.dead_.count(r.id))
         throw Error("id " + std::to_string(r.id) + " is both in %_delta and live in %_node");
       x.delta_.emplace(r.id, r.box);
-      x.max_id_ = std::max(x.max_id_, r.id);
     }
     x.tree_stale_ = !x.delta_.empty();
     return x;
@@ -450,7 +468,7 @@ class RTreeIndex {
     std::sort(by_id_.begin(), by_id_.end(), [&](std::uint32_t a, std::uint32_t b) {
       return ids_[items()[a]] < ids_[items()[b]];
     });
-    max_id_ = n ? id_at(n - 1) : 0;
+    max_known_ = false;
   }
   static double distance(const Point2& p, const Box2& b) {
     const double dx = std::max({b.min[0] - p[0], 0.0, p[0] - b.max[0]});
@@ -490,7 +508,8 @@ class RTreeIndex {
   RStarTree<2> delta_tree_;
   bool tree_stale_ = false;
   std::size_t unqueried_ = 0;
-  RowId max_id_ = 0;
+  RowId max_id_ = 0;  // the largest live id when max_known_
+  bool max_known_ = true;
   std::vector<RowId> touched_;
 };
 

@@ -380,9 +380,10 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
         throw SqlError{SQLITE_MISMATCH,
                        format_sql("loci_rtree %s: the id must be an integer", t.name.c_str())};
     } else {
-      if (index.max_id() == std::numeric_limits<RowId>::max())
+      const std::optional<RowId> top = index.max_id();
+      if (top == std::numeric_limits<RowId>::max())
         throw SqlError{SQLITE_FULL, format_sql("loci_rtree %s: no id left", t.name.c_str())};
-      id = index.any_row() ? index.max_id() + 1 : 1;
+      id = top ? *top + 1 : 1;
     }
     Box2 b;
     b.min[0] = coordinate(argv[3], "minx", t);

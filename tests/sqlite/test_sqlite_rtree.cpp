@@ -251,6 +251,49 @@ TEST(SqliteRtreeSql, AuxColumnsTravelWithTheirRows) {
   EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
 }
 
+// A NULL id takes one more than the largest live id, as in a rowid table: the top id erased is
+// not remembered, negative ids count, an empty table starts at 1. Checked in the packed base
+// (after a commit reloads it), in the unpacked rows, and after a rollback.
+TEST(SqliteRtreeSql, NewIdsFollowTheRowidTableRule) {
+  Db db;
+  db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy)");
+  db.exec("CREATE TABLE m(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, miny REAL, maxy REAL)");
+  const auto both = [&](const std::string& sql) {
+    for (const char* table : {"t", "m"}) {
+      std::string s = sql;
+      for (std::size_t p; (p = s.find("$T")) != std::string::npos;)
+        s.replace(p, 2, table);
+      db.exec(s);
+    }
+  };
+  const auto check = [&](const char* when) {
+    EXPECT_EQ(all(db, "t"), all(db, "m")) << when;
+    EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok") << when;
+  };
+  both("INSERT INTO $T VALUES (NULL, 0, 1, 0, 1)");
+  both("INSERT INTO $T VALUES (-7, 0, 1, 0, 1), (12, 2, 3, 2, 3), (5, 4, 5, 4, 5)");
+  both("DELETE FROM $T WHERE id = 12");
+  both("INSERT INTO $T VALUES (NULL, 6, 7, 6, 7)");
+  check("after the top id was erased");
+  both("DELETE FROM $T WHERE id > 0");
+  both("INSERT INTO $T VALUES (NULL, 8, 9, 8, 9)");
+  check("with only a negative id left");
+  db.exec("BEGIN");
+  both("INSERT INTO $T SELECT id + 100, minx, maxx, miny, maxy FROM $T");
+  db.exec("COMMIT");
+  both("DELETE FROM $T WHERE id > 100");
+  both("INSERT INTO $T VALUES (NULL, 1, 2, 1, 2)");
+  check("after a commit and deleting the top of the packed rows");
+  db.exec("BEGIN");
+  both("INSERT INTO $T VALUES (1000, 0, 1, 0, 1)");
+  db.exec("ROLLBACK");
+  both("INSERT INTO $T VALUES (NULL, 3, 4, 3, 4)");
+  check("after a rolled-back insert of a high id");
+  both("DELETE FROM $T");
+  both("INSERT INTO $T VALUES (NULL, 5, 6, 5, 6)");
+  check("emptied");
+}
+
 // Random INSERT, UPDATE, DELETE, bulk inserts and deletes, applied to t and m alike, under
 // BEGIN / COMMIT / ROLLBACK, SAVEPOINT / RELEASE / ROLLBACK TO; after every step t answers
 // like m and loci_check passes.
