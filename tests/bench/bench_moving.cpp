@@ -61,6 +61,7 @@ struct Options {
   std::size_t vessels = 100000;
   std::size_t all_pairs_rows = 2000;
   bool peer = true;
+  std::string only;  // "objects" or "conflicts": that part alone
 };
 
 // ---- libspatialindex ---------------------------------------------------------------------
@@ -514,11 +515,13 @@ int main(int argc, char** argv) {
       o.all_pairs_rows = std::stoul(next());
     else if (a == "--no-peer")
       o.peer = false;
+    else if (a == "--only")
+      o.only = next();
     else {
       std::fprintf(stderr, "bench_moving: unknown argument %s\n", a.c_str());
       return 2;
     }
   }
-  run_objects(o);
-  run_conflicts(o);
+  if (o.only != "conflicts") run_objects(o);
+  if (o.only != "objects") run_conflicts(o);
 }

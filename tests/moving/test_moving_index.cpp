@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 #include <unordered_map>
 #include <vector>
@@ -223,6 +224,86 @@ TEST(TprTreeBuild, PackedTreeAnswersLikeInsertedOne) {
       check_queries(tree, objs, test::fleet_epoch(f) + 1, n + 1, test::name(f) + " after");
     }
   }
+}
+
+// Rebuilt every tick, as the rebuild-per-tick strategy does: the same ids (the id map kept),
+// then after updates and erasures, permuted, renamed, and a build refused for a duplicate id
+// leaving the last one whole. Every build answers as brute force; 3D too.
+template <int D>
+void check_rebuilds() {
+  std::mt19937_64 rng(D);
+  std::uniform_real_distribution<double> pos(0, 1000), vel(-3, 3);
+  const std::size_t n = 3000;
+  std::vector<Motion<D>> fleet(n);
+  std::vector<Id> ids(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    fleet[i].t = 0;
+    for (int a = 0; a < D; ++a)
+      fleet[i].p[a] = pos(rng), fleet[i].v[a] = vel(rng);
+    ids[i] = 3 * i + 7;
+  }
+  TprTree<D> tree;
+  const auto check = [&](double now, const char* what) {
+    tree.validate();
+    ASSERT_EQ(tree.size(), n) << what;
+    for (int q = 0; q < 30; ++q) {
+      Box<D> w;
+      for (int a = 0; a < D; ++a) {
+        w.min[a] = pos(rng) - 100;
+        w.max[a] = w.min[a] + 200;
+      }
+      const double t = now + 20 * (q % 4);
+      std::vector<Id> got, want;
+      tree.query(MovingWindow<D>::at(w, t), [&](Id id, const Motion<D>&) {
+        got.push_back(id);
+        return true;
+      });
+      for (std::size_t i = 0; i < n; ++i)
+        if (intersects(w, position(fleet[i], t))) want.push_back(ids[i]);
+      std::sort(got.begin(), got.end());
+      std::sort(want.begin(), want.end());
+      ASSERT_EQ(got, want) << what << " query " << q;
+    }
+  };
+  for (int tick = 0; tick < 6; ++tick) {
+    const double now = tick;
+    for (std::size_t u = 0; u < n / 10; ++u) {  // new reports
+      const std::size_t i = rng() % n;
+      fleet[i] = {now, position(fleet[i], now), fleet[i].v};
+      fleet[i].v[0] = vel(rng);
+    }
+    if (tick == 2) {  // updates and an erasure between builds: the map is made again
+      tree.update(ids[0], fleet[0]);
+      tree.erase(ids[1]);
+    }
+    if (tick == 3) {  // the same objects in another order
+      std::vector<std::size_t> perm(n);
+      std::iota(perm.begin(), perm.end(), std::size_t(0));
+      std::shuffle(perm.begin(), perm.end(), rng);
+      std::vector<Motion<D>> f2(n);
+      std::vector<Id> i2(n);
+      for (std::size_t i = 0; i < n; ++i)
+        f2[i] = fleet[perm[i]], i2[i] = ids[perm[i]];
+      fleet.swap(f2), ids.swap(i2);
+    }
+    if (tick == 4)
+      for (Id& id : ids)
+        id += 1;  // other names
+    tree.build(ids, fleet);
+    check(now, "rebuilt");
+    if (tick == 5) {
+      std::vector<Id> dup = ids;
+      dup[n - 1] = dup[0];
+      EXPECT_THROW(tree.build(dup, fleet), InvalidArgument);
+      check(now, "after a refused build");
+      EXPECT_FALSE(tree.contains(ids[n - 1] + 1000000));
+    }
+  }
+}
+
+TEST(TprTreeBuild, RebuiltEveryTickAnswersLikeBruteForce) {
+  check_rebuilds<2>();
+  check_rebuilds<3>();
 }
 
 TEST(TprTreeBuild, RefusesBadInput) {

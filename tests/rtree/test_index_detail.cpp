@@ -123,6 +123,55 @@ TEST(StrTile, GroupsAreSlabsThenTiles) {
   }
 }
 
+// Reference for str_tile_cells: at each level a stable comparison sort of the whole range by
+// the axis's cell, then the same slabs.
+template <int D>
+void reference_cells(CellItem* base, std::span<const std::size_t> groups, int axis = 0) {
+  const std::size_t k = groups.size() - 1;
+  if (k <= 1) return;
+  constexpr int bits = cell_bits<D>();
+  const auto cell = [&](const CellItem& c) {
+    return (c.cells >> (bits * axis)) & ((std::uint64_t(1) << bits) - 1);
+  };
+  std::stable_sort(base + groups.front(), base + groups.back(),
+                   [&](const CellItem& x, const CellItem& y) { return cell(x) < cell(y); });
+  if (axis == D - 1) return;
+  const auto slabs = std::size_t(std::ceil(std::pow(double(k), 1.0 / (D - axis)) - 1e-9));
+  const std::size_t per = (k + slabs - 1) / slabs;
+  for (std::size_t first = 0; first < k; first += per)
+    reference_cells<D>(base, groups.subspan(first, std::min(per, k - first) + 1), axis + 1);
+}
+
+template <int D>
+void check_cells_tiling(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<CellItem> tmp;
+  for (std::size_t n : {0, 1, 5, 64, 65, 1000, 20000}) {
+    for (int form = 0; form < 3; ++form) {  // random cells, few distinct cells, all equal
+      std::vector<CellItem> v(n);
+      for (std::uint32_t i = 0; i < n; ++i)
+        v[i] = {form == 0 ? rng() : form == 1 ? rng() & 0x0003000300030003 : 42, i};
+      std::vector<std::size_t> groups;
+      const std::size_t k = std::max<std::size_t>(1, n / (1 + rng() % 40));
+      for (std::size_t g = 0; g <= k; ++g)
+        groups.push_back(n * g / k);
+      auto ref = v;
+      str_tile_cells<D>(v.data(), std::span<const std::size_t>(groups), tmp);
+      reference_cells<D>(ref.data(), std::span<const std::size_t>(groups));
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(v[i].index, ref[i].index) << "D " << D << " n " << n << " form " << form;
+        ASSERT_EQ(v[i].cells, ref[i].cells);
+      }
+    }
+  }
+}
+
+TEST(StrTileCells, MatchesStableSortsLevelByLevel) {
+  check_cells_tiling<2>(11);
+  check_cells_tiling<4>(12);
+  check_cells_tiling<6>(13);  // 10 bits an axis
+}
+
 TEST(SoaBoxes, MasksMatchScalarTests) {
   std::mt19937_64 rng(6);
   SoaBoxes<3, 16> node;

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -59,6 +60,76 @@ void str_tile(Item* base, std::span<const std::size_t> groups, Coord coord, int 
     const std::size_t first = s * per_slab;
     const std::size_t count = std::min(per_slab, k - first);
     str_tile<D>(base, groups.subspan(first, count + 1), coord, axis + 1);
+  }
+}
+
+}  // namespace loci::detail
+
+namespace loci::detail {
+
+// An item of str_tile_cells: its key on each of up to D axes quantized to cell_bits<D>() bits
+// (axis a in bits [a B, a B + B)), and the caller's index.
+struct CellItem {
+  std::uint64_t cells;
+  std::uint32_t index;
+};
+
+// Bits an axis gets in CellItem::cells: 16, or fewer when D axes would not fit in 64 bits.
+template <int D>
+constexpr int cell_bits() {
+  return 64 / D < 16 ? 64 / D : 16;
+}
+
+// The same tiling as str_tile, over keys quantized to cell_bits<D>() bits an axis (a grid of
+// 2^16 cells over each axis's range for D <= 4, so that items closer than 1/65536 of the range
+// may tie), found by sorting instead of selecting: each level is one stable counting sort of
+// 8-bit passes, so the whole tiling costs O(n D) and reads 16-byte items sequentially. What
+// rebuilding a moving index every tick needs. `tmp` is scratch, resized as needed.
+template <int D>
+void str_tile_cells(CellItem* base, std::span<const std::size_t> groups, std::vector<CellItem>& tmp,
+                    int axis = 0) {
+  constexpr int kBits = cell_bits<D>();
+  static_assert(D >= 1 && kBits >= 8, "at most 8 axes");
+  const std::size_t k = groups.size() - 1;
+  if (k <= 1) return;
+  const std::size_t lo = groups.front(), n = groups.back() - lo;
+  CellItem* const a = base + lo;
+  const int shift = kBits * axis;
+  constexpr std::uint64_t kMask = (std::uint64_t(1) << kBits) - 1;
+  if (n <= 64) {
+    std::stable_sort(a, a + n, [&](const CellItem& x, const CellItem& y) {
+      return ((x.cells >> shift) & kMask) < ((y.cells >> shift) & kMask);
+    });
+  } else {
+    // Two passes of 8 bits (the second of kBits - 8): the result lands back in place.
+    static_assert(kBits <= 16);
+    if (tmp.size() < n) tmp.resize(n);
+    CellItem* const b = tmp.data();
+    for (int pass = 0; pass < 2; ++pass) {
+      CellItem* const from = pass == 0 ? a : b;
+      CellItem* const to = pass == 0 ? b : a;
+      const int s = shift + 8 * pass;
+      const std::uint64_t mask = pass == 0 ? 0xff : (std::uint64_t(1) << (kBits - 8)) - 1;
+      std::size_t count[256] = {};
+      for (std::size_t i = 0; i < n; ++i)
+        ++count[(from[i].cells >> s) & mask];
+      std::size_t sum = 0;
+      for (std::size_t& c : count) {
+        const std::size_t m = c;
+        c = sum;
+        sum += m;
+      }
+      for (std::size_t i = 0; i < n; ++i)
+        to[count[(from[i].cells >> s) & mask]++] = from[i];
+    }
+  }
+  if (axis == D - 1) return;  // sorted along the last axis: consecutive groups are the tiles
+  const auto slabs =
+      static_cast<std::size_t>(std::ceil(std::pow(double(k), 1.0 / (D - axis)) - 1e-9));
+  const std::size_t per_slab = (k + slabs - 1) / slabs;
+  for (std::size_t first = 0; first < k; first += per_slab) {
+    const std::size_t count = std::min(per_slab, k - first);
+    str_tile_cells<D>(base, groups.subspan(first, count + 1), tmp, axis + 1);
   }
 }
 

@@ -88,6 +88,9 @@ class MovingRTree {
   // level is packed from consecutive nodes of the one below, in tiling order. The
   // tree's epoch and clock become the latest report time. Throws InvalidArgument for
   // duplicate ids or lengths that differ, InvalidGeometry for a bad report.
+  //
+  // Rebuilt every tick, the tree reuses its memory (nodes and scratch arrays touch no new
+  // pages) and, when the ids are those of the last build in the same order, its id map.
   void build(std::span<const Id> ids, std::span<const Motion<D>> objects) {
     if (ids.size() != objects.size())
       throw InvalidArgument(std::string(kName) + ": ids and reports differ in length");
@@ -100,30 +103,45 @@ class MovingRTree {
       latest = std::max(latest, m.t);
     }
     const std::size_t n = objects.size();
+    // Object i takes slot i. The map from ids to slots stands when every slot holds the id
+    // given for it (then the ids are distinct too); otherwise a new one is made.
+    const bool same_ids =
+        count_ == n && obj_id_.size() == n && std::equal(ids.begin(), ids.end(), obj_id_.begin());
     detail::IdMap map;
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (map.find(ids[i]) != kNone)
-        throw InvalidArgument(std::string(kName) + ": id " + std::to_string(ids[i]) +
-                              " is given twice");
-      map.insert(ids[i], i, i + 1);
-    }
-    // Leaves are tiles of the 2 D-dimensional space of positions at mid-horizon and
-    // velocities scaled by half the horizon (how far a velocity difference spreads a node
-    // by then), cut by Sort-Tile-Recursive.
-    const double mid = latest + 0.5 * Policy::lookahead(params_);
-    const double spread = std::max(0.5 * Policy::lookahead(params_), 1e-9);
-    struct Keyed {
-      double key[2 * D];
-      std::uint32_t index;
-    };
-    std::vector<Keyed> keyed(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      const Point<D> p = position(objects[i], mid);
-      for (int a = 0; a < D; ++a) {
-        keyed[i].key[a] = p[a];
-        keyed[i].key[D + a] = objects[i].v[a] * spread;
+    if (!same_ids)
+      for (std::uint32_t i = 0; i < n; ++i) {
+        if (map.find(ids[i]) != kNone)
+          throw InvalidArgument(std::string(kName) + ": id " + std::to_string(ids[i]) +
+                                " is given twice");
+        map.insert(ids[i], i, i + 1);
       }
-      keyed[i].index = i;
+    // Leaves are tiles of the 2 D-dimensional space of positions at mid-horizon and
+    // velocities, cut by Sort-Tile-Recursive on quantized keys (detail::str_tile_cells).
+    const double mid = latest + 0.5 * Policy::lookahead(params_);
+    const auto key = [&](const Motion<D>& m, int axis) {
+      return axis < D ? m.p[axis] + m.v[axis] * (mid - m.t) : m.v[axis - D];
+    };
+    constexpr int kCellBits = detail::cell_bits<2 * D>();
+    constexpr double kCellMax = double((1u << kCellBits) - 1);
+    double kmin[2 * D], kscale[2 * D];
+    for (int a = 0; a < 2 * D; ++a) {
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (const Motion<D>& m : objects) {
+        const double k = key(m, a);
+        lo = std::min(lo, k), hi = std::max(hi, k);
+      }
+      const double scale = kCellMax / (hi - lo);
+      kmin[a] = lo;
+      kscale[a] = std::isfinite(scale) ? scale : 0.0;  // one value, or beyond doubles
+    }
+    cells_.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      std::uint64_t c = 0;
+      for (int a = 0; a < 2 * D; ++a) {
+        const double q = (key(objects[i], a) - kmin[a]) * kscale[a];
+        c |= std::uint64_t(q >= 0 ? std::min(q, kCellMax) : 0.0) << (kCellBits * a);
+      }
+      cells_[i] = {c, i};
     }
     constexpr std::size_t kFill = std::max<std::size_t>(kMinFill, M * 3 / 4);
     const std::size_t leaves = (n + kFill - 1) / kFill;
@@ -131,21 +149,18 @@ class MovingRTree {
       std::vector<std::size_t> groups(leaves + 1);
       for (std::size_t g = 0; g <= leaves; ++g)
         groups[g] = n * g / leaves;
-      detail::str_tile<2 * D>(keyed.data(), std::span<const std::size_t>(groups),
-                              [](const Keyed& k, int axis) { return k.key[axis]; });
+      detail::str_tile_cells<2 * D>(cells_.data(), std::span<const std::size_t>(groups),
+                                    cells_tmp_);
     }
-    // The old contents go; their memory is reused (a tree rebuilt every tick touches no new
-    // pages). Object slots follow the tiling order, so a leaf's objects are neighbours.
+    // The old contents go; their memory is reused.
     nodes_.clear();
     nodes_.reserve(leaves + leaves / (kFill - 1) + 8);
     root_ = kNone;
     free_slots_.clear();
-    obj_id_.resize(n);
-    obj_motion_.resize(n);
+    obj_id_.assign(ids.begin(), ids.end());
+    obj_motion_.assign(objects.begin(), objects.end());
     obj_leaf_.resize(n);
-    map_.clear();
-    for (std::uint32_t k = 0; k < n; ++k)
-      map_.insert(ids[keyed[k].index], k, k + 1);
+    if (!same_ids) map_ = std::move(map);
     count_ = n;
     epoch_ = clock_ = n > 0 ? latest : 0;
     mag_ = vmag_ = 0;
@@ -153,7 +168,8 @@ class MovingRTree {
       clock_ = -std::numeric_limits<double>::infinity();
       return;
     }
-    std::vector<Item> level(leaves);
+    std::vector<Item>& level = level_;
+    level.resize(leaves);
     for (std::size_t g = 0; g < leaves; ++g) {
       const std::uint32_t node = nodes_.allocate(kName);
       Node& nd = nodes_[node];
@@ -162,23 +178,22 @@ class MovingRTree {
       nd.count = 0;
       nd.grouped = 0;
       for (std::size_t k = n * g / leaves; k < n * (g + 1) / leaves; ++k) {
-        const std::uint32_t i = keyed[k].index;
+        const std::uint32_t i = cells_[k].index;
         const Box_ b = Box_::of(objects[i], epoch_);
         for (int a = 0; a < D; ++a) {
           mag_ = std::max(mag_, std::abs(b.lo[a]));
           vmag_ = std::max(vmag_, std::abs(b.vlo[a]));
         }
-        obj_id_[k] = ids[i];
-        obj_motion_[k] = objects[i];
-        obj_leaf_[k] = node;
-        put(nd, nd.count++, {b, std::uint32_t(k), objects[i], ids[i]});
+        obj_leaf_[i] = node;
+        put(nd, nd.count++, {b, i, objects[i], ids[i]});
       }
       level[g] = {bound(nd), node, {}, 0};
     }
     // Pack each level above into nodes of nearly equal counts, about 3/4 full.
     for (int height = 1; level.size() > 1; ++height) {
       const std::size_t groups = (level.size() + kFill - 1) / kFill;
-      std::vector<Item> up(groups);
+      std::vector<Item>& up = up_;
+      up.resize(groups);
       for (std::size_t g = 0; g < groups; ++g) {
         const std::uint32_t node = nodes_.allocate(kName);
         Node& nd = nodes_[node];
@@ -960,6 +975,9 @@ class MovingRTree {
   std::vector<Motion<D>> obj_motion_;
   std::vector<std::uint32_t> obj_leaf_;  // kNone: a free slot
   std::vector<std::uint32_t> free_slots_;
+  // Scratch of build, kept so that a tree rebuilt every tick touches no new pages.
+  std::vector<detail::CellItem> cells_, cells_tmp_;
+  std::vector<Item> level_, up_;
   detail::IdMap map_;
   std::size_t count_ = 0;
   double epoch_ = 0;
