@@ -437,6 +437,8 @@ void run_conflicts(const Options& o) {
   std::uniform_int_distribution<std::size_t> pick(0, n - 1);
   std::vector<double> inc_s, full_s, refresh_s;
   std::size_t answer = 0;
+  // A stream keeps its output buffer from tick to tick, as it keeps the monitor.
+  std::vector<loci::Conflict> inc;
   for (int tick = 0; tick <= 12; ++tick) {
     const double now = 10.0 * tick;
     std::vector<std::pair<std::size_t, Motion2>> batch;
@@ -449,7 +451,7 @@ void run_conflicts(const Options& o) {
             {i,
              {now, loci::position(fleet[i], now), {v[0] * c - v[1] * sn, v[0] * sn + v[1] * c}}});
       }
-    std::vector<loci::Conflict> inc;
+    inc.clear();
     const double ti = [&] {
       const auto t0 = Clock::now();
       for (const auto& [i, m] : batch)

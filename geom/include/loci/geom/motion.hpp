@@ -190,30 +190,59 @@ struct Approach {
   double t_exit;   // last time it is, within the horizon
 };
 
+namespace detail {
+// The relative position d of b from a at s0, their relative velocity w, the time u in
+// [0, horizon] after s0 when they are closest, and the distance then.
+template <int D>
+struct Closest {
+  Point<D> d, w;
+  double u, dcpa;
+};
+// The same from the positions pa, pb at s0 and the velocities va, vb.
+template <int D>
+Closest<D> closest_at(const Point<D>& pa, const Point<D>& va, const Point<D>& pb,
+                      const Point<D>& vb, double horizon) {
+  Closest<D> c;
+  double dw = 0, ww = 0;
+  for (int i = 0; i < D; ++i) {
+    c.d[i] = pb[i] - pa[i];
+    c.w[i] = vb[i] - va[i];
+    dw += c.d[i] * c.w[i];
+    ww += c.w[i] * c.w[i];
+  }
+  c.u = ww > 0 ? std::clamp(-dw / ww, 0.0, horizon) : 0.0;
+  double dd = 0;
+  for (int i = 0; i < D; ++i) {
+    const double e = c.d[i] + c.w[i] * c.u;
+    dd += e * e;
+  }
+  c.dcpa = std::sqrt(dd);
+  return c;
+}
+template <int D>
+Closest<D> closest(const Motion<D>& a, const Motion<D>& b, double s0, double horizon) {
+  return closest_at(position(a, s0), a.v, position(b, s0), b.v, horizon);
+}
+}  // namespace detail
+
+// Whether a and b come within `within` of each other during [s0, s0 + horizon]: exactly
+// when closest_approach(a, b, s0, horizon, within) has a value, without its times.
+template <int D>
+bool comes_within(const Motion<D>& a, const Motion<D>& b, double s0, double horizon,
+                  double within) {
+  return detail::closest(a, b, s0, horizon).dcpa <= within;
+}
+
 // The closest approach of a and b over [s0, s0 + horizon] when it is at most `within`;
 // nullopt otherwise. horizon >= 0, within >= 0.
 template <int D>
 std::optional<Approach> closest_approach(const Motion<D>& a, const Motion<D>& b, double s0,
                                          double horizon, double within) {
-  const Point<D> pa = position(a, s0), pb = position(b, s0);
-  Point<D> d{}, w{};
-  double dw = 0, ww = 0;
-  for (int i = 0; i < D; ++i) {
-    d[i] = pb[i] - pa[i];
-    w[i] = b.v[i] - a.v[i];
-    dw += d[i] * w[i];
-    ww += w[i] * w[i];
-  }
-  const double u = ww > 0 ? std::clamp(-dw / ww, 0.0, horizon) : 0.0;
-  double dd = 0;
-  for (int i = 0; i < D; ++i) {
-    const double c = d[i] + w[i] * u;
-    dd += c * c;
-  }
-  const double dcpa = std::sqrt(dd);
+  const detail::Closest<D> c = detail::closest(a, b, s0, horizon);
+  const double u = c.u, dcpa = c.dcpa;
   if (!(dcpa <= within)) return std::nullopt;
   const Point<D> zero{};
-  const ContactInterval in = sphere_contact(d, within, w, zero, 0.0, zero, 0.0, horizon);
+  const ContactInterval in = sphere_contact(c.d, within, c.w, zero, 0.0, zero, 0.0, horizon);
   // The interval holds u in exact arithmetic; rounding at a grazing pass may leave it empty
   // or a hair off, and then it is widened to include u.
   const double enter = in.empty() ? u : std::min(in.enter, u);

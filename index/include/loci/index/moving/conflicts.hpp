@@ -36,7 +36,6 @@
 
 #include "loci/geom/motion.hpp"
 #include "loci/index/broadphase/detail/proxy_table.hpp"
-#include "loci/index/broadphase/dynamic_aabb_tree.hpp"
 #include "loci/index/broadphase/sweep_prune.hpp"
 #include "loci/index/detail/hilbert.hpp"
 #include "loci/index/detail/radix_sort.hpp"
@@ -263,21 +262,29 @@ std::vector<Conflict> find_conflicts(std::span<const Id> ids, std::span<const Mo
 // ConflictMonitor<D>: the conflicts of a fleet kept up to date as reports stream in.
 //
 // It computes ahead: at a full computation at time b it keeps every pair within D during
-// [b, b + H + slack] (find_conflicts), and the grown swept boxes of that span in a packed
-// R-tree (packed_rtree.hpp). After a batch of reports, refresh(now) with now <= b + slack
-// drops the kept pairs of the objects that reported and looks for their new pairs with one
-// query each: the pairs of the others cannot have changed, since their reports did not and
-// [now, now + H] lies inside the span already searched. Objects that reported since b have
-// stale boxes in the packed tree, which queries skip; their current boxes are in a small
-// dynamic AABB tree (broadphase/dynamic_aabb_tree.hpp) that queries look at too. Once now passes
-// b + slack, refresh computes everything again from now. conflicts(visit) then reports, from
-// the kept pairs, those within D during [now, now + H], with the same closest approach as
-// find_conflicts at now (each kept pair is tested again at now, so answers are identical to a
-// computation from scratch).
+// [b, b + H + slack] (find_conflicts), each with its closest approach over that span, and the
+// grown swept boxes of the span in a packed R-tree (packed_rtree.hpp). After a batch of
+// reports, refresh(now) with now <= b + slack forgets the kept pairs of the objects that
+// reported and looks for their new pairs with one query each: the pairs of the others cannot
+// have changed, since their reports did not and [now, now + H] lies inside the span already
+// searched. Objects that reported since b have stale boxes in the packed tree, which queries
+// skip; their current boxes are packed afresh into a small tree at each refresh, which
+// queries look at too. Once now passes b + slack, refresh computes everything again from now.
+//
+// conflicts(visit) then reports, from the kept pairs, those within D during [now, now + H]
+// without computing them again: the distance of two linear motions is convex in time, so
+// over [now, now + H] it is least at the span's time of closest approach clamped to that
+// window, and the pair is within D from max(t_enter, now) to min(t_exit, now + H). Only a pair
+// whose closest approach falls outside the window needs its distance at the window's end,
+// and only a pair within rounding of D (1e-9 of the coordinates' magnitude) is decided by
+// closest_approach at now, as find_conflicts decides it; so the pairs are exactly those of a
+// computation from scratch, and the times and distances agree with it to rounding.
 //
 // Cost: a full computation as find_conflicts over the longer span; an incremental refresh
-// O(reported x (log n + candidates)); conflicts() O(kept pairs). Objects are named by the
-// caller's ids. Thread-safety: one thread at a time.
+// O(reported x (log n + candidates)); conflicts() O(kept pairs), reading them in order. A
+// pair of an object that reported is forgotten by a version check, not found and erased;
+// forgotten pairs are swept out when they would be a quarter of those kept. Objects are named
+// by the caller's ids. Thread-safety: one thread at a time.
 template <int D>
 class ConflictMonitor {
  public:
@@ -302,7 +309,9 @@ class ConflictMonitor {
         motion_.emplace_back();
         alive_.push_back(0);
         dirty_.push_back(0);
-        adj_.emplace_back();
+        version_.push_back(0);
+        degree_.push_back(0);
+        at_base_.emplace_back();
       }
       ids_[s] = id;
       alive_[s] = 1;
@@ -336,45 +345,49 @@ class ConflictMonitor {
     QueryStats st;
     const double t1 = base_ + horizon_ + slack_;
     dirty_seen_.resize(ids_.size(), 0);
-    for (std::uint32_t s : dirty_list_)
-      if (alive_[s]) widen(motion_[s], t1 - base_);
-    // Drop every kept pair of the objects that reported.
-    for (std::uint32_t s : dirty_list_) {
-      for (std::uint32_t t : adj_[s])
-        std::erase(adj_[t], s);
-      adj_[s].clear();
-    }
     moved_.resize(ids_.size(), 0);
     for (std::uint32_t s : dirty_list_) {
+      // Its kept pairs are forgotten: their versions no longer match.
+      forgotten_ += degree_[s];
+      degree_[s] = 0;
       dirty_[s] = 0;
-      moved_[s] = 1;
+      if (!moved_[s]) moved_[s] = 1, recent_.push_back(s);
       if (!alive_[s]) {
-        recent_.remove(s);
         free_.push_back(s);
         continue;
       }
-      const Box<D> b = detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_);
-      if (recent_.contains(s))
-        recent_.move(s, b);
-      else
-        recent_.add(s, b);
+      widen(motion_[s], t1 - base_);
+      at_base_[s] = {position(motion_[s], base_), motion_[s].v};
     }
+    if (forgotten_ > kept_.size() / 4) sweep();
+    // The objects that reported since the base, in a small packed tree made afresh.
+    recent_live_.clear();
+    std::vector<Box<D>> boxes;
+    for (std::uint32_t s : recent_)
+      if (alive_[s]) {
+        recent_live_.push_back(s);
+        boxes.push_back(detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_));
+      }
+    recent_tree_ = PackedRTree<D>::build(boxes);
     for (std::uint32_t s : dirty_list_) {
       if (!alive_[s]) continue;
       const Box<D> b = detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_);
-      auto candidate = [&](Id other, const Box<D>&) {
-        const auto t = std::uint32_t(other);
+      auto candidate = [&](std::uint32_t t) {
         // A pair of two reporting objects is taken from the first of them looked at.
         if (t == s || dirty_seen_[t]) return true;
-        if (closest_approach(motion_[s], motion_[t], base_, t1 - base_, keep_)) link(s, t);
+        // comes_within(motion_[s], motion_[t], base_, t1 - base_, keep_), from the positions
+        // at the base kept for every object
+        const State& x = at_base_[s];
+        const State& y = at_base_[t];
+        if (detail::closest_at(x.p, x.v, y.p, y.v, t1 - base_).dcpa <= keep_) keep(s, t);
         return true;
       };
-      st += packed_.query(b, [&](Id k, const Box<D>& ob) {
+      st += packed_.query(b, [&](Id k, const Box<D>&) {
         // Boxes of objects that reported since the base are stale here.
         const std::uint32_t other = packed_slot_[k];
-        return moved_[other] ? true : candidate(other, ob);
+        return moved_[other] ? true : candidate(other);
       });
-      st += recent_.query(b, candidate);
+      st += recent_tree_.query(b, [&](Id e, const Box<D>&) { return candidate(recent_live_[e]); });
       dirty_seen_[s] = 1;
     }
     for (std::uint32_t s : dirty_list_)
@@ -386,15 +399,36 @@ class ConflictMonitor {
   // The conflicts during [now, now + H] (now as given to the last refresh), by ids, a < b.
   template <class F>
   void conflicts(F&& visit) const {
-    for (std::uint32_t s = 0; s < adj_.size(); ++s)
-      for (std::uint32_t t : adj_[s]) {
-        if (t < s) continue;
-        const bool sa = ids_[s] < ids_[t];
-        const Motion<D>& a = sa ? motion_[s] : motion_[t];
-        const Motion<D>& b = sa ? motion_[t] : motion_[s];
-        if (auto ap = closest_approach(a, b, now_, horizon_, within_))
-          if (!visit(sa ? ids_[s] : ids_[t], sa ? ids_[t] : ids_[s], *ap)) return;
+    const double end = now_ + horizon_;
+    const double lo = within_ - margin_, hi = within_ + margin_;
+    for (const Kept& k : kept_) {
+      if (version_[k.s] != k.vs || version_[k.t] != k.vt) continue;  // forgotten
+      const bool st = ids_[k.s] < ids_[k.t];
+      const Motion<D>& a = motion_[st ? k.s : k.t];
+      const Motion<D>& b = motion_[st ? k.t : k.s];
+      std::optional<Approach> ap;
+      if (k.dcpa <= within_) {
+        // Least distance over the window: at the span's closest approach clamped to it.
+        const double tc = std::clamp(k.tcpa, now_, end);
+        double d = k.dcpa;
+        if (tc != k.tcpa) {
+          const Point<D> pa = position(a, tc), pb = position(b, tc);
+          double dd = 0;
+          for (int i = 0; i < D; ++i)
+            dd += (pb[i] - pa[i]) * (pb[i] - pa[i]);
+          d = std::sqrt(dd);
+        }
+        if (d > hi) continue;
+        if (d < lo)
+          ap = Approach{tc, d, std::min(std::max(k.t_enter, now_), tc),
+                        std::max(std::min(k.t_exit, end), tc)};
       }
+      if (!ap) {  // within rounding of D (or kept within keep_ only): decided as from scratch
+        ap = closest_approach(a, b, now_, horizon_, within_);
+        if (!ap) continue;
+      }
+      if (!visit(ids_[st ? k.s : k.t], ids_[st ? k.t : k.s], *ap)) return;
+    }
   }
   std::vector<Conflict> conflicts() const {
     std::vector<Conflict> out;
@@ -404,7 +438,18 @@ class ConflictMonitor {
   }
 
  private:
+  struct State {
+    Point<D> p, v;  // position at the base, velocity
+  };
+  // A kept pair, by slots, with the versions of their reports when it was found and its
+  // closest approach within D over the span (dcpa = infinity when it comes within keep_ only).
+  struct Kept {
+    std::uint32_t s, t, vs, vt;
+    double tcpa, dcpa, t_enter, t_exit;
+  };
+
   void mark(std::uint32_t s) {
+    ++version_[s];
     if (!dirty_[s]) {
       dirty_[s] = 1;
       dirty_list_.push_back(s);
@@ -417,10 +462,24 @@ class ConflictMonitor {
     for (int a = 0; a < D; ++a)
       scale_ = std::max(scale_, std::abs(p[a]) + std::abs(m.v[a]) * span);
     keep_ = within_ * (1 + 1e-9) + 1e-9 * scale_;
+    margin_ = 0.5 * (keep_ - within_);
   }
-  void link(std::uint32_t s, std::uint32_t t) {
-    adj_[s].push_back(t);
-    adj_[t].push_back(s);
+  void keep(std::uint32_t s, std::uint32_t t) {
+    Kept k{s, t, version_[s], version_[t], 0, std::numeric_limits<double>::infinity(), 0, 0};
+    if (auto ap = closest_approach(motion_[s], motion_[t], base_, horizon_ + slack_, within_))
+      k.tcpa = ap->tcpa, k.dcpa = ap->dcpa, k.t_enter = ap->t_enter, k.t_exit = ap->t_exit;
+    kept_.push_back(k);
+    ++degree_[s];
+    ++degree_[t];
+  }
+  // Drops the forgotten pairs.
+  void sweep() {
+    std::erase_if(kept_,
+                  [&](const Kept& k) { return version_[k.s] != k.vs || version_[k.t] != k.vt; });
+    std::fill(degree_.begin(), degree_.end(), 0);
+    for (const Kept& k : kept_)
+      ++degree_[k.s], ++degree_[k.t];
+    forgotten_ = 0;
   }
 
   QueryStats recompute(double now) {
@@ -437,13 +496,17 @@ class ConflictMonitor {
     std::vector<std::uint32_t> live;
     std::vector<Motion<D>> dense;
     recent_.clear();
+    recent_tree_ = {};
     moved_.assign(ids_.size(), 0);
     scale_ = 0;
+    kept_.clear();
+    std::fill(degree_.begin(), degree_.end(), 0);
+    forgotten_ = 0;
     for (std::uint32_t s = 0; s < ids_.size(); ++s) {
-      adj_[s].clear();
       if (!alive_[s]) continue;
       live.push_back(s);
       dense.push_back(motion_[s]);
+      at_base_[s] = {position(motion_[s], now), motion_[s].v};
       widen(motion_[s], span);
     }
     // The packed tree names entries by their index in `boxes`, packed_slot_ maps it back.
@@ -455,25 +518,31 @@ class ConflictMonitor {
     packed_slot_ = live;
     return finder_.find(std::span<const Motion<D>>(dense), keep_, now, span,
                         [&](std::uint32_t i, std::uint32_t j, const Approach&) {
-                          link(live[i], live[j]);
+                          keep(live[i], live[j]);
                           return true;
                         });
   }
 
   double within_, horizon_, slack_;
-  double base_ = 0, now_ = 0, scale_ = 0, keep_ = 0;
+  double base_ = 0, now_ = 0, scale_ = 0, keep_ = 0, margin_ = 0;
   bool computed_ = false;
   std::size_t full_ = 0, incremental_ = 0;
   std::vector<Id> ids_;
   std::vector<Motion<D>> motion_;
   std::vector<std::uint8_t> alive_, dirty_, dirty_seen_, moved_;
   std::vector<std::uint32_t> dirty_list_, free_;
-  std::vector<std::vector<std::uint32_t>> adj_;  // kept pairs, both ways
+  std::vector<std::uint32_t> version_;  // reports and removals of each slot, counted
+  std::vector<std::uint32_t> degree_;   // kept pairs of each slot since the last sweep
+  std::vector<Kept> kept_;
+  std::vector<State> at_base_;  // by slot
+  std::size_t forgotten_ = 0;   // kept pairs whose versions no longer match, at most
   detail::IdMap slots_;
   std::size_t count_ = 0;
   PackedRTree<D> packed_;                   // grown swept boxes at the base
   std::vector<std::uint32_t> packed_slot_;  // slot of each entry of packed_
-  DynamicAabbTree<D> recent_;               // the same for objects that reported since the base
+  std::vector<std::uint32_t> recent_;       // objects that reported since the base, by slot
+  std::vector<std::uint32_t> recent_live_;  // those alive, by entry of recent_tree_
+  PackedRTree<D> recent_tree_;              // their grown swept boxes
   ConflictFinder<D> finder_;
 };
 
