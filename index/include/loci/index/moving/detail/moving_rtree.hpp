@@ -170,6 +170,7 @@ class MovingRTree {
     }
     std::vector<Item>& level = level_;
     level.resize(leaves);
+    constexpr std::size_t kAhead = 16;
     for (std::size_t g = 0; g < leaves; ++g) {
       const std::uint32_t node = nodes_.allocate(kName);
       Node& nd = nodes_[node];
@@ -178,6 +179,8 @@ class MovingRTree {
       nd.count = 0;
       nd.grouped = 0;
       for (std::size_t k = n * g / leaves; k < n * (g + 1) / leaves; ++k) {
+        // Reports are read in tiling order, scattered over memory: ask for them ahead.
+        if (k + kAhead < n) __builtin_prefetch(&objects[cells_[k + kAhead].index]);
         const std::uint32_t i = cells_[k].index;
         const Box_ b = Box_::of(objects[i], epoch_);
         for (int a = 0; a < D; ++a) {
