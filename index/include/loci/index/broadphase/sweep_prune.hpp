@@ -56,6 +56,7 @@
 #include "loci/index/broadphase/broad_phase.hpp"
 #include "loci/index/broadphase/detail/pair_tracker.hpp"
 #include "loci/index/broadphase/detail/proxy_table.hpp"
+#include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/detail/radix_sort.hpp"
 
 namespace loci {
@@ -99,6 +100,9 @@ class BasicSweepPrune {
 
   // SweepPrune cuts space into stripes once it holds `striped_from` proxies (see above).
   explicit BasicSweepPrune(std::size_t striped_from = kStripedFrom) : striped_from_(striped_from) {}
+
+  // Room for n proxies, so that adding them one by one does not move the tables.
+  void reserve(std::size_t n) { proxies_.reserve(n); }
 
   void add(Id id, const Box<D>& b) {
     const std::uint32_t s = proxies_.add(id, b, kName);
@@ -404,24 +408,24 @@ class BasicSweepPrune {
   std::size_t striped_from_;
   detail::ProxyTable<D> proxies_;
   detail::PairTracker tracker_;
-  int axis_ = 0;                           // sweep axis of the last tick
-  bool sorted_once_ = false;               // incremental: order_ has been sorted at least once
-  std::vector<std::uint32_t> order_;       // slots by increasing min on axis_ (kNone: a hole)
-  std::vector<std::uint32_t> pos_;         // incremental: position of each slot in order_
-  std::size_t holes_ = 0;                  // incremental: kNone entries in order_
-  std::vector<detail::KeyedIndex> keyed_;  // sort records (key, slot)
-  std::vector<double> key_;                // incremental: min on axis_ in order_
-  int stripe_axis_ = 1;                    // the axis cut into stripes
-  std::uint32_t stripes_ = 1;              // stripe count (1: a plain sweep)
+  int axis_ = 0;                              // sweep axis of the last tick
+  bool sorted_once_ = false;                  // incremental: order_ has been sorted at least once
+  detail::LargeVector<std::uint32_t> order_;  // slots by increasing min on axis_ (kNone: a hole)
+  std::vector<std::uint32_t> pos_;            // incremental: position of each slot in order_
+  std::size_t holes_ = 0;                     // incremental: kNone entries in order_
+  detail::LargeVector<detail::KeyedIndex> keyed_;  // sort records (key, slot)
+  std::vector<double> key_;                        // incremental: min on axis_ in order_
+  int stripe_axis_ = 1;                            // the axis cut into stripes
+  std::uint32_t stripes_ = 1;                      // stripe count (1: a plain sweep)
   double stripe_origin_ = 0, stripe_inv_ = 0;
   // The sweep's structure-of-arrays in sorted order, stripe after stripe, each stripe
   // followed by a sentinel.
-  std::size_t count_ = 0;        // entries and sentinels gathered
-  std::vector<double> start_;    // run order key: <= min on axis_, +inf at a sentinel
-  std::vector<double> lo_, hi_;  // box on axis_
-  std::vector<double> olo_[D - 1], ohi_[D - 1];  // box on the other axes
-  std::vector<std::uint32_t> home_;              // 1 in the stripe of the box's min on stripe_axis_
-  std::vector<Id> ids_;
+  std::size_t count_ = 0;                // entries and sentinels gathered
+  detail::LargeVector<double> start_;    // run order key: <= min on axis_, +inf at a sentinel
+  detail::LargeVector<double> lo_, hi_;  // box on axis_
+  detail::LargeVector<double> olo_[D - 1], ohi_[D - 1];  // box on the other axes
+  detail::LargeVector<std::uint32_t> home_;  // 1 in the stripe of the box's min on stripe_axis_
+  detail::LargeVector<Id> ids_;
   std::vector<std::uint32_t> hits_;  // left-packed candidates of one run
 };
 

@@ -1,5 +1,5 @@
 // LargeAllocator: an allocator for the big temporary arrays of bulk work (a join's boxes and
-// tile lists, a radix sort's buffers), which asks the kernel to back blocks of 4 MB or more
+// tile lists, a radix sort's buffers), which asks the kernel to back blocks of 1 MB or more
 // with transparent huge pages (madvise(MADV_HUGEPAGE), where the system leaves huge pages to
 // programs that ask). Touching fresh memory costs a page fault per 4 KB page otherwise; on the
 // virtual machines a library runs on, that can cost more than the work done on the memory
@@ -22,7 +22,7 @@ template <class T>
 struct LargeAllocator {
   using value_type = T;
   static constexpr std::size_t kHuge = std::size_t(2) << 20;
-  static constexpr std::size_t kThreshold = std::size_t(4) << 20;
+  static constexpr std::size_t kThreshold = std::size_t(1) << 20;
 
   LargeAllocator() = default;
   template <class U>

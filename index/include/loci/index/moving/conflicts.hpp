@@ -38,6 +38,7 @@
 #include "loci/index/broadphase/detail/proxy_table.hpp"
 #include "loci/index/broadphase/sweep_prune.hpp"
 #include "loci/index/detail/hilbert.hpp"
+#include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/detail/radix_sort.hpp"
 #include "loci/index/packed_rtree.hpp"
 #include "loci/index/query.hpp"
@@ -141,6 +142,7 @@ class ConflictFinder {
     if (objects.size() >= kNone) throw InvalidArgument("find_conflicts: too many objects");
     prepare(objects, now, horizon);
     const std::size_t n = objects.size();
+    broad_.reserve(n);
     // Pairs whose closest approach computed from the positions at `now` is clearly beyond D
     // (by more than rounding can explain) are dropped before the exact test, which alone
     // decides the rest.
@@ -227,11 +229,12 @@ class ConflictFinder {
 
   SweepPrune<D> broad_;
   std::size_t held_ = 0;  // proxies 0 .. held_ - 1 are in broad_
-  std::vector<detail::KeyedIndex> keyed_;
-  std::vector<std::uint32_t> order_;  // input index by proxy number
-  std::vector<Point<D>> at_now_;      // positions at `now` by proxy number
-  std::vector<Motion<D>> motion_;     // the reports by proxy number
-  double scale_ = 0;                  // largest coordinate magnitude reached
+  // Large arrays, so that a search made once does not spend its time faulting pages in.
+  detail::LargeVector<detail::KeyedIndex> keyed_;
+  detail::LargeVector<std::uint32_t> order_;  // input index by proxy number
+  detail::LargeVector<Point<D>> at_now_;      // positions at `now` by proxy number
+  detail::LargeVector<Motion<D>> motion_;     // the reports by proxy number
+  double scale_ = 0;                          // largest coordinate magnitude reached
 };
 
 template <int D, ConflictVisitor F>

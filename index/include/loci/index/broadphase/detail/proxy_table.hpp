@@ -67,6 +67,12 @@ class ProxyTable {
     return s;
   }
 
+  void reserve(std::size_t n) {
+    ids_.reserve(n);
+    boxes_.reserve(n);
+    alive_.reserve(n);
+  }
+
   // A fresh slot for (id, box). Throws InvalidGeometry for a bad box and InvalidArgument when
   // the id is already held or slots run out.
   std::uint32_t add(Id id, const Box<D>& b, const char* owner) {
