@@ -519,11 +519,15 @@ class ConflictMonitor {
       boxes.push_back(detail::grown_sweep(motion_[s], now, now + span, 0.5 * keep_));
     packed_ = PackedRTree<D>::build(boxes);
     packed_slot_ = live;
-    return finder_.find(std::span<const Motion<D>>(dense), keep_, now, span,
-                        [&](std::uint32_t i, std::uint32_t j, const Approach&) {
-                          keep(live[i], live[j]);
-                          return true;
-                        });
+    const QueryStats st = finder_.find(std::span<const Motion<D>>(dense), keep_, now, span,
+                                       [&](std::uint32_t i, std::uint32_t j, const Approach&) {
+                                         keep(live[i], live[j]);
+                                         return true;
+                                       });
+    // Room for the pairs refreshes add before the next sweep, so that the table is not moved
+    // (and its pages faulted in again) in the middle of a stream.
+    kept_.reserve(kept_.size() + kept_.size() / 2 + 1024);
+    return st;
   }
 
   double within_, horizon_, slack_;
@@ -536,9 +540,9 @@ class ConflictMonitor {
   std::vector<std::uint32_t> dirty_list_, free_;
   std::vector<std::uint32_t> version_;  // reports and removals of each slot, counted
   std::vector<std::uint32_t> degree_;   // kept pairs of each slot since the last sweep
-  std::vector<Kept> kept_;
-  std::vector<State> at_base_;  // by slot
-  std::size_t forgotten_ = 0;   // kept pairs whose versions no longer match, at most
+  detail::LargeVector<Kept> kept_;      // on huge pages: tens of megabytes in a dense fleet
+  std::vector<State> at_base_;          // by slot
+  std::size_t forgotten_ = 0;           // kept pairs whose versions no longer match, at most
   detail::IdMap slots_;
   std::size_t count_ = 0;
   PackedRTree<D> packed_;                   // grown swept boxes at the base
