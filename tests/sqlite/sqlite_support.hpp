@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,16 @@ class Db {
   void exec(const std::string& sql) {
     const std::string err = try_exec(sql);
     EXPECT_EQ(err, "") << sql;
+  }
+  // Runs sql once for each table named, with $T standing for its name: the same statement on
+  // the loci table and on the plain table it is checked against.
+  void exec_on(std::initializer_list<const char*> tables, const std::string& sql) {
+    for (const char* table : tables) {
+      std::string s = sql;
+      for (std::size_t p; (p = s.find("$T")) != std::string::npos;)
+        s.replace(p, 2, table);
+      exec(s);
+    }
   }
   // Runs SQL; returns the error message, or "" on success.
   std::string try_exec(const std::string& sql) {

@@ -260,14 +260,7 @@ TEST(SqliteFleetSql, RandomWritesFollowRollbackAndSavepoints) {
   std::mt19937_64 rng(19);
   std::uniform_real_distribution<double> u(0, 1000), v(-3, 3), tt(0, 100);
   int depth = 0;
-  const auto both = [&](const std::string& sql) {
-    for (const char* table : {"f", "m"}) {
-      std::string s = sql;
-      for (std::size_t p; (p = s.find("$T")) != std::string::npos;)
-        s.replace(p, 2, table);
-      db.exec(s);
-    }
-  };
+  const auto both = [&](const std::string& sql) { db.exec_on({"f", "m"}, sql); };
   for (int step = 0; step < 500; ++step) {
     const int what = int(rng() % 16);
     const std::string id = std::to_string(int(rng() % 200) - 20);

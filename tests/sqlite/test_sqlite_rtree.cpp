@@ -258,14 +258,7 @@ TEST(SqliteRtreeSql, NewIdsFollowTheRowidTableRule) {
   Db db;
   db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy)");
   db.exec("CREATE TABLE m(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, miny REAL, maxy REAL)");
-  const auto both = [&](const std::string& sql) {
-    for (const char* table : {"t", "m"}) {
-      std::string s = sql;
-      for (std::size_t p; (p = s.find("$T")) != std::string::npos;)
-        s.replace(p, 2, table);
-      db.exec(s);
-    }
-  };
+  const auto both = [&](const std::string& sql) { db.exec_on({"t", "m"}, sql); };
   const auto check = [&](const char* when) {
     EXPECT_EQ(all(db, "t"), all(db, "m")) << when;
     EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok") << when;
@@ -303,14 +296,7 @@ TEST(SqliteRtreeSql, RandomWritesFollowRollbackAndSavepoints) {
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> u(0, 1000);
   int depth = 0;  // open savepoints, BEGIN counted as one
-  const auto both = [&](const std::string& sql) {
-    for (const char* table : {"t", "m"}) {
-      std::string s = sql;
-      for (std::size_t p; (p = s.find("$T")) != std::string::npos;)
-        s.replace(p, 2, table);
-      db.exec(s);
-    }
-  };
+  const auto both = [&](const std::string& sql) { db.exec_on({"t", "m"}, sql); };
   for (int step = 0; step < 400; ++step) {
     const int what = int(rng() % 20);
     const std::string x = real(u(rng)), y = real(u(rng));
