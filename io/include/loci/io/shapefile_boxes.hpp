@@ -1,0 +1,47 @@
+// Per-feature boxes of an ESRI shapefile, read straight from its .shx and .shp.
+//
+// An index per feature needs one box per feature, yet reading the layer through GDAL builds
+// every geometry whole (and, for polygons, sorts rings into polygons), which is most of the
+// time `loci index --per feature` takes on a large shapefile. The shapefile format
+// (ESRI Shapefile Technical Description, 1998) makes a direct read simple:
+//
+//   .shx  100-byte header (file length in 16-bit words, big-endian, at byte 24), then one
+//         8-byte entry per record: offset and content length, in 16-bit words, big-endian.
+//   .shp  the same header; each record an 8-byte big-endian header, then little-endian
+//         content: shape type, and for multipoints, lines and polygons a stored box, the
+//         counts of parts and points, the part starts and the x,y points (Z and M follow).
+//   .dbf  the attribute table: one record per shape, a leading '*' marking it deleted.
+//
+// The stored box is not trusted: each feature's box is the minimum and maximum over its
+// points, which is GDAL's envelope, and every point is checked for NaN, infinity and range
+// as the GDAL path does, with the same message. FIDs are record numbers from 0, as GDAL's
+// shapefile driver gives them; null shapes are skipped, as features without geometry are.
+//
+// Anything unusual hands the file back to GDAL (nullopt): a missing .shx or .dbf, deleted
+// records, counts that disagree, a record out of bounds or inconsistent, mixed or
+// multipatch shapes, empty shapes. So a file is either read here with GDAL's answer, or read
+// by GDAL. The .shp is read sequentially in chunks, never held whole.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "loci/io/layer_reader.hpp"
+
+namespace loci::io {
+
+struct ShapefileBoxes {
+  LayerItems items;            // per feature
+  std::uint64_t segments = 0;  // what a per-segment read would give: to choose granularity
+};
+
+// Reads the per-feature boxes of the shapefile at `path` (a .shp) directly, or returns
+// nullopt when `path` is not a shapefile this reader takes (GDAL then reads it). `layer`
+// as for read_items. Throws InvalidGeometry for a bad coordinate, loci::Error when the file
+// cannot be opened or read.
+std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
+                                                   const std::string& layer = {},
+                                                   const Progress& progress = {});
+
+}  // namespace loci::io

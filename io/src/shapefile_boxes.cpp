@@ -1,0 +1,284 @@
+// Per-feature boxes straight from a shapefile's .shx and .shp: see shapefile_boxes.hpp.
+#include "loci/io/shapefile_boxes.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <vector>
+
+#include "gdal_layer.hpp"
+#include "loci/geom/error.hpp"
+
+namespace loci::io {
+
+namespace {
+
+std::uint32_t be32(const unsigned char* p) {
+  return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 | p[3];
+}
+std::uint32_t le32(const unsigned char* p) {
+  return std::uint32_t(p[3]) << 24 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[1]) << 8 | p[0];
+}
+std::uint32_t le16(const unsigned char* p) {
+  return std::uint32_t(p[1]) << 8 | p[0];
+}
+// The shapefile's doubles are little-endian; the caller checked the host is too.
+double le_double(const unsigned char* p) {
+  double d;
+  std::memcpy(&d, p, sizeof d);
+  return d;
+}
+
+// A file read forward in large chunks: get(offset, n) gives n bytes that stay valid until the
+// next call. Records in file order read each byte once; any order stays correct.
+class ChunkReader {
+ public:
+  explicit ChunkReader(const std::string& path) : path_(path) {
+    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd_ < 0) return;
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
+      ::close(fd_);
+      fd_ = -1;
+      return;
+    }
+    size_ = std::uint64_t(st.st_size);
+  }
+  ~ChunkReader() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  ChunkReader(const ChunkReader&) = delete;
+  ChunkReader& operator=(const ChunkReader&) = delete;
+
+  bool is_open() const { return fd_ >= 0; }
+  std::uint64_t size() const { return size_; }
+
+  // Nullptr when [offset, offset + n) runs past the end of the file.
+  const unsigned char* get(std::uint64_t offset, std::uint64_t n) {
+    if (offset > size_ || n > size_ - offset) return nullptr;
+    if (offset >= at_ && offset + n <= at_ + held_) return buffer_.data() + (offset - at_);
+    const std::uint64_t want = std::min(size_ - offset, std::max<std::uint64_t>(n, kChunk));
+    if (buffer_.size() < want) buffer_.resize(want);
+    std::uint64_t done = 0;
+    while (done < want) {
+      const ssize_t r = ::pread(fd_, buffer_.data() + done, want - done, off_t(offset + done));
+      if (r < 0 && errno == EINTR) continue;
+      if (r < 0) throw Error(path_ + ": cannot read (" + std::strerror(errno) + ")");
+      if (r == 0) break;  // shrunk while read: the caller sees too few bytes
+      done += std::uint64_t(r);
+    }
+    at_ = offset;
+    held_ = done;
+    return done >= n ? buffer_.data() : nullptr;
+  }
+
+ private:
+  static constexpr std::uint64_t kChunk = 8u << 20;
+  std::string path_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+  std::vector<unsigned char> buffer_;
+  std::uint64_t at_ = 0, held_ = 0;
+};
+
+// The sibling of a .shp with another extension, in either case as shapefile writers do.
+std::string sibling(const std::string& shp, const char* lower_ext, const char* upper_ext) {
+  const std::string stem = shp.substr(0, shp.size() - 4);
+  for (const char* ext : {lower_ext, upper_ext}) {
+    struct stat st {};
+    if (::stat((stem + ext).c_str(), &st) == 0 && S_ISREG(st.st_mode)) return stem + ext;
+  }
+  return {};
+}
+
+bool is_shp_path(const std::string& path) {
+  if (path.size() < 5) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext)
+    c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".shp";
+}
+
+enum class Kind { point, multipoint, polyline_or_polygon, other };
+
+Kind kind_of(std::uint32_t type) {
+  switch (type) {
+    case 1:
+    case 11:
+    case 21:
+      return Kind::point;
+    case 8:
+    case 18:
+    case 28:
+      return Kind::multipoint;
+    case 3:
+    case 5:
+    case 13:
+    case 15:
+    case 23:
+    case 25:
+      return Kind::polyline_or_polygon;
+    default:
+      return Kind::other;
+  }
+}
+
+bool is_polygon_type(std::uint32_t type) {
+  return type == 5 || type == 15 || type == 25;
+}
+
+// Whether the .dbf holds exactly `count` records, none deleted.
+bool plain_attributes(const std::string& dbf_path, std::uint64_t count) {
+  ChunkReader dbf(dbf_path);
+  if (!dbf.is_open()) return false;
+  const unsigned char* h = dbf.get(0, 32);
+  if (!h) return false;
+  const std::uint64_t records = le32(h + 4), header = le16(h + 8), length = le16(h + 10);
+  if (records != count || length == 0 || header < 32) return false;
+  if (dbf.size() < header + records * length) return false;
+  for (std::uint64_t i = 0; i < records; ++i) {
+    const unsigned char* flag = dbf.get(header + i * length, 1);
+    if (!flag || *flag == '*') return false;
+  }
+  return true;
+}
+
+// Adds one record's points to `box`, refusing a bad coordinate as the GDAL path does.
+void add_points(const unsigned char* xy, std::uint64_t n, Box2& box, const std::string& path,
+                std::int64_t fid) {
+  for (std::uint64_t i = 0; i < n; ++i, xy += 16) {
+    const Point2 p{le_double(xy), le_double(xy + 8)};
+    if (!within_coordinate_range(p)) [[unlikely]]
+      detail::check_layer_point(p, detail::where(path, fid));
+    box.min[0] = std::min(box.min[0], p[0]);
+    box.min[1] = std::min(box.min[1], p[1]);
+    box.max[0] = std::max(box.max[0], p[0]);
+    box.max[1] = std::max(box.max[1], p[1]);
+  }
+}
+
+// A record's contribution: its box and its segments, or nothing for a null shape.
+struct RecordRead {
+  bool ok = false;    // false: hand the file to GDAL
+  bool null = false;  // a null shape: no geometry
+  Box2 box = Box2::empty();
+  std::uint64_t segments = 0;
+};
+
+RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32_t file_type,
+                       const std::string& path, std::int64_t fid) {
+  RecordRead r;
+  if (length < 4) return r;
+  const std::uint32_t type = le32(c);
+  if (type == 0) {
+    r.ok = r.null = true;
+    return r;
+  }
+  if (type != file_type) return r;
+  switch (kind_of(type)) {
+    case Kind::point:
+      if (length < 20) return r;
+      add_points(c + 4, 1, r.box, path, fid);
+      r.segments = 1;  // an isolated point is one zero-length segment
+      break;
+    case Kind::multipoint: {
+      if (length < 40) return r;
+      const std::uint64_t n = le32(c + 36);
+      if (n == 0 || n > (length - 40) / 16) return r;
+      add_points(c + 40, n, r.box, path, fid);
+      r.segments = n;
+      break;
+    }
+    case Kind::polyline_or_polygon: {
+      if (length < 44) return r;
+      const std::uint64_t parts = le32(c + 36), n = le32(c + 40);
+      if (parts == 0 || n == 0 || parts > n || 44 + 4 * parts + 16 * n > length) return r;
+      // Parts start at 0 and each holds at least one point.
+      std::uint64_t previous = 0;
+      for (std::uint64_t i = 0; i < parts; ++i) {
+        const std::uint64_t start = le32(c + 44 + 4 * i);
+        if ((i == 0 && start != 0) || (i > 0 && start <= previous) || start >= n) return r;
+        previous = start;
+      }
+      add_points(c + 44 + 4 * parts, n, r.box, path, fid);
+      r.segments = n - parts;
+      break;
+    }
+    case Kind::other:
+      return r;
+  }
+  check_box(r.box, detail::where(path, fid).c_str());
+  r.ok = true;
+  return r;
+}
+
+}  // namespace
+
+std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
+                                                   const std::string& layer,
+                                                   const Progress& progress) {
+  if constexpr (std::endian::native != std::endian::little) return std::nullopt;
+  if (!is_shp_path(path)) return std::nullopt;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+  const std::string shx_path = sibling(path, ".shx", ".SHX");
+  const std::string dbf_path = sibling(path, ".dbf", ".DBF");
+  if (shx_path.empty() || dbf_path.empty()) return std::nullopt;
+
+  // GDAL opens it: the same errors for a file it refuses, the layer's name, its count.
+  auto ol = detail::open_layer(path, layer);
+  const GDALDriver* driver = ol.dataset->GetDriver();
+  if (!driver || std::strcmp(driver->GetDescription(), "ESRI Shapefile") != 0) return std::nullopt;
+
+  ChunkReader shx(shx_path), shp(path);
+  if (!shx.is_open() || !shp.is_open()) return std::nullopt;
+  const unsigned char* sh = shx.get(0, 100);
+  const unsigned char* ph = shp.get(0, 100);
+  if (!sh || !ph || be32(sh) != 9994 || be32(ph) != 9994 || le32(sh + 28) != 1000 ||
+      le32(ph + 28) != 1000)
+    return std::nullopt;
+  const std::uint32_t file_type = le32(ph + 32);
+  if (le32(sh + 32) != file_type || kind_of(file_type) == Kind::other) return std::nullopt;
+  if (2 * std::uint64_t(be32(sh + 24)) != shx.size() || (shx.size() - 100) % 8 != 0)
+    return std::nullopt;
+  const std::uint64_t count = (shx.size() - 100) / 8;
+  if (ol.layer->GetFeatureCount(FALSE) != GIntBig(count)) return std::nullopt;
+  if (!plain_attributes(dbf_path, count)) return std::nullopt;
+
+  ShapefileBoxes out;
+  LayerItems& items = out.items;
+  items.per = Per::feature;
+  items.layer_name = ol.layer->GetName();
+  items.boxes.reserve(count);
+  items.records.reserve(count);
+  ProgressTicker ticker(progress, double(count));
+  // The index entries are read in chunks too: their 8 bytes each run ahead of the records.
+  for (std::uint64_t i = 0; i < count; ++i) {
+    ticker.tick(double(i + 1));
+    const unsigned char* e = shx.get(100 + 8 * i, 8);
+    if (!e) return std::nullopt;
+    const std::uint64_t offset = 2 * std::uint64_t(be32(e)),
+                        length = 2 * std::uint64_t(be32(e + 4));
+    if (offset < 100) return std::nullopt;
+    const unsigned char* record = shp.get(offset, 8 + length);
+    if (!record || be32(record + 4) != be32(e + 4)) return std::nullopt;
+    const auto fid = std::int64_t(i);
+    const RecordRead r = read_record(record + 8, length, file_type, path, fid);
+    if (!r.ok) return std::nullopt;
+    if (r.null) continue;
+    ++items.features;
+    items.boxes.push_back(r.box);
+    items.records.push_back({fid, 0, 0u});
+    out.segments += r.segments;
+  }
+  items.has_polygons = is_polygon_type(file_type) && items.features > 0;
+  return out;
+}
+
+}  // namespace loci::io
