@@ -208,13 +208,24 @@ IndexReport index_layer(const IndexOptions& options) {
   IndexReport r;
   r.path = options.out_path.empty() ? default_sidecar_path(options.layer_path) : options.out_path;
   refuse_overwriting(r.path, options.layer_path);
-  // Fingerprint first: a layer changing while it is read must not look fresh afterwards.
-  const Fingerprint source = fingerprint_of(options.layer_path);
+  // Sizes, times and inodes before reading and after: a layer changing while it is read must
+  // not look fresh afterwards. The content hash comes from the reader when it had the bytes
+  // (a shapefile read directly), else from a pass of its own.
+  const Fingerprint before = fingerprint_stat(options.layer_path);
   Progress reading;
   if (options.progress) reading = [&](double f) { options.progress(0.9 * f); };
   LayerItems items = options.per
                          ? read_items(options.layer_path, options.layer_name, *options.per, reading)
                          : read_items_choosing(options.layer_path, options.layer_name, reading);
+  Fingerprint source = before;
+  if (items.content_hash)
+    source.hash = *items.content_hash;
+  else
+    source = fingerprint_of(options.layer_path);
+  if (fingerprint_stat(options.layer_path) != before || source.size != before.size ||
+      source.mtime_ns != before.mtime_ns || source.inode != before.inode)
+    throw Error(options.layer_path +
+                ": changed while it was being indexed; run 'loci index' again");
   const Packing packing =
       options.structure == Structure::packed_str ? Packing::str : Packing::hilbert;
   const PackedRTree2 tree = PackedRTree2::build(items.boxes, packing);

@@ -5,6 +5,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <bit>
 #include <cctype>
@@ -39,7 +43,10 @@ double le_double(const unsigned char* p) {
 // next call. Records in file order read each byte once; any order stays correct.
 class ChunkReader {
  public:
-  explicit ChunkReader(const std::string& path) : path_(path) {
+  // With `hash`, the bytes read are hashed as they pass, as long as each read starts within
+  // what was read before (records in file order); hash_rest() then reads and hashes the rest.
+  explicit ChunkReader(const std::string& path, StreamHash* hash = nullptr)
+      : path_(path), hash_(hash) {
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd_ < 0) return;
     struct stat st {};
@@ -75,12 +82,30 @@ class ChunkReader {
     }
     at_ = offset;
     held_ = done;
+    if (hash_ && hashed_ != kBroken) {
+      if (offset > hashed_) {
+        hashed_ = kBroken;  // a gap: the hash needs a pass of its own
+      } else if (offset + done > hashed_) {
+        hash_->update(buffer_.data() + (hashed_ - offset), offset + done - hashed_);
+        hashed_ = offset + done;
+      }
+    }
     return done >= n ? buffer_.data() : nullptr;
+  }
+
+  // Reads what no get() reached; false when the bytes did not pass in order.
+  bool hash_rest() {
+    while (hashed_ != kBroken && hashed_ < size_)
+      if (!get(hashed_, std::min(kChunk, size_ - hashed_))) return false;
+    return hash_ && hashed_ == size_;
   }
 
  private:
   static constexpr std::uint64_t kChunk = 8u << 20;
+  static constexpr std::uint64_t kBroken = ~std::uint64_t(0);
   std::string path_;
+  StreamHash* hash_;
+  std::uint64_t hashed_ = 0;
   int fd_ = -1;
   std::uint64_t size_ = 0;
   std::vector<unsigned char> buffer_;
@@ -149,18 +174,43 @@ bool plain_attributes(const std::string& dbf_path, std::uint64_t count) {
   return true;
 }
 
-// Adds one record's points to `box`, refusing a bad coordinate as the GDAL path does.
+// Adds one record's points to `box`, refusing a bad coordinate as the GDAL path does. The
+// loop keeps no branch per point (a NaN drops out of min and max, so range is tracked apart);
+// the first bad point is looked for only when there is one.
 void add_points(const unsigned char* xy, std::uint64_t n, Box2& box, const std::string& path,
                 std::int64_t fid) {
-  for (std::uint64_t i = 0; i < n; ++i, xy += 16) {
-    const Point2 p{le_double(xy), le_double(xy + 8)};
-    if (!within_coordinate_range(p)) [[unlikely]]
-      detail::check_layer_point(p, detail::where(path, fid));
-    box.min[0] = std::min(box.min[0], p[0]);
-    box.min[1] = std::min(box.min[1], p[1]);
-    box.max[0] = std::max(box.max[0], p[0]);
-    box.max[1] = std::max(box.max[1], p[1]);
+  double lo[2] = {box.min[0], box.min[1]}, hi[2] = {box.max[0], box.max[1]};
+  bool in_range = true;
+#if defined(__SSE2__)
+  // Each point is one (x, y) vector: min, max and the range test take one instruction each.
+  __m128d vlo = _mm_loadu_pd(lo), vhi = _mm_loadu_pd(hi), ok = _mm_castsi128_pd(_mm_set1_epi32(-1));
+  const __m128d limit = _mm_set1_pd(kMaxCoordinate), sign = _mm_set1_pd(-0.0);
+  for (std::uint64_t i = 0; i < n; ++i) {
+    const __m128d p = _mm_loadu_pd(reinterpret_cast<const double*>(xy + 16 * i));
+    ok = _mm_and_pd(ok, _mm_cmple_pd(_mm_andnot_pd(sign, p), limit));
+    vlo = _mm_min_pd(p, vlo);  // a NaN in p gives the second operand
+    vhi = _mm_max_pd(p, vhi);
   }
+  _mm_storeu_pd(lo, vlo);
+  _mm_storeu_pd(hi, vhi);
+  in_range = _mm_movemask_pd(ok) == 3;
+#else
+  for (std::uint64_t i = 0; i < n; ++i) {
+    double p[2];
+    std::memcpy(p, xy + 16 * i, sizeof p);
+    for (int a = 0; a < 2; ++a) {
+      in_range &= p[a] >= -kMaxCoordinate && p[a] <= kMaxCoordinate;
+      lo[a] = p[a] < lo[a] ? p[a] : lo[a];
+      hi[a] = p[a] > hi[a] ? p[a] : hi[a];
+    }
+  }
+#endif
+  if (!in_range) [[unlikely]]
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const Point2 p{le_double(xy + 16 * i), le_double(xy + 16 * i + 8)};
+      if (!within_coordinate_range(p)) detail::check_layer_point(p, detail::where(path, fid));
+    }
+  box = Box2{{lo[0], lo[1]}, {hi[0], hi[1]}};
 }
 
 // A record's contribution: its box and its segments, or nothing for a null shape.
@@ -236,7 +286,8 @@ std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
   const GDALDriver* driver = ol.dataset->GetDriver();
   if (!driver || std::strcmp(driver->GetDescription(), "ESRI Shapefile") != 0) return std::nullopt;
 
-  ChunkReader shx(shx_path), shp(path);
+  StreamHash shp_hash;
+  ChunkReader shx(shx_path), shp(path, &shp_hash);
   if (!shx.is_open() || !shp.is_open()) return std::nullopt;
   const unsigned char* sh = shx.get(0, 100);
   const unsigned char* ph = shp.get(0, 100);
@@ -278,6 +329,13 @@ std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
     out.segments += r.segments;
   }
   items.has_polygons = is_polygon_type(file_type) && items.features > 0;
+  // The fingerprint's hash from the same bytes: the .shp as read, then the (small) .shx, in
+  // the order and with the seeds of fingerprint_of().
+  if (shp.hash_rest()) {
+    StreamHash shx_hash(shp_hash.digest());
+    ChunkReader again(shx_path, &shx_hash);
+    if (again.hash_rest()) items.content_hash = shx_hash.digest();
+  }
   return out;
 }
 

@@ -212,6 +212,25 @@ std::optional<Fingerprint> stat_fingerprint(const std::string& layer_path, bool&
 
 }  // namespace
 
+Fingerprint fingerprint_stat(const std::string& layer_path) {
+  bool regular = false;
+  return stat_fingerprint(layer_path, regular).value_or(Fingerprint{});
+}
+
+struct StreamHash::State {
+  XXH3_state_t xxh;
+};
+StreamHash::StreamHash(std::uint64_t seed) : state_(std::make_unique<State>()) {
+  XXH3_64bits_reset_withSeed(&state_->xxh, seed);
+}
+StreamHash::~StreamHash() = default;
+void StreamHash::update(const void* data, std::size_t size) {
+  XXH3_64bits_update(&state_->xxh, data, size);
+}
+std::uint64_t StreamHash::digest() const {
+  return XXH3_64bits_digest(&state_->xxh);
+}
+
 Fingerprint fingerprint_of(const std::string& layer_path) {
   bool regular = false;
   const auto stat = stat_fingerprint(layer_path, regular);
@@ -223,8 +242,7 @@ Fingerprint fingerprint_of(const std::string& layer_path) {
   for (const auto& file : layer_files(layer_path)) {
     const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) throw Error(file + ": cannot open (" + std::strerror(errno) + ")");
-    XXH3_state_t state;
-    XXH3_64bits_reset_withSeed(&state, f.hash);
+    StreamHash state(f.hash);
     for (;;) {
       const ssize_t n = ::read(fd, buffer.data(), buffer.size());
       if (n < 0 && errno == EINTR) continue;
@@ -234,10 +252,10 @@ Fingerprint fingerprint_of(const std::string& layer_path) {
         throw Error(file + ": cannot read (" + std::strerror(e) + ")");
       }
       if (n == 0) break;
-      XXH3_64bits_update(&state, buffer.data(), std::size_t(n));
+      state.update(buffer.data(), std::size_t(n));
     }
     ::close(fd);
-    f.hash = XXH3_64bits_digest(&state);
+    f.hash = state.digest();
   }
   return f;
 }

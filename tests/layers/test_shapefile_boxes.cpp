@@ -98,6 +98,9 @@ void expect_like_gdal(const std::string& path) {
   EXPECT_EQ(direct->segments, by_segment.records.size());
   EXPECT_EQ(items.has_polygons, by_segment.has_polygons);
   EXPECT_EQ(items.layer_name, by_segment.layer_name);
+  // The fingerprint's hash, from the bytes read, is the one a pass of its own gives.
+  ASSERT_TRUE(items.content_hash);
+  EXPECT_EQ(*items.content_hash, loci::io::fingerprint_of(path).hash);
 }
 
 double coordinate(std::mt19937_64& rng) {

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -51,6 +52,9 @@ struct LayerItems {
   // place): every feature's flattened geometry, so that queries need not read it again.
   std::unordered_map<std::int64_t, FlatGeometry> geometries;
   std::uint64_t features = 0;  // features with a geometry
+  // The hash fingerprint_of() gives the layer's files, when the reader had it from the bytes
+  // it read (a shapefile read directly); else nothing, and the caller hashes them itself.
+  std::optional<std::uint64_t> content_hash;
 };
 
 // Throws like read_segments; features with an empty or missing geometry are skipped.

@@ -34,7 +34,9 @@
 // (for a shapefile, of its .shp and .shx, which hold every geometry and the record offsets).
 // At query time size, modification time and inode are compared, nothing read; only when they
 // differ (a touched, copied or rewritten layer) is the content hashed again, and the index is
-// fresh if size and hash still agree.
+// fresh if size and hash still agree. Sizes, times and inodes are taken before the layer is
+// read and compared after; a shapefile read directly (shapefile_boxes.hpp) has its hash taken
+// from the bytes as they are read, in one pass.
 //
 // Writing goes through AtomicFile (atomic_file.hpp): a hidden temporary file in the same
 // directory, synced, then renamed over the target, so readers see either the old file or the
@@ -87,6 +89,27 @@ struct Fingerprint {
 // file(s) cannot be read. Paths GDAL understands that are not plain files (for instance a
 // database connection) get an empty fingerprint.
 Fingerprint fingerprint_of(const std::string& layer_path);
+
+// Size, modification time and inode only, nothing read (hash 0). Taken before a layer is
+// read and compared after, it catches a layer that changed while it was being indexed.
+Fingerprint fingerprint_stat(const std::string& layer_path);
+
+// XXH3-64 over bytes given in pieces, as fingerprint_of() hashes each file (seeded with the
+// previous file's hash): a reader that streams a layer's files anyway gives the fingerprint's
+// hash without a second pass over them.
+class StreamHash {
+ public:
+  explicit StreamHash(std::uint64_t seed = 0);
+  ~StreamHash();
+  StreamHash(const StreamHash&) = delete;
+  StreamHash& operator=(const StreamHash&) = delete;
+  void update(const void* data, std::size_t size);
+  std::uint64_t digest() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // Whether the layer still holds what `was` was taken of: size, modification time and inode
 // equal (nothing is read), or else the same size and content hash. `now` receives what was
