@@ -217,15 +217,13 @@ IndexReport index_layer(const IndexOptions& options) {
   LayerItems items = options.per
                          ? read_items(options.layer_path, options.layer_name, *options.per, reading)
                          : read_items_choosing(options.layer_path, options.layer_name, reading);
-  Fingerprint source = before;
-  if (items.content_hash)
-    source.hash = *items.content_hash;
-  else
-    source = fingerprint_of(options.layer_path);
-  if (fingerprint_stat(options.layer_path) != before || source.size != before.size ||
-      source.mtime_ns != before.mtime_ns || source.inode != before.inode)
+  Fingerprint source = items.content_hash ? fingerprint_stat(options.layer_path)
+                                          : fingerprint_of(options.layer_path);
+  if (source.size != before.size || source.mtime_ns != before.mtime_ns ||
+      source.inode != before.inode)
     throw Error(options.layer_path +
                 ": changed while it was being indexed; run 'loci index' again");
+  if (items.content_hash) source.hash = *items.content_hash;
   const Packing packing =
       options.structure == Structure::packed_str ? Packing::str : Packing::hilbert;
   const PackedRTree2 tree = PackedRTree2::build(items.boxes, packing);
