@@ -317,17 +317,70 @@ const LayerIndex::Features& LayerIndex::features() const {
     }
     const PackedRTree2* t = packed();
     if (!t || t->size() == 0) return;
-    const std::size_t n = t->size();
+    // Level 0: per leaf of the tree, one node per feature it holds, grouped by feature (a
+    // counting sort that keeps packed order, so that a feature's neighbouring leaves stay
+    // together).
+    const std::size_t n = t->size(), features = f.fid.size();
     f.at.resize(n);
-    f.end.resize(n);
-    for (std::size_t pos = 0; pos < n; ++pos) {
-      const Id id = t->item_at(pos);
-      f.at[pos] = id < f.of_item.size() ? f.of_item[id] : Features::none;
+    const std::span<const std::uint32_t> items = t->item_indices().first(n);
+    for (std::size_t pos = 0; pos < n; ++pos)
+      f.at[pos] = items[pos] < f.of_item.size() ? f.of_item[items[pos]] : Features::none;
+    constexpr std::uint32_t kFanout = 16;
+    static_assert(kFanout == PackedRTree2::node_size);
+    loci::detail::LargeVector<Features::Node> leaves;
+    for (std::size_t b = 0, first = 0; first < n; ++b, first += kFanout) {
+      const std::size_t last = std::min<std::size_t>(first + kFanout, n);
+      std::uint32_t seen[kFanout];
+      int distinct = 0;
+      for (std::size_t pos = first; pos < last; ++pos) {
+        const std::uint32_t g = f.at[pos];
+        if (g != Features::none && std::find(seen, seen + distinct, g) == seen + distinct)
+          seen[distinct++] = g;
+      }
+      // The box the tree stores for the leaf bounds each of its features' parts: looser for a
+      // leaf shared by several features, but no leaf is read until a query reaches it.
+      Box2 box = Box2::empty();
+      if (t->levels() > 1) {
+        box = t->entry_box(1, b);
+      } else {
+        for (std::size_t pos = first; pos < last; ++pos)
+          box.expand(t->box_at(pos));
+      }
+      for (int i = 0; i < distinct; ++i)
+        leaves.push_back({box, seen[i], std::uint32_t(b), std::uint32_t(b)});
     }
-    f.end[n - 1] = static_cast<std::uint32_t>(n);
-    for (std::size_t pos = n - 1; pos-- > 0;)
-      f.end[pos] =
-          f.at[pos] == f.at[pos + 1] ? f.end[pos + 1] : static_cast<std::uint32_t>(pos + 1);
+    std::vector<std::uint32_t> start(features + 1, 0);
+    for (const Features::Node& node : leaves)
+      ++start[node.feature + 1];
+    for (std::size_t i = 0; i < features; ++i)
+      start[i + 1] += start[i];
+    loci::detail::LargeVector<Features::Node> level(leaves.size());
+    for (const Features::Node& node : leaves)
+      level[start[node.feature]++] = node;
+    leaves = {};
+    // Then up to 16 nodes of one feature per node, until each feature has one node, its root.
+    while (!level.empty()) {
+      loci::detail::LargeVector<Features::Node> up;
+      const auto l = std::uint32_t(f.levels.size());
+      for (std::uint32_t i = 0; i < level.size();) {
+        std::uint32_t j = i + 1;
+        while (j < level.size() && level[j].feature == level[i].feature)
+          ++j;
+        if (j - i == 1) {
+          f.roots.emplace_back(l, i);
+        } else {
+          for (std::uint32_t c = i; c < j; c += kFanout) {
+            Features::Node node{Box2::empty(), level[i].feature, c, std::min(c + kFanout, j)};
+            for (std::uint32_t k = node.first; k < node.last; ++k)
+              node.box.expand(level[k].box);
+            up.push_back(node);
+          }
+        }
+        i = j;
+      }
+      f.levels.push_back(std::move(level));
+      level = std::move(up);
+    }
   });
   return features_->value;
 }
@@ -412,21 +465,55 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
         offer(f, distance(geometries_->get(r.fid), p));
       return true;
     };
-    if (per_segment && !features.end.empty()) {
-      // Positions [first, last) cannot change the answer when each of the features of their
-      // first few runs is final or already known at most as far as their box; more runs than
-      // that are kept without looking further.
-      index_.browse(p, visit, [&](std::size_t first, std::size_t last, double box_distance) {
-        int runs = 16;
-        for (std::size_t pos = first; pos < last; pos = features.end[pos]) {
-          if (--runs < 0 || pos >= features.at.size()) return true;
-          const std::uint32_t f = features.at[pos];
-          if (f == LayerIndex::Features::none) return true;
-          const FeatureState& s = state(f);
-          if (!s.done && s.best > box_distance) return true;
+    if (per_segment && !features.roots.empty()) {
+      // Best first over the features' hierarchies (squared distances; level and node packed
+      // in one key), from every feature's root.
+      const PackedRTree2& tree = *index_.packed();
+      const auto all = index_.records();
+      auto later = [](const auto& a, const auto& b) { return a.first > b.first; };
+      auto& heap = walk_;
+      heap.clear();
+      for (const auto& [l, i] : features.roots)
+        heap.emplace_back(squared_distance(p, features.levels[l][i].box),
+                          (std::uint64_t(l) << 32) | i);
+      std::make_heap(heap.begin(), heap.end(), later);
+      while (!heap.empty()) {
+        std::pop_heap(heap.begin(), heap.end(), later);
+        const auto [d2, key] = heap.back();
+        heap.pop_back();
+        const double d = std::sqrt(d2);
+        settle(d);
+        if (found >= q.k) break;
+        const auto level = std::uint32_t(key >> 32);
+        const LayerIndex::Features::Node& node = features.levels[level][key & 0xffffffffu];
+        const FeatureState& s = state(node.feature);
+        if (s.done || s.best <= d) continue;  // nothing here can be nearer
+        if (level == 0) {
+          double best = std::numeric_limits<double>::infinity();
+          const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
+          const std::size_t last = std::min(first + PackedRTree2::node_size, tree.size());
+          for (std::size_t pos = first; pos < last; ++pos) {
+            if (features.at[pos] != node.feature) continue;
+            const Id id = tree.item_at(pos);
+            const Box2 b = tree.box_at(pos);
+            best =
+                std::min(best, candidates_only ? squared_distance(p, b)
+                                               : squared_distance(p, segment_of(b, all[id].flags)));
+          }
+          if (best < std::numeric_limits<double>::infinity()) offer(node.feature, std::sqrt(best));
+          continue;
         }
-        return false;
-      });
+        // Children that cannot improve their feature stay out.
+        const double limit = s.best * s.best;
+        const auto& below = features.levels[level - 1];
+        for (std::uint32_t c = node.first; c < node.last; ++c) {
+          const double c2 = squared_distance(p, below[c].box);
+          if (c2 < limit) {
+            heap.emplace_back(c2, (std::uint64_t(level - 1) << 32) | c);
+            std::push_heap(heap.begin(), heap.end(), later);
+          }
+        }
+      }
     } else {
       index_.browse(p, visit);
     }

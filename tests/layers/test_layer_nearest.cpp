@@ -134,6 +134,17 @@ TEST(LayerNearest, ManySmallFeatures) {
   check(index, l, 12);
 }
 
+// A tree of one leaf (13 segments of 4 features): the features' boxes come from the leaf itself.
+TEST(LayerNearest, OneLeaf) {
+  for (const Structure s : {Structure::packed_hilbert, Structure::packed_str}) {
+    Layer l = interleaved(3, 4, 9);
+    ASSERT_LE(l.items.boxes.size(), 16u);
+    Layer copy = l;
+    const LayerIndex index = LayerIndex::build(std::move(copy.items), s);
+    check(index, l, 14);
+  }
+}
+
 TEST(LayerNearest, InterleavedFeaturesFromASidecar) {
   Layer l = interleaved(40, 200, 6);
   const PackedRTree2 tree = PackedRTree2::build(l.items.boxes);

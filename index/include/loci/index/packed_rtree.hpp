@@ -202,8 +202,13 @@ class PackedRTree {
   // for example (the first hit of a line of sight, without enumerating all it crosses).
   template <class Key, class Visit>
   QueryStats ordered(Key&& key, Visit&& visit) const;
-  // The id of the item at packed position pos < size().
+  // The id and the box of the item at packed position pos < size().
   Id item_at(std::size_t pos) const { return Id(item_index(pos)); }
+  Box<D> box_at(std::size_t pos) const { return leaf_box(pos); }
+  // The box of entry e < level(l).entries of level l (level 0: box_at(e)).
+  Box<D> entry_box(int l, std::size_t e) const {
+    return block(l, e / NodeSize).box(int(e % NodeSize));
+  }
 
   // Throws loci::Error describing the first broken invariant.
   void validate() const;

@@ -22,10 +22,10 @@
 // Nearest-n browses entry boxes by increasing distance (the trees' browse()) and refines with
 // exact distances: a feature is final once its exact distance is no larger than the box
 // distance of the next entry, since every entry not yet seen is at least that far, and the
-// walk stops there. Per segment, a feature's many segments would all come out of the walk
-// before the next feature's; instead a subtree holding segments of one feature only (runs of
-// packed positions, found once per index) is dropped unseen when that feature is final or
-// already known nearer than the subtree; so is a subtree whose few runs all are. --candidates
+// walk stops there. Per segment on a packed tree, the walk goes over one hierarchy of boxes
+// per feature instead (Features): a feature's many segments never come out one by one, a
+// node is dropped unseen when its feature is final or already known at most as far, and the
+// segments of a level-0 node give the feature's exact distance there at once. --candidates
 // answers from boxes alone. Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry
 // and belongs to one thread.
 #pragma once
@@ -104,22 +104,6 @@ class LayerIndex {
         },
         tree_);
   }
-  // browse() that drops what keep(first, last, box_distance) refuses before it is queued:
-  // [first, last) are packed positions (feature_runs()) of a packed tree; the other
-  // structures browse everything.
-  template <class Visit, class Keep>
-  void browse(const Point2& p, Visit&& visit, Keep&& keep) const {
-    if (const PackedRTree2* t = packed()) {
-      t->browse(
-          p,
-          [&](Id id, const Box2& b, double d) {
-            return id < records_.size() ? visit(record(Id(id)), b, d) : true;
-          },
-          keep);
-      return;
-    }
-    browse(p, visit);
-  }
   // visit(record, box, key) for entries in increasing key(box) (>= 0; infinity leaves a box
   // out, and key must not decrease from a node to what it holds) until visit returns false.
   // Packed trees walk nearest key first; the others collect the entries meeting `search`
@@ -149,16 +133,25 @@ class LayerIndex {
   }
   // The features of the index numbered densely (0, 1, ... in order of first appearance), so
   // that per-query state is a flat array: the feature of every item (`none` for a corrupt
-  // record), the FID of every feature, and for a packed tree, per packed position, that
-  // position's feature and one past the last position of the run of entries of one feature
-  // that starts there. Built on first use, once for all threads.
+  // record) and the FID of every feature. For a packed tree, also one hierarchy of boxes per
+  // feature over its entries: a level-0 node is the part of one leaf of the tree that belongs
+  // to one feature (bounded by the leaf's box), a level-l node groups up to 16 level-(l - 1)
+  // nodes of one feature, and `roots` names each feature's top node. Nearest-n walks these: no
+  // node mixes features, so a node of a feature already answered is dropped in one test. Built
+  // on first use, once for all threads.
   struct Features {
     static constexpr std::uint32_t none = 0xffffffffu;
+    struct Node {
+      Box2 box;
+      std::uint32_t feature;
+      std::uint32_t first, last;  // level 0: the leaf; above: its nodes one level down
+    };
     loci::detail::LargeVector<std::uint32_t> of_item;
     std::vector<std::int64_t> fid;
     std::unordered_map<std::int64_t, std::uint32_t> number;  // fid -> feature
     loci::detail::LargeVector<std::uint32_t> at;             // packed trees: per position
-    loci::detail::LargeVector<std::uint32_t> end;            // packed trees: per position
+    std::vector<loci::detail::LargeVector<Node>> levels;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> roots;  // (level, node) per feature
   };
   const Features& features() const;
 
@@ -253,6 +246,7 @@ class LayerQuery {
   };
   std::vector<FeatureState> state_;
   std::uint32_t generation_ = 0;
+  std::vector<std::pair<double, std::uint64_t>> walk_;  // nearest-n's queue, kept between queries
 };
 
 }  // namespace loci::io
