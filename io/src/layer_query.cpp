@@ -316,7 +316,7 @@ const LayerIndex::Features& LayerIndex::features() const {
       f.of_item[id] = last;
     }
     const PackedRTree2* t = packed();
-    if (!t || t->size() == 0) return;
+    if (!t || t->size() == 0 || per_ != Per::segment) return;  // only per segment walks them
     // Level 0: per leaf of the tree, one node per feature it holds, grouped by feature (a
     // counting sort that keeps packed order, so that a feature's neighbouring leaves stay
     // together).

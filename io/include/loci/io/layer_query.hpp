@@ -133,12 +133,12 @@ class LayerIndex {
   }
   // The features of the index numbered densely (0, 1, ... in order of first appearance), so
   // that per-query state is a flat array: the feature of every item (`none` for a corrupt
-  // record) and the FID of every feature. For a packed tree, also one hierarchy of boxes per
-  // feature over its entries: a level-0 node is the part of one leaf of the tree that belongs
-  // to one feature (bounded by the leaf's box), a level-l node groups up to 16 level-(l - 1)
-  // nodes of one feature, and `roots` names each feature's top node. Nearest-n walks these: no
-  // node mixes features, so a node of a feature already answered is dropped in one test. Built
-  // on first use, once for all threads.
+  // record) and the FID of every feature. For a packed tree per segment, also one hierarchy
+  // of boxes per feature over its entries: a level-0 node is the part of one leaf of the tree
+  // that belongs to one feature (bounded by the leaf's box), a level-l node groups up to 16
+  // level-(l - 1) nodes of one feature, and `roots` names each feature's top node. Nearest-n
+  // walks these: no node mixes features, so a node of a feature already answered is dropped
+  // in one test. Built on first use, once for all threads.
   struct Features {
     static constexpr std::uint32_t none = 0xffffffffu;
     struct Node {
@@ -149,7 +149,7 @@ class LayerIndex {
     loci::detail::LargeVector<std::uint32_t> of_item;
     std::vector<std::int64_t> fid;
     std::unordered_map<std::int64_t, std::uint32_t> number;  // fid -> feature
-    loci::detail::LargeVector<std::uint32_t> at;             // packed trees: per position
+    loci::detail::LargeVector<std::uint32_t> at;             // per position, as levels
     std::vector<loci::detail::LargeVector<Node>> levels;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> roots;  // (level, node) per feature
   };
