@@ -25,6 +25,7 @@
 #include <utility>
 #include <vector>
 
+#include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/packed_rtree.hpp"
 #include "loci/index/rstar_tree.hpp"
 
@@ -220,17 +221,33 @@ class RTreeIndex {
   void window(const Window& w, std::vector<Hit>& out) {
     if (w.empty()) return;
     const Box2 prune = w.prune();
+    // The base's items are numbered in packed order (repack, load), so ids_ is read by packed
+    // position, its lines fetched as soon as a leaf is queued.
+    const RowId* ids = ids_.data();
+    const std::size_t last = ids_.empty() ? 0 : ids_.size() - 1;
+    const auto ahead = [ids, last](std::size_t pos) {
+      __builtin_prefetch(ids + std::min(pos, last));
+      __builtin_prefetch(ids + std::min(pos + 8, last));
+    };
     if (w.prune_is_exact() && dead_.empty()) {
-      base_.query(prune, [&](Id item, const Box2& b) {
-        out.push_back({ids_[item], b});
-        return true;
-      });
+      base_.query_packed(
+          prune,
+          [&](std::size_t pos, const Box2& b) {
+            if (out.size() == out.capacity()) [[unlikely]]
+              out.reserve(2 * out.size() + 64);
+            out.push_back({ids[pos], b});
+            return true;
+          },
+          ahead);
     } else {
-      base_.query(prune, [&](Id item, const Box2& b) {
-        const RowId id = ids_[item];
-        if (w.matches(b) && (dead_.empty() || !dead_.count(id))) out.push_back({id, b});
-        return true;
-      });
+      base_.query_packed(
+          prune,
+          [&](std::size_t pos, const Box2& b) {
+            const RowId id = ids[pos];
+            if (w.matches(b) && (dead_.empty() || !dead_.count(id))) out.push_back({id, b});
+            return true;
+          },
+          ahead);
     }
     if (delta_.empty()) return;
     if (delta_.size() < 64) {
@@ -315,8 +332,7 @@ class RTreeIndex {
     const std::size_t n = rows.size();
     auto arrays = std::make_shared<Arrays>();
     const auto blocks = built.blocks();
-    arrays->blocks.reset(new Block[blocks.size()]);
-    std::copy(blocks.begin(), blocks.end(), arrays->blocks.get());
+    arrays->blocks.assign(blocks.begin(), blocks.end());
     const auto items = built.item_indices();
     arrays->items.resize(items.size());
     ids_.assign(n, 0);
@@ -324,8 +340,7 @@ class RTreeIndex {
       arrays->items[pos] = pos < n ? std::uint32_t(pos) : items[pos];  // unused slots as built
       if (pos < n) ids_[pos] = rows[items[pos]].id;
     }
-    base_ = Packed::adopt(n, Packing::hilbert,
-                          std::span<const Block>(arrays->blocks.get(), blocks.size()),
+    base_ = Packed::adopt(n, Packing::hilbert, std::span<const Block>(arrays->blocks),
                           arrays->items, arrays);
     base_arrays_ = arrays;
     index_by_id();
@@ -371,14 +386,14 @@ class RTreeIndex {
     auto arrays = std::make_shared<Arrays>();
     const std::size_t blocks = Packed::block_count(n);
     const std::size_t slots = n == 0 ? 0 : Packed::layout(n)[0].blocks * Packed::node_size;
-    arrays->blocks.reset(new Block[blocks]);
+    arrays->blocks.resize(blocks);
     arrays->items.resize(slots);
     x.ids_.resize(n);
     x.by_id_.resize(n);
     const auto fill = [&](auto& span) {
       if (!read(std::as_writable_bytes(span))) throw Error("the %_node payload is truncated");
     };
-    std::span<Block> bs(arrays->blocks.get(), blocks);
+    std::span<Block> bs(arrays->blocks);
     std::span<std::uint32_t> is(arrays->items);
     std::span<RowId> ids(x.ids_);
     std::span<std::uint32_t> order(x.by_id_);
@@ -388,6 +403,18 @@ class RTreeIndex {
     x.base_ = Packed::adopt(n, Packing(h.packing), bs, is, arrays);
     x.base_arrays_ = arrays;
     x.base_.validate();
+    // Number the items in packed order, as repack() does, if an older writer did not.
+    bool packed_order = true;
+    for (std::size_t pos = 0; pos < n && packed_order; ++pos)
+      packed_order = is[pos] == pos;
+    if (!packed_order) {
+      detail::LargeVector<RowId> by_position(n);
+      for (std::size_t pos = 0; pos < n; ++pos)
+        by_position[pos] = x.ids_[is[pos]];
+      x.ids_.swap(by_position);
+      for (std::size_t pos = 0; pos < n; ++pos)
+        is[pos] = std::uint32_t(pos);
+    }
     for (std::size_t j = 0; j < n; ++j) {
       if (x.by_id_[j] >= n) throw Error("the %_node id order points outside the tree");
       if (j > 0 && !(x.id_at(j - 1) < x.id_at(j)))
@@ -432,9 +459,10 @@ class RTreeIndex {
 
  private:
   static constexpr std::size_t kAbsent = std::size_t(-1);
+  // Large arrays ask for huge pages: a query's cache misses then cost no page walk as well.
   struct Arrays {
-    std::unique_ptr<Block[]> blocks;
-    std::vector<std::uint32_t> items;
+    detail::LargeVector<Block> blocks;
+    detail::LargeVector<std::uint32_t> items;
   };
 
   static std::uint64_t payload_bytes(std::uint64_t n) {
@@ -501,7 +529,7 @@ class RTreeIndex {
 
   Packed base_;
   std::shared_ptr<Arrays> base_arrays_;  // the base's memory when it was loaded
-  std::vector<RowId> ids_;               // builder index -> id
+  detail::LargeVector<RowId> ids_;       // builder index (= packed position) -> id
   std::vector<std::uint32_t> by_id_;     // packed positions sorted by id
   std::unordered_set<RowId> dead_;
   std::unordered_map<RowId, Box2> delta_;

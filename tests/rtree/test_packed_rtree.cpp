@@ -34,6 +34,23 @@ void check_tree(const std::vector<Box<D>>& boxes, Packing packing, std::uint64_t
       const auto expected = brute_window(boxes, ids, w, rel);
       ASSERT_EQ(sorted(tree.query(w, rel)), expected)
           << "window " << to_string(w) << " rel " << int(rel);
+      // By packed position: the same items, each leaf announced before it is read.
+      std::vector<Id> by_position;
+      std::vector<bool> announced((boxes.size() + N - 1) / N + 1, false);
+      tree.query_packed(
+          w,
+          [&](std::size_t pos, const Box<D>& b) {
+            EXPECT_TRUE(announced[pos / N]) << pos;
+            EXPECT_TRUE(b == tree.box_at(pos));
+            by_position.push_back(tree.item_at(pos));
+            return true;
+          },
+          [&](std::size_t pos) {
+            EXPECT_EQ(pos % N, 0u);
+            announced[pos / N] = true;
+          },
+          rel);
+      ASSERT_EQ(sorted(by_position), expected) << "window " << to_string(w) << " rel " << int(rel);
       total_hits += expected.size();
     }
   }
@@ -110,6 +127,22 @@ TEST(PackedRTree, VisitorStopsEarly) {
   seen = 0;
   tree.nearest(Point2{500, 500}, 50, [&](Id, const Box2&, double) { return ++seen < 7; });
   EXPECT_EQ(seen, 7u);
+  const auto no_ahead = [](std::size_t) {};
+  seen = 0;  // whole subtrees reported in runs
+  tree.query_packed(
+      Box2{{-1e9, -1e9}, {1e9, 1e9}}, [&](std::size_t, const Box2&) { return ++seen < 40; },
+      no_ahead);
+  EXPECT_EQ(seen, 40u);
+  // Every leaf tested: boxes around the origin, the ones containing it asked for.
+  std::vector<Box2> around(3000);
+  for (std::size_t i = 0; i < around.size(); ++i)
+    around[i] = {{-1.0 - double(i), -2.0}, {1.0, 2.0 + double(i)}};
+  const auto nested = PackedRTree<2>::build(around);
+  seen = 0;
+  nested.query_packed(
+      Box2{{0, 0}, {0, 0}}, [&](std::size_t, const Box2&) { return ++seen < 40; }, no_ahead,
+      Relation::contains);
+  EXPECT_EQ(seen, 40u);
 }
 
 TEST(PackedRTree, NearestReportsBoxesAndOrder) {

@@ -176,6 +176,15 @@ class PackedRTree {
   std::vector<Id> query(const Box<D>& window, Relation rel = Relation::intersects) const {
     return collect_ids([&](auto&& v) { return query(window, v, rel); });
   }
+  // query() for a caller that keeps its own arrays in packed order: visit(pos, box) gets the
+  // packed position (item_at(pos) is the id). ahead(pos) announces the leaf holding positions
+  // [pos, pos + node_size) before any of them is visited, as early as the walk knows it will
+  // read that leaf, so the caller can prefetch what it will read for them.
+  template <class Visit, class Ahead>
+  QueryStats query_packed(const Box<D>& window, Visit&& visit, Ahead&& ahead,
+                          Relation rel = Relation::intersects) const {
+    return walk_window<true>(window, visit, ahead, rel);
+  }
 
   // Calls visit(id, box, distance) for the k items nearest to p, nearest first; stops when it
   // returns false. Throws InvalidArgument for k = 0, InvalidGeometry for a bad point.
@@ -254,8 +263,11 @@ class PackedRTree {
   void order_str(std::span<const Box<D>> boxes, std::uint32_t* order) const;
   void tile(Item* base, std::size_t first, std::size_t count, std::size_t cap) const;
 
-  template <class Visit>
-  bool report_run(std::size_t first, std::size_t last, Visit& visit, QueryStats& s) const;
+  template <bool ByPosition, class Visit, class Ahead>
+  bool report_run(std::size_t first, std::size_t last, Visit& visit, Ahead& ahead,
+                  QueryStats& s) const;
+  template <bool ByPosition, class Visit, class Ahead>
+  QueryStats walk_window(const Box<D>& window, Visit& visit, Ahead& ahead, Relation rel) const;
 
   std::size_t size_ = 0;
   Packing packing_ = Packing::hilbert;
@@ -374,13 +386,20 @@ Box<D> PackedRTree<D, NodeSize>::item_box(Id id) const {
 }
 
 template <int D, int NodeSize>
-template <class Visit>
+template <bool ByPosition, class Visit, class Ahead>
 bool PackedRTree<D, NodeSize>::report_run(std::size_t first, std::size_t last, Visit& visit,
-                                          QueryStats& s) const {
+                                          Ahead& ahead, QueryStats& s) const {
+  // first is the start of a leaf; each leaf is announced while the one before it is read.
   last = std::min(last, size_);
+  if (first < last) ahead(first);
   for (std::size_t pos = first; pos < last; ++pos) {
     ++s.results;
-    if (!visit(Id(item_index(pos)), leaf_box(pos))) return false;
+    if (pos % NodeSize == 0 && pos + NodeSize < last) ahead(pos + NodeSize);
+    if constexpr (ByPosition) {
+      if (!visit(pos, leaf_box(pos))) return false;
+    } else {
+      if (!visit(Id(item_index(pos)), leaf_box(pos))) return false;
+    }
   }
   return true;
 }
@@ -389,12 +408,57 @@ template <int D, int NodeSize>
 template <WindowVisitor<D> Visit>
 QueryStats PackedRTree<D, NodeSize>::query(const Box<D>& window, Visit&& visit,
                                            Relation rel) const {
+  const auto no_ahead = [](std::size_t) {};
+  return walk_window<false>(window, visit, no_ahead, rel);
+}
+
+template <int D, int NodeSize>
+template <bool ByPosition, class Visit, class Ahead>
+QueryStats PackedRTree<D, NodeSize>::walk_window(const Box<D>& window, Visit& visit, Ahead& ahead,
+                                                 Relation rel) const {
   check_box(window, "query window");
   QueryStats s;
   if (empty()) return s;
-  detail::Scratch<std::uint64_t> scratch;
-  auto& stack = *scratch;
-  stack.push_back(std::uint64_t(levels() - 1) << 32);
+  // The internal levels are walked depth first. The leaves they lead to are not read at once:
+  // each is fetched as soon as it is found and read a little later, a batch at a time, so the
+  // cache misses of a batch overlap instead of following one another.
+  detail::Scratch<std::uint64_t> stack_scratch, leaf_scratch;
+  auto& stack = *stack_scratch;
+  auto& leaves = *leaf_scratch;  // leaf block << 1 | 1 when the whole leaf is inside
+  constexpr std::size_t kBatch = 32;
+  const auto read_leaves = [&]() -> bool {
+    for (const std::uint64_t x : leaves) {
+      const std::size_t b = std::size_t(x >> 1);
+      if (x & 1) {
+        if (!report_run<ByPosition>(b * NodeSize, (b + 1) * NodeSize, visit, ahead, s))
+          return false;
+        continue;
+      }
+      const Block& node = block(0, b);
+      ++s.nodes_visited;
+      s.entries_tested += std::min<std::size_t>(NodeSize, level(0).entries - b * NodeSize);
+      auto hits = rel == Relation::contains ? node.containing(window) : node.intersecting(window);
+      if (rel == Relation::within) hits &= node.inside(window);
+      const std::size_t base = b * NodeSize;
+      while (hits) {
+        const int i = detail::pop_lowest(hits);
+        ++s.results;
+        if constexpr (ByPosition) {
+          if (!visit(base + std::size_t(i), node.box(i))) return false;
+        } else {
+          if (!visit(Id(item_index(base + std::size_t(i))), node.box(i))) return false;
+        }
+      }
+    }
+    leaves.clear();
+    return true;
+  };
+  if (levels() == 1) {
+    ahead(std::size_t(0));
+    leaves.push_back(0);
+  } else {
+    stack.push_back(std::uint64_t(levels() - 1) << 32);
+  }
   while (!stack.empty()) {
     const std::uint64_t top = stack.back();
     stack.pop_back();
@@ -406,28 +470,34 @@ QueryStats PackedRTree<D, NodeSize>::query(const Box<D>& window, Visit&& visit,
     auto hits = rel == Relation::contains ? node.containing(window) : node.intersecting(window);
     if (!hits) continue;
     const std::size_t base = b * NodeSize;
-    if (level == 0) {
-      if (rel == Relation::within) hits &= node.inside(window);
-      while (hits) {
-        const int i = detail::pop_lowest(hits);
-        ++s.results;
-        if (!visit(Id(item_index(base + i)), node.box(i))) return s;
-      }
-      continue;
-    }
     auto inside = rel == Relation::contains ? decltype(hits)(0) : node.inside(window) & hits;
     hits &= ~inside;
+    if (level == 1) {
+      for (auto all = hits | inside; all;) {
+        const int i = detail::pop_lowest(all);
+        const std::size_t e = base + std::size_t(i);
+        block(0, e).prefetch();
+        ahead(e * NodeSize);
+        leaves.push_back(std::uint64_t(e) << 1 | ((inside >> i) & 1u));
+      }
+      if (leaves.size() >= kBatch && !read_leaves()) return s;
+      continue;
+    }
+    // Fetch every child at once; the stack is filled from the last, so the first is tested
+    // first.
+    for (auto all = hits | inside; all;)
+      block(level - 1, base + std::size_t(detail::pop_lowest(all))).prefetch();
     while (inside) {
-      const std::size_t e = base + detail::pop_lowest(inside);
+      const std::size_t e = base + std::size_t(detail::pop_lowest(inside));
       const std::size_t span = this->level(level).span;
-      if (!report_run(e * span, (e + 1) * span, visit, s)) return s;
+      if (!report_run<ByPosition>(e * span, (e + 1) * span, visit, ahead, s)) return s;
     }
     while (hits) {
-      const std::size_t e = base + detail::pop_lowest(hits);
-      block(level - 1, e).prefetch();
-      stack.push_back((std::uint64_t(level - 1) << 32) | e);
+      const int i = detail::pop_highest(hits);
+      stack.push_back((std::uint64_t(level - 1) << 32) | (base + std::size_t(i)));
     }
   }
+  read_leaves();
   return s;
 }
 

@@ -199,4 +199,11 @@ inline int pop_lowest(Mask& m) {
   return i;
 }
 
+template <class Mask>
+inline int pop_highest(Mask& m) {
+  const int i = std::bit_width(m) - 1;
+  m &= ~(Mask(1) << i);
+  return i;
+}
+
 }  // namespace loci::detail
