@@ -263,6 +263,15 @@ class PackedRTree {
   void order_str(std::span<const Box<D>> boxes, std::uint32_t* order) const;
   void tile(Item* base, std::size_t first, std::size_t count, std::size_t cap) const;
 
+  // Counts and reports the item at packed position pos (by position or by id).
+  template <bool ByPosition, class Visit>
+  bool report(std::size_t pos, const Box<D>& box, Visit& visit, QueryStats& s) const {
+    ++s.results;
+    if constexpr (ByPosition)
+      return visit(pos, box);
+    else
+      return visit(Id(item_index(pos)), box);
+  }
   template <bool ByPosition, class Visit, class Ahead>
   bool report_run(std::size_t first, std::size_t last, Visit& visit, Ahead& ahead,
                   QueryStats& s) const;
@@ -393,13 +402,8 @@ bool PackedRTree<D, NodeSize>::report_run(std::size_t first, std::size_t last, V
   last = std::min(last, size_);
   if (first < last) ahead(first);
   for (std::size_t pos = first; pos < last; ++pos) {
-    ++s.results;
     if (pos % NodeSize == 0 && pos + NodeSize < last) ahead(pos + NodeSize);
-    if constexpr (ByPosition) {
-      if (!visit(pos, leaf_box(pos))) return false;
-    } else {
-      if (!visit(Id(item_index(pos)), leaf_box(pos))) return false;
-    }
+    if (!report<ByPosition>(pos, leaf_box(pos), visit, s)) return false;
   }
   return true;
 }
@@ -442,12 +446,7 @@ QueryStats PackedRTree<D, NodeSize>::walk_window(const Box<D>& window, Visit& vi
       const std::size_t base = b * NodeSize;
       while (hits) {
         const int i = detail::pop_lowest(hits);
-        ++s.results;
-        if constexpr (ByPosition) {
-          if (!visit(base + std::size_t(i), node.box(i))) return false;
-        } else {
-          if (!visit(Id(item_index(base + std::size_t(i))), node.box(i))) return false;
-        }
+        if (!report<ByPosition>(base + std::size_t(i), node.box(i), visit, s)) return false;
       }
     }
     leaves.clear();
