@@ -212,8 +212,10 @@ IndexReport index_layer(const IndexOptions& options) {
   // not look fresh afterwards. The content hash comes from the reader when it had the bytes
   // (a shapefile read directly), else from a pass of its own.
   const Fingerprint before = fingerprint_stat(options.layer_path);
+  // Reading takes most of the bar; packing and writing, which for a shapefile read directly
+  // take as long, the rest.
   Progress reading;
-  if (options.progress) reading = [&](double f) { options.progress(0.9 * f); };
+  if (options.progress) reading = [&](double f) { options.progress(0.6 * f); };
   LayerItems items = options.per
                          ? read_items(options.layer_path, options.layer_name, *options.per, reading)
                          : read_items_choosing(options.layer_path, options.layer_name, reading);
@@ -227,6 +229,7 @@ IndexReport index_layer(const IndexOptions& options) {
   const Packing packing =
       options.structure == Structure::packed_str ? Packing::str : Packing::hilbert;
   const PackedRTree2 tree = PackedRTree2::build(items.boxes, packing);
+  if (options.progress) options.progress(0.8);
   SidecarInfo info;
   info.per = items.per;
   info.per_chosen = !options.per;

@@ -91,11 +91,9 @@ void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& pat
         detail::check_layer_point(a, where(path, fid));
         detail::check_layer_point(b, where(path, fid));
       }
-      const Segment2 s{a, b};
       // The box keeps the segment when we also know which diagonal of it the segment is.
-      const bool anti = (a[0] < b[0]) != (a[1] < b[1]) && a[0] != b[0] && a[1] != b[1];
-      out.boxes.push_back(s.box());
-      out.records.push_back({fid, part, (ring ? item_ring : 0u) | (anti ? item_antidiagonal : 0u)});
+      out.boxes.push_back(Segment2{a, b}.box());
+      out.records.push_back({fid, part, segment_flags(a, b, ring)});
     }
     ++part;
   });
@@ -168,6 +166,8 @@ LayerItems read_items(const std::string& path, const std::string& layer, Per per
   // reads a shapefile's features by FID in place: there are no geometries to keep).
   if (per == Per::feature)
     if (auto direct = read_shapefile_boxes(path, layer, progress)) return std::move(direct->items);
+  if (per == Per::segment)
+    if (auto direct = read_shapefile_segments(path, layer, progress)) return std::move(*direct);
   LayerItems out;
   out.per = per;
   read_layer_items(path, layer, progress, keep_geometries, per == Per::feature ? &out : nullptr,
@@ -180,19 +180,19 @@ LayerItems read_items_choosing(const std::string& path, const std::string& layer
   const auto segments_serve = [](std::uint64_t segments, std::uint64_t features) {
     return features > 0 && segments >= kSegmentsPerFeatureForSegments * features;
   };
-  // The direct pass is quick beside a per-segment read through GDAL: it takes the first tenth
-  // of the progress bar, the GDAL pass (when segments serve) the rest.
+  // A shapefile is read directly, boxes first; when segments serve, a second direct pass
+  // (about twice the work: it writes every segment) reads them.
   Progress first, rest;
   if (progress) {
-    first = [&](double f) { progress(0.1 * f); };
-    rest = [&](double f) { progress(0.1 + 0.9 * f); };
+    first = [&](double f) { progress(0.3 * f); };
+    rest = [&](double f) { progress(0.3 + 0.7 * f); };
   }
   if (auto direct = read_shapefile_boxes(path, layer, first)) {
     if (!segments_serve(direct->segments, direct->items.features)) {
       if (progress) progress(1.0);
       return std::move(direct->items);
     }
-    // The content hash stays that of the direct pass: the caller's before-and-after check of
+    // The content hash stays that of the first pass: the caller's before-and-after check of
     // sizes, times and inodes covers both passes.
     LayerItems by_segment = read_items(path, layer, Per::segment, rest);
     by_segment.content_hash = direct->items.content_hash;

@@ -101,7 +101,7 @@ class ChunkReader {
   }
 
  private:
-  static constexpr std::uint64_t kChunk = 8u << 20;
+  static constexpr std::uint64_t kChunk = 256u << 10;
   static constexpr std::uint64_t kBroken = ~std::uint64_t(0);
   std::string path_;
   StreamHash* hash_;
@@ -183,17 +183,36 @@ void add_points(const unsigned char* xy, std::uint64_t n, Box2& box, const std::
   bool in_range = true;
 #if defined(__SSE2__)
   // Each point is one (x, y) vector: min, max and the range test take one instruction each.
-  __m128d vlo = _mm_loadu_pd(lo), vhi = _mm_loadu_pd(hi), ok = _mm_castsi128_pd(_mm_set1_epi32(-1));
-  const __m128d limit = _mm_set1_pd(kMaxCoordinate), sign = _mm_set1_pd(-0.0);
-  for (std::uint64_t i = 0; i < n; ++i) {
-    const __m128d p = _mm_loadu_pd(reinterpret_cast<const double*>(xy + 16 * i));
-    ok = _mm_and_pd(ok, _mm_cmple_pd(_mm_andnot_pd(sign, p), limit));
-    vlo = _mm_min_pd(p, vlo);  // a NaN in p gives the second operand
-    vhi = _mm_max_pd(p, vhi);
+  // Four points at a time into four sets of accumulators, so that the minimum and maximum of
+  // one point need not wait for those of the previous one.
+  constexpr int kWays = 4;
+  __m128d vlo[kWays], vhi[kWays], ok[kWays];
+  for (int k = 0; k < kWays; ++k) {
+    vlo[k] = _mm_loadu_pd(lo);
+    vhi[k] = _mm_loadu_pd(hi);
+    ok[k] = _mm_castsi128_pd(_mm_set1_epi32(-1));
   }
-  _mm_storeu_pd(lo, vlo);
-  _mm_storeu_pd(hi, vhi);
-  in_range = _mm_movemask_pd(ok) == 3;
+  const __m128d limit = _mm_set1_pd(kMaxCoordinate), sign = _mm_set1_pd(-0.0);
+  const auto add = [&](int k, std::uint64_t i) {
+    const __m128d p = _mm_loadu_pd(reinterpret_cast<const double*>(xy + 16 * i));
+    ok[k] = _mm_and_pd(ok[k], _mm_cmple_pd(_mm_andnot_pd(sign, p), limit));
+    vlo[k] = _mm_min_pd(p, vlo[k]);  // a NaN in p gives the second operand
+    vhi[k] = _mm_max_pd(p, vhi[k]);
+  };
+  std::uint64_t i = 0;
+  for (; i + kWays <= n; i += kWays)
+    for (int k = 0; k < kWays; ++k)
+      add(k, i + std::uint64_t(k));
+  for (; i < n; ++i)
+    add(0, i);
+  for (int k = 1; k < kWays; ++k) {
+    vlo[0] = _mm_min_pd(vlo[k], vlo[0]);
+    vhi[0] = _mm_max_pd(vhi[k], vhi[0]);
+    ok[0] = _mm_and_pd(ok[k], ok[0]);
+  }
+  _mm_storeu_pd(lo, vlo[0]);
+  _mm_storeu_pd(hi, vhi[0]);
+  in_range = _mm_movemask_pd(ok[0]) == 3;
 #else
   for (std::uint64_t i = 0; i < n; ++i) {
     double p[2];
@@ -268,66 +287,60 @@ RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32
   return r;
 }
 
-}  // namespace
-
-std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
-                                                   const std::string& layer,
-                                                   const Progress& progress) {
-  if constexpr (std::endian::native != std::endian::little) return std::nullopt;
-  if (!is_shp_path(path)) return std::nullopt;
+// Checks that the shapefile at `path` is one this reader takes, then reads and checks each
+// record in file order (read_record) and hands each shape to `add(read, fid, content,
+// file_type)`, counting it in `items`; `items` gets the layer's name, whether it holds
+// polygons and the fingerprint's hash from the bytes read. False: GDAL must read the file.
+template <class Add>
+bool scan_shapefile(const std::string& path, const std::string& layer, const Progress& progress,
+                    LayerItems& items, Add&& add) {
+  if constexpr (std::endian::native != std::endian::little) return false;
+  if (!is_shp_path(path)) return false;
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
   const std::string shx_path = sibling(path, ".shx", ".SHX");
   const std::string dbf_path = sibling(path, ".dbf", ".DBF");
-  if (shx_path.empty() || dbf_path.empty()) return std::nullopt;
+  if (shx_path.empty() || dbf_path.empty()) return false;
 
   // GDAL opens it: the same errors for a file it refuses, the layer's name, its count.
   auto ol = detail::open_layer(path, layer);
   const GDALDriver* driver = ol.dataset->GetDriver();
-  if (!driver || std::strcmp(driver->GetDescription(), "ESRI Shapefile") != 0) return std::nullopt;
+  if (!driver || std::strcmp(driver->GetDescription(), "ESRI Shapefile") != 0) return false;
 
   StreamHash shp_hash;
   ChunkReader shx(shx_path), shp(path, &shp_hash);
-  if (!shx.is_open() || !shp.is_open()) return std::nullopt;
+  if (!shx.is_open() || !shp.is_open()) return false;
   const unsigned char* sh = shx.get(0, 100);
   const unsigned char* ph = shp.get(0, 100);
   if (!sh || !ph || be32(sh) != 9994 || be32(ph) != 9994 || le32(sh + 28) != 1000 ||
       le32(ph + 28) != 1000)
-    return std::nullopt;
+    return false;
   const std::uint32_t file_type = le32(ph + 32);
-  if (le32(sh + 32) != file_type || kind_of(file_type) == Kind::other) return std::nullopt;
-  if (2 * std::uint64_t(be32(sh + 24)) != shx.size() || (shx.size() - 100) % 8 != 0)
-    return std::nullopt;
+  if (le32(sh + 32) != file_type || kind_of(file_type) == Kind::other) return false;
+  if (2 * std::uint64_t(be32(sh + 24)) != shx.size() || (shx.size() - 100) % 8 != 0) return false;
   const std::uint64_t count = (shx.size() - 100) / 8;
-  if (ol.layer->GetFeatureCount(FALSE) != GIntBig(count)) return std::nullopt;
-  if (!plain_attributes(dbf_path, count)) return std::nullopt;
+  if (ol.layer->GetFeatureCount(FALSE) != GIntBig(count)) return false;
+  if (!plain_attributes(dbf_path, count)) return false;
 
-  ShapefileBoxes out;
-  LayerItems& items = out.items;
-  items.per = Per::feature;
-  items.layer_name = ol.layer->GetName();
-  items.boxes.reserve(count);
-  items.records.reserve(count);
   ProgressTicker ticker(progress, double(count));
   // The index entries are read in chunks too: their 8 bytes each run ahead of the records.
   for (std::uint64_t i = 0; i < count; ++i) {
     ticker.tick(double(i + 1));
     const unsigned char* e = shx.get(100 + 8 * i, 8);
-    if (!e) return std::nullopt;
+    if (!e) return false;
     const std::uint64_t offset = 2 * std::uint64_t(be32(e)),
                         length = 2 * std::uint64_t(be32(e + 4));
-    if (offset < 100) return std::nullopt;
+    if (offset < 100) return false;
     const unsigned char* record = shp.get(offset, 8 + length);
-    if (!record || be32(record + 4) != be32(e + 4)) return std::nullopt;
+    if (!record || be32(record + 4) != be32(e + 4)) return false;
     const auto fid = std::int64_t(i);
     const RecordRead r = read_record(record + 8, length, file_type, path, fid);
-    if (!r.ok) return std::nullopt;
+    if (!r.ok) return false;
     if (r.null) continue;
     ++items.features;
-    items.boxes.push_back(r.box);
-    items.records.push_back({fid, 0, 0u});
-    out.segments += r.segments;
+    add(r, fid, record + 8, file_type);
   }
+  items.layer_name = ol.layer->GetName();
   items.has_polygons = is_polygon_type(file_type) && items.features > 0;
   // The fingerprint's hash from the same bytes: the .shp as read, then the (small) .shx, in
   // the order and with the seeds of fingerprint_of().
@@ -336,7 +349,87 @@ std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
     ChunkReader again(shx_path, &shx_hash);
     if (again.hash_rest()) items.content_hash = shx_hash.digest();
   }
+  return true;
+}
+
+// A record's segments, as a per-segment read through GDAL gives them: each line or ring's
+// consecutive points (parts numbered in file order), each point of a point or multipoint
+// shape as a zero-length segment. The record was read and checked by read_record.
+void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::int64_t fid,
+                         LayerItems& out) {
+  const auto point = [](const unsigned char* xy) {
+    return Point2{le_double(xy), le_double(xy + 8)};
+  };
+  const auto add_point = [&](const unsigned char* xy, std::int32_t part) {
+    out.boxes.push_back(Box2::of_point(point(xy)));
+    out.records.push_back({fid, part, 0u});
+  };
+  switch (kind_of(file_type)) {
+    case Kind::point:
+      add_point(c + 4, 0);
+      break;
+    case Kind::multipoint:
+      for (std::uint32_t i = 0, n = le32(c + 36); i < n; ++i)
+        add_point(c + 40 + 16 * std::uint64_t(i), std::int32_t(i));
+      break;
+    case Kind::polyline_or_polygon: {
+      const std::uint32_t parts = le32(c + 36), n = le32(c + 40);
+      const bool ring = is_polygon_type(file_type);
+      const unsigned char* xy = c + 44 + 4 * std::uint64_t(parts);
+      for (std::uint32_t k = 0; k < parts; ++k) {
+        const std::uint32_t begin = le32(c + 44 + 4 * std::uint64_t(k)),
+                            end = k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n;
+        Point2 a = point(xy + 16 * std::uint64_t(begin));
+        for (std::uint32_t i = begin + 1; i < end; ++i) {
+          const Point2 b = point(xy + 16 * std::uint64_t(i));
+          out.boxes.push_back(Segment2{a, b}.box());
+          out.records.push_back({fid, std::int32_t(k), segment_flags(a, b, ring)});
+          a = b;
+        }
+      }
+      break;
+    }
+    case Kind::other:
+      break;
+  }
+}
+
+}  // namespace
+
+std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
+                                                   const std::string& layer,
+                                                   const Progress& progress) {
+  ShapefileBoxes out;
+  out.items.per = Per::feature;
+  const bool read = scan_shapefile(
+      path, layer, progress, out.items,
+      [&](const RecordRead& r, std::int64_t fid, const unsigned char*, std::uint32_t) {
+        out.items.boxes.push_back(r.box);
+        out.items.records.push_back({fid, 0, 0u});
+        out.segments += r.segments;
+      });
+  if (!read) return std::nullopt;
   return out;
+}
+
+std::optional<LayerItems> read_shapefile_segments(const std::string& path, const std::string& layer,
+                                                  const Progress& progress) {
+  LayerItems items;
+  items.per = Per::segment;
+  // A shape's points take 16 bytes each in the .shp, so its size bounds the segments: the
+  // arrays never move while they fill.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && st.st_size > 100) {
+    items.boxes.reserve(std::size_t(st.st_size - 100) / 16);
+    items.records.reserve(std::size_t(st.st_size - 100) / 16);
+  }
+  const bool read = scan_shapefile(
+      path, layer, progress, items,
+      [&](const RecordRead&, std::int64_t fid, const unsigned char* c, std::uint32_t file_type) {
+        add_record_segments(c, file_type, fid, items);
+      });
+  if (!read) return std::nullopt;
+  return items;
 }
 
 }  // namespace loci::io

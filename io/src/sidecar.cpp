@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cerrno>
 #include <cstring>
@@ -329,27 +330,60 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   h.source_hash = info.source.hash;
   h.source_inode = info.source.inode;
 
-  std::vector<std::byte> payload(h.file_size - sizeof(SidecarHeader));
-  auto at = [&](std::uint64_t offset) { return payload.data() + (offset - sizeof(SidecarHeader)); };
+  // The data (blocks, item indices, records, each from a 64-byte boundary, zeros between)
+  // is hashed and written from the tree's own arrays: the file is never assembled in
+  // memory, which for a large index meant faulting in and clearing as many fresh pages.
+  struct Piece {
+    std::uint64_t offset;
+    const void* data;
+    std::size_t size;
+  };
+  const std::array<Piece, 3> pieces{{{h.blocks_offset, blocks.data(), blocks.size_bytes()},
+                                     {h.items_offset, items.data(), items.size_bytes()},
+                                     {h.records_offset, records.data(), records.size_bytes()}}};
+  // The bytes [first, first + size) of the file's data: in place when one piece holds them,
+  // else gathered into `buffer`.
+  std::vector<std::byte> buffer;
+  const auto data_bytes_at = [&](std::uint64_t first, std::size_t size) -> const std::byte* {
+    for (const Piece& p : pieces)
+      if (first >= p.offset && first + size <= p.offset + p.size)
+        return static_cast<const std::byte*>(p.data) + (first - p.offset);
+    buffer.assign(size, std::byte{0});
+    for (const Piece& p : pieces) {
+      const std::uint64_t from = std::max(first, p.offset),
+                          to = std::min(first + size, p.offset + p.size);
+      if (from < to)
+        std::memcpy(buffer.data() + (from - first),
+                    static_cast<const std::byte*>(p.data) + (from - p.offset), to - from);
+    }
+    return buffer.data();
+  };
+
+  // The front: the layer name and the checksum table, with their padding.
+  std::vector<std::byte> front(h.data_offset - sizeof(SidecarHeader));
   auto put = [&](std::uint64_t offset, const void* data, std::size_t size) {
-    if (size) std::memcpy(at(offset), data, size);
+    if (size) std::memcpy(front.data() + (offset - sizeof(SidecarHeader)), data, size);
   };
   put(h.name_offset, info.layer_name.data(), info.layer_name.size());
-  put(h.blocks_offset, blocks.data(), blocks.size_bytes());
-  put(h.items_offset, items.data(), items.size_bytes());
-  put(h.records_offset, records.data(), records.size_bytes());
   for (std::uint64_t c = 0; c < h.chunk_count; ++c) {
     const std::uint64_t first = h.data_offset + (c << kChunkShift);
-    const std::uint64_t bytes = std::min<std::uint64_t>(h.file_size - first, 1ull << kChunkShift);
-    const std::uint64_t sum = hash_bytes(at(first), bytes);
+    const std::size_t bytes = std::min<std::uint64_t>(h.file_size - first, 1ull << kChunkShift);
+    const std::uint64_t sum = hash_bytes(data_bytes_at(first, bytes), bytes);
     put(h.checks_offset + 8 * c, &sum, 8);
   }
-  h.front_checksum = hash_bytes(payload.data(), h.data_offset - sizeof(SidecarHeader));
+  h.front_checksum = hash_bytes(front.data(), front.size());
   h.header_checksum = hash_bytes(&h, offsetof(SidecarHeader, header_checksum));
 
   AtomicFile out(path);
   write_all(out.fd(), &h, sizeof h, path);
-  write_all(out.fd(), payload.data(), payload.size(), path);
+  write_all(out.fd(), front.data(), front.size(), path);
+  static constexpr std::array<std::byte, kAlign> zeros{};
+  std::uint64_t at = h.data_offset;
+  for (const Piece& p : pieces) {
+    write_all(out.fd(), zeros.data(), p.offset - at, path);  // at most kAlign - 1 bytes
+    write_all(out.fd(), p.data, p.size, path);
+    at = p.offset + p.size;
+  }
   out.commit();
 }
 

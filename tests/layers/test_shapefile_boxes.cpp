@@ -1,13 +1,16 @@
-// Per-feature boxes read straight from shapefiles (read_shapefile_boxes) against GDAL read
-// feature by feature: every shape family, Z variants, null and empty shapes, random and
-// degenerate coordinates; the granularity chosen; the files handed back to GDAL (deleted
-// records, a missing .dbf, corrupt bytes) and bad coordinates refused with GDAL's message.
+// Per-feature boxes and per-segment items read straight from shapefiles
+// (read_shapefile_boxes, read_shapefile_segments) against GDAL read feature by feature: every
+// shape family, Z variants, null and empty shapes, random and degenerate coordinates; the
+// granularity chosen; the files handed back to GDAL (deleted records, a missing .dbf, corrupt
+// bytes) and bad coordinates refused with GDAL's message.
 #include "loci/io/shapefile_boxes.hpp"
 
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
 #include <ogrsf_frmts.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -16,10 +19,12 @@
 #include <limits>
 #include <memory>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "loci/geom/error.hpp"
 #include "loci/io/layer_reader.hpp"
+#include "loci/io/sidecar.hpp"
 
 namespace {
 
@@ -79,6 +84,75 @@ Reference gdal_reference(const std::string& path) {
   return r;
 }
 
+// One per-segment item, comparable: GDAL may regroup a polygon's rings, so for polygons the
+// items are compared as a multiset without their part numbers.
+struct SegmentItem {
+  std::int64_t fid;
+  std::int32_t part;
+  std::uint32_t flags;
+  std::array<double, 4> box;
+  auto key(bool with_part) const { return std::tuple(fid, with_part ? part : 0, flags, box); }
+};
+
+std::array<double, 4> corners(const loci::Box2& b) {
+  return {b.min[0], b.min[1], b.max[0], b.max[1]};
+}
+
+// GDAL's own per-segment reading: the segments of its lines and rings (read_segments), and
+// each point of a point or multipoint feature as a zero-length segment.
+std::vector<SegmentItem> gdal_segments(const std::string& path, bool polygons) {
+  std::vector<SegmentItem> out;
+  for (const loci::io::SegmentRecord& r : loci::io::read_segments(path))
+    out.push_back({r.fid, r.part, loci::io::segment_flags(r.segment.a, r.segment.b, polygons),
+                   corners(r.segment.box())});
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+  for (auto& f : *ds->GetLayer(0)) {
+    const OGRGeometry* g = f->GetGeometryRef();
+    if (!g) continue;
+    const auto add = [&](const OGRPoint* p, int part) {
+      const loci::Point2 q{p->getX(), p->getY()};
+      out.push_back({f->GetFID(), part, 0u, corners(loci::Box2::of_point(q))});
+    };
+    if (wkbFlatten(g->getGeometryType()) == wkbPoint) add(g->toPoint(), 0);
+    if (wkbFlatten(g->getGeometryType()) == wkbMultiPoint)
+      for (int i = 0; i < g->toMultiPoint()->getNumGeometries(); ++i)
+        add(g->toMultiPoint()->getGeometryRef(i), i);
+  }
+  return out;
+}
+
+std::vector<SegmentItem> items_of(const LayerItems& items) {
+  std::vector<SegmentItem> out;
+  for (std::size_t i = 0; i < items.records.size(); ++i)
+    out.push_back({items.records[i].fid, items.records[i].part, items.records[i].flags,
+                   corners(items.boxes[i])});
+  return out;
+}
+
+// The direct per-segment read gives GDAL's segments: in GDAL's order with GDAL's parts for
+// lines and points, as the same multiset for polygons.
+void expect_segments_like_gdal(const std::string& path, const LayerItems& direct) {
+  EXPECT_EQ(direct.per, Per::segment);
+  const bool polygons = direct.has_polygons;
+  const std::vector<SegmentItem> ref = gdal_segments(path, polygons), got = items_of(direct);
+  ASSERT_EQ(got.size(), ref.size());
+  std::vector<decltype(ref[0].key(true))> a, b;
+  for (const SegmentItem& x : ref)
+    a.push_back(x.key(!polygons));
+  for (const SegmentItem& x : got)
+    b.push_back(x.key(!polygons));
+  // A shapefile holds one shape type, so the reference lists either segments or points, in
+  // file order; polygons' rings are compared as a multiset.
+  if (polygons) {
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+  }
+  EXPECT_TRUE(a == b);
+  // Every part's segments are consecutive, as the GDAL path writes them.
+  for (std::size_t i = 1; i < got.size(); ++i)
+    if (got[i].fid == got[i - 1].fid) EXPECT_GE(got[i].part, got[i - 1].part);
+}
+
 void expect_like_gdal(const std::string& path) {
   SCOPED_TRACE(path);
   const auto direct = loci::io::read_shapefile_boxes(path);
@@ -94,10 +168,18 @@ void expect_like_gdal(const std::string& path) {
     EXPECT_EQ(items.boxes[i], ref.boxes[i]) << "feature " << ref.fids[i];
   }
   // The segment count decides the granularity: it must be what a per-segment read gives.
-  const LayerItems by_segment = loci::io::read_items(path, "", Per::segment);
-  EXPECT_EQ(direct->segments, by_segment.records.size());
-  EXPECT_EQ(items.has_polygons, by_segment.has_polygons);
-  EXPECT_EQ(items.layer_name, by_segment.layer_name);
+  const auto by_segment = loci::io::read_shapefile_segments(path);
+  ASSERT_TRUE(by_segment) << "segments handed back to GDAL";
+  expect_segments_like_gdal(path, *by_segment);
+  EXPECT_EQ(direct->segments, by_segment->records.size());
+  EXPECT_EQ(by_segment->features, items.features);
+  EXPECT_EQ(items.has_polygons, by_segment->has_polygons);
+  EXPECT_EQ(items.layer_name, by_segment->layer_name);
+  EXPECT_EQ(by_segment->content_hash, items.content_hash);
+  // read_items takes the same direct path.
+  const LayerItems through = loci::io::read_items(path, "", Per::segment);
+  EXPECT_EQ(through.boxes, by_segment->boxes);
+  EXPECT_EQ(through.records.size(), by_segment->records.size());
   // The fingerprint's hash, from the bytes read, is the one a pass of its own gives.
   ASSERT_TRUE(items.content_hash);
   EXPECT_EQ(*items.content_hash, loci::io::fingerprint_of(path).hash);
@@ -311,8 +393,15 @@ TEST(ShapefileBoxes, BadCoordinatesAreRefusedAsGdalRefusesThem) {
     } catch (const loci::InvalidGeometry& e) {
       gdal = e.what();
     }
+    std::string segments;
+    try {
+      loci::io::read_shapefile_segments(path);
+    } catch (const loci::InvalidGeometry& e) {
+      segments = e.what();
+    }
     EXPECT_NE(direct.find(": feature 4 has"), std::string::npos) << direct;
     EXPECT_EQ(direct, gdal);
+    EXPECT_EQ(segments, gdal);
     fs::remove(path);
   }
 }
@@ -355,6 +444,11 @@ TEST(ShapefileBoxes, CorruptFilesNeverCrash) {
         const Reference ref = gdal_reference(copy);
         CPLPopErrorHandler();
         EXPECT_EQ(direct->items.boxes, ref.boxes) << "round " << round;
+      }
+      if (const auto segments = loci::io::read_shapefile_segments(copy)) {
+        CPLPushErrorHandler(CPLQuietErrorHandler);
+        expect_segments_like_gdal(copy, *segments);
+        CPLPopErrorHandler();
       }
     } catch (const loci::Error&) {
       ++refused;

@@ -1,9 +1,10 @@
-// Per-feature boxes of an ESRI shapefile, read straight from its .shx and .shp.
+// Per-feature boxes and per-segment items of an ESRI shapefile, read straight from its .shx
+// and .shp.
 //
-// An index per feature needs one box per feature, yet reading the layer through GDAL builds
-// every geometry whole (and, for polygons, sorts rings into polygons), which is most of the
-// time `loci index --per feature` takes on a large shapefile. The shapefile format
-// (ESRI Shapefile Technical Description, 1998) makes a direct read simple:
+// An index per feature needs one box per feature, and one per segment the segments, yet
+// reading the layer through GDAL builds every geometry whole (and, for polygons, sorts rings
+// into polygons), which is most of the time `loci index` takes on a large shapefile. The shapefile
+// format (ESRI Shapefile Technical Description, 1998) makes a direct read simple:
 //
 //   .shx  100-byte header (file length in 16-bit words, big-endian, at byte 24), then one
 //         8-byte entry per record: offset and content length, in 16-bit words, big-endian.
@@ -43,5 +44,14 @@ struct ShapefileBoxes {
 std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
                                                    const std::string& layer = {},
                                                    const Progress& progress = {});
+
+// The per-segment items of the same shapefiles, read directly under the same rules: every
+// segment of every line and ring, with its flags, as read_items(path, layer, Per::segment)
+// gives through GDAL, parts numbered in the file's order (GDAL may regroup a polygon's
+// rings); each point of a point or multipoint shape as a zero-length segment. nullopt when
+// GDAL must read the file; throws as read_shapefile_boxes.
+std::optional<LayerItems> read_shapefile_segments(const std::string& path,
+                                                  const std::string& layer = {},
+                                                  const Progress& progress = {});
 
 }  // namespace loci::io

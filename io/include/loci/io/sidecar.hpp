@@ -74,6 +74,12 @@ inline Segment2 segment_of(const Box2& box, std::uint32_t flags) {
   return {box.min, box.max};
 }
 
+// The flags under which segment_of() gives back the segment from a to b (as a point set).
+inline std::uint32_t segment_flags(const Point2& a, const Point2& b, bool ring) {
+  const bool anti = (a[0] < b[0]) != (a[1] < b[1]) && a[0] != b[0] && a[1] != b[1];
+  return (ring ? item_ring : 0u) | (anti ? item_antidiagonal : 0u);
+}
+
 // Granularity of an index: one entry per feature, or one per segment of the linework.
 enum class Per : std::uint8_t { feature = 0, segment = 1 };
 
