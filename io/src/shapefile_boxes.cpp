@@ -287,13 +287,14 @@ RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32
   return r;
 }
 
-// Checks that the shapefile at `path` is one this reader takes, then reads and checks each
-// record in file order (read_record) and hands each shape to `add(read, fid, content,
-// file_type)`, counting it in `items`; `items` gets the layer's name, whether it holds
-// polygons and the fingerprint's hash from the bytes read. False: GDAL must read the file.
-template <class Add>
+// Checks that the shapefile at `path` is one this reader takes and calls `begin(file_type,
+// records, shp_bytes)`, then reads and checks each record in file order (read_record) and
+// hands each shape to `add(read, fid, content, file_type)`, counting it in `items`; `items`
+// gets the layer's name, whether it holds polygons and the fingerprint's hash from the bytes
+// read. False: GDAL must read the file.
+template <class Begin, class Add>
 bool scan_shapefile(const std::string& path, const std::string& layer, const Progress& progress,
-                    LayerItems& items, Add&& add) {
+                    LayerItems& items, Begin&& begin, Add&& add) {
   if constexpr (std::endian::native != std::endian::little) return false;
   if (!is_shp_path(path)) return false;
   struct stat st {};
@@ -321,6 +322,7 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
   const std::uint64_t count = (shx.size() - 100) / 8;
   if (ol.layer->GetFeatureCount(FALSE) != GIntBig(count)) return false;
   if (!plain_attributes(dbf_path, count)) return false;
+  begin(file_type, count, shp.size());
 
   ProgressTicker ticker(progress, double(count));
   // The index entries are read in chunks too: their 8 bytes each run ahead of the records.
@@ -400,12 +402,17 @@ std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
                                                    const std::string& layer,
                                                    const Progress& progress) {
   ShapefileBoxes out;
-  out.items.per = Per::feature;
+  LayerItems& items = out.items;
+  items.per = Per::feature;
   const bool read = scan_shapefile(
-      path, layer, progress, out.items,
+      path, layer, progress, items,
+      [&](std::uint32_t, std::uint64_t records, std::uint64_t) {
+        items.boxes.reserve(records);
+        items.records.reserve(records);
+      },
       [&](const RecordRead& r, std::int64_t fid, const unsigned char*, std::uint32_t) {
-        out.items.boxes.push_back(r.box);
-        out.items.records.push_back({fid, 0, 0u});
+        items.boxes.push_back(r.box);
+        items.records.push_back({fid, 0, 0u});
         out.segments += r.segments;
       });
   if (!read) return std::nullopt;
@@ -416,15 +423,16 @@ std::optional<LayerItems> read_shapefile_segments(const std::string& path, const
                                                   const Progress& progress) {
   LayerItems items;
   items.per = Per::segment;
-  // A shape's points take 16 bytes each in the .shp, so its size bounds the segments: the
-  // arrays never move while they fill.
-  struct stat st {};
-  if (::stat(path.c_str(), &st) == 0 && st.st_size > 100) {
-    items.boxes.reserve(std::size_t(st.st_size - 100) / 16);
-    items.records.reserve(std::size_t(st.st_size - 100) / 16);
-  }
   const bool read = scan_shapefile(
       path, layer, progress, items,
+      [&](std::uint32_t file_type, std::uint64_t, std::uint64_t shp_bytes) {
+        // Each point takes 16 bytes in the .shp (24 or more with M or Z values), so the size
+        // bounds the segments: the arrays never move while they fill.
+        const std::uint64_t point_bytes = file_type < 10 ? 16 : 24;
+        const auto bound = std::size_t(shp_bytes / point_bytes);
+        items.boxes.reserve(bound);
+        items.records.reserve(bound);
+      },
       [&](const RecordRead&, std::int64_t fid, const unsigned char* c, std::uint32_t file_type) {
         add_record_segments(c, file_type, fid, items);
       });

@@ -17,9 +17,9 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <random>
-#include <tuple>
 #include <vector>
 
 #include "loci/geom/error.hpp"
@@ -84,73 +84,68 @@ Reference gdal_reference(const std::string& path) {
   return r;
 }
 
-// One per-segment item, comparable: GDAL may regroup a polygon's rings, so for polygons the
-// items are compared as a multiset without their part numbers.
-struct SegmentItem {
-  std::int64_t fid;
-  std::int32_t part;
-  std::uint32_t flags;
-  std::array<double, 4> box;
-  auto key(bool with_part) const { return std::tuple(fid, with_part ? part : 0, flags, box); }
-};
-
 std::array<double, 4> corners(const loci::Box2& b) {
   return {b.min[0], b.min[1], b.max[0], b.max[1]};
 }
 
-// GDAL's own per-segment reading: the segments of its lines and rings (read_segments), and
-// each point of a point or multipoint feature as a zero-length segment.
-std::vector<SegmentItem> gdal_segments(const std::string& path, bool polygons) {
-  std::vector<SegmentItem> out;
-  for (const loci::io::SegmentRecord& r : loci::io::read_segments(path))
-    out.push_back({r.fid, r.part, loci::io::segment_flags(r.segment.a, r.segment.b, polygons),
-                   corners(r.segment.box())});
-  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
-  for (auto& f : *ds->GetLayer(0)) {
-    const OGRGeometry* g = f->GetGeometryRef();
-    if (!g) continue;
-    const auto add = [&](const OGRPoint* p, int part) {
-      const loci::Point2 q{p->getX(), p->getY()};
-      out.push_back({f->GetFID(), part, 0u, corners(loci::Box2::of_point(q))});
-    };
-    if (wkbFlatten(g->getGeometryType()) == wkbPoint) add(g->toPoint(), 0);
-    if (wkbFlatten(g->getGeometryType()) == wkbMultiPoint)
-      for (int i = 0; i < g->toMultiPoint()->getNumGeometries(); ++i)
-        add(g->toMultiPoint()->getGeometryRef(i), i);
-  }
-  return out;
+// GDAL's own per-segment reading, through read_items: the same .shp and .shx without their
+// .dbf, which the direct reader hands to GDAL.
+LayerItems through_gdal(const std::string& path) {
+  const fs::path sub = dir() / "no_dbf";
+  fs::create_directories(sub);
+  const fs::path stem = fs::path(path).replace_extension();
+  const std::string name = stem.filename().string();
+  fs::remove(sub / (name + ".dbf"));
+  for (const char* ext : {".shp", ".shx"})
+    fs::copy_file(stem.string() + ext, sub / (name + ext), fs::copy_options::overwrite_existing);
+  const std::string copy = (sub / (name + ".shp")).string();
+  EXPECT_FALSE(loci::io::read_shapefile_segments(copy)) << "no .dbf: GDAL reads it";
+  return loci::io::read_items(copy, "", Per::segment);
 }
 
-std::vector<SegmentItem> items_of(const LayerItems& items) {
-  std::vector<SegmentItem> out;
+// Each feature's parts as lists of (box, flags), in any order and each sorted: GDAL may
+// regroup a polygon's rings (and so number them differently).
+using Parts = std::map<std::int64_t,
+                       std::vector<std::vector<std::pair<std::array<double, 4>, std::uint32_t>>>>;
+Parts parts_of(const LayerItems& items) {
+  std::map<std::int64_t,
+           std::map<std::int32_t, std::vector<std::pair<std::array<double, 4>, std::uint32_t>>>>
+      by;
   for (std::size_t i = 0; i < items.records.size(); ++i)
-    out.push_back({items.records[i].fid, items.records[i].part, items.records[i].flags,
-                   corners(items.boxes[i])});
+    by[items.records[i].fid][items.records[i].part].emplace_back(corners(items.boxes[i]),
+                                                                 items.records[i].flags);
+  Parts out;
+  for (auto& [fid, parts] : by)
+    for (auto& [part, segments] : parts) {
+      std::sort(segments.begin(), segments.end());
+      out[fid].push_back(std::move(segments));
+    }
+  for (auto& [fid, parts] : out)
+    std::sort(parts.begin(), parts.end());
   return out;
 }
 
-// The direct per-segment read gives GDAL's segments: in GDAL's order with GDAL's parts for
-// lines and points, as the same multiset for polygons.
+// The direct per-segment read gives GDAL's items: the same items in the same order with the
+// same parts for lines and points; the same rings, each with its segments, for polygons.
 void expect_segments_like_gdal(const std::string& path, const LayerItems& direct) {
+  const LayerItems gdal = through_gdal(path);
   EXPECT_EQ(direct.per, Per::segment);
-  const bool polygons = direct.has_polygons;
-  const std::vector<SegmentItem> ref = gdal_segments(path, polygons), got = items_of(direct);
-  ASSERT_EQ(got.size(), ref.size());
-  std::vector<decltype(ref[0].key(true))> a, b;
-  for (const SegmentItem& x : ref)
-    a.push_back(x.key(!polygons));
-  for (const SegmentItem& x : got)
-    b.push_back(x.key(!polygons));
-  // A shapefile holds one shape type, so the reference lists either segments or points, in
-  // file order; polygons' rings are compared as a multiset.
-  if (polygons) {
-    std::sort(a.begin(), a.end());
-    std::sort(b.begin(), b.end());
+  EXPECT_EQ(direct.features, gdal.features);
+  EXPECT_EQ(direct.has_polygons, gdal.has_polygons);
+  ASSERT_EQ(direct.records.size(), gdal.records.size());
+  EXPECT_EQ(parts_of(direct), parts_of(gdal));
+  if (!gdal.has_polygons) {
+    EXPECT_EQ(direct.boxes, gdal.boxes);
+    for (std::size_t i = 0; i < gdal.records.size(); ++i) {
+      EXPECT_EQ(direct.records[i].fid, gdal.records[i].fid) << "item " << i;
+      EXPECT_EQ(direct.records[i].part, gdal.records[i].part) << "item " << i;
+      EXPECT_EQ(direct.records[i].flags, gdal.records[i].flags) << "item " << i;
+    }
   }
-  EXPECT_TRUE(a == b);
   // Every part's segments are consecutive, as the GDAL path writes them.
-  for (std::size_t i = 1; i < got.size(); ++i)
-    if (got[i].fid == got[i - 1].fid) EXPECT_GE(got[i].part, got[i - 1].part);
+  for (std::size_t i = 1; i < direct.records.size(); ++i)
+    if (direct.records[i].fid == direct.records[i - 1].fid)
+      EXPECT_GE(direct.records[i].part, direct.records[i - 1].part);
 }
 
 void expect_like_gdal(const std::string& path) {
@@ -176,10 +171,10 @@ void expect_like_gdal(const std::string& path) {
   EXPECT_EQ(items.has_polygons, by_segment->has_polygons);
   EXPECT_EQ(items.layer_name, by_segment->layer_name);
   EXPECT_EQ(by_segment->content_hash, items.content_hash);
-  // read_items takes the same direct path.
+  // read_items takes the direct path (the one that has the content hash from the bytes read).
   const LayerItems through = loci::io::read_items(path, "", Per::segment);
+  EXPECT_TRUE(through.content_hash);
   EXPECT_EQ(through.boxes, by_segment->boxes);
-  EXPECT_EQ(through.records.size(), by_segment->records.size());
   // The fingerprint's hash, from the bytes read, is the one a pass of its own gives.
   ASSERT_TRUE(items.content_hash);
   EXPECT_EQ(*items.content_hash, loci::io::fingerprint_of(path).hash);
@@ -357,53 +352,129 @@ TEST(ShapefileBoxes, DeletedRecordsAndMissingAttributesGoToGdal) {
   EXPECT_FALSE(loci::io::read_shapefile_boxes(bare));
 }
 
+TEST(ShapefileBoxes, MeasuredShapesAndOnePointParts) {
+  // M-only shape types (21, 23, 25, 28) and lines with a part of one point (no segment, yet a
+  // part number of its own).
+  const auto point_m = [](std::mt19937_64& rng) {
+    auto p = std::make_unique<OGRPoint>(coordinate(rng), coordinate(rng));
+    p->setM(coordinate(rng));
+    return p;
+  };
+  expect_like_gdal(write_shapefile(
+      "points_m", wkbPointM, 40,
+      [&](int i, std::mt19937_64& rng) { return sometimes_null(i, point_m(rng)); }, 20));
+  expect_like_gdal(write_shapefile(
+      "multipoints_m", wkbMultiPointM, 40,
+      [&](int i, std::mt19937_64& rng) {
+        auto m = std::make_unique<OGRMultiPoint>();
+        for (int k = 0, n = 1 + int(rng() % 5); k < n; ++k)
+          m->addGeometryDirectly(point_m(rng).release());
+        return sometimes_null(i, std::move(m));
+      },
+      21));
+  expect_like_gdal(write_shapefile(
+      "lines_m", wkbMultiLineStringM, 60,
+      [&](int i, std::mt19937_64& rng) {
+        auto m = std::make_unique<OGRMultiLineString>();
+        for (int k = 0, parts = 1 + int(rng() % 4); k < parts; ++k) {
+          auto l = std::make_unique<OGRLineString>();
+          for (int j = 0, n = k == 1 ? 1 : 2 + int(rng() % 6); j < n; ++j)
+            l->addPointM(coordinate(rng), coordinate(rng), double(j));
+          m->addGeometryDirectly(l.release());
+        }
+        return sometimes_null(i, std::move(m));
+      },
+      22));
+  expect_like_gdal(write_shapefile(
+      "polygons_m", wkbMultiPolygonM, 40,
+      [&](int i, std::mt19937_64& rng) {
+        auto m = std::make_unique<OGRMultiPolygon>();
+        for (int k = 0, n = 1 + int(rng() % 3); k < n; ++k) {
+          auto p = random_polygon(rng, 1 + int(rng() % 2), false);
+          p->setMeasured(TRUE);
+          m->addGeometryDirectly(p.release());
+        }
+        return sometimes_null(i, std::move(m));
+      },
+      23));
+  // The files are what they say: M types, and a line feature with a part of one point.
+  const auto direct = loci::io::read_shapefile_segments((dir() / "lines_m.shp").string());
+  ASSERT_TRUE(direct);
+  bool skipped_part = false;
+  for (std::size_t i = 1; i < direct->records.size(); ++i)
+    skipped_part |= direct->records[i].fid == direct->records[i - 1].fid &&
+                    direct->records[i].part == direct->records[i - 1].part + 2;
+  EXPECT_TRUE(skipped_part) << "no part of one point between two others";
+  std::ifstream shp(dir() / "lines_m.shp", std::ios::binary);
+  unsigned char header[36];
+  shp.read(reinterpret_cast<char*>(header), sizeof header);
+  EXPECT_EQ(header[32], 23);  // PolyLineM
+}
+
 TEST(ShapefileBoxes, BadCoordinatesAreRefusedAsGdalRefusesThem) {
-  for (const double bad :
-       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), 1e200}) {
-    // GDAL refuses to write a non-finite coordinate: a marker value is written, then
-    // replaced in the file's bytes.
-    constexpr double marker = 123456.78125;
-    const std::string path = write_shapefile(
-        "bad", wkbPolygon, 6,
-        [&](int i, std::mt19937_64& rng) -> std::unique_ptr<OGRGeometry> {
-          auto p = random_polygon(rng, 1, false);
-          if (i == 4) p->getExteriorRing()->setPoint(1, marker, 3.0);
-          return p;
-        },
-        11);
-    std::vector<char> bytes(fs::file_size(path));
-    std::ifstream(path, std::ios::binary).read(bytes.data(), std::streamsize(bytes.size()));
-    int replaced = 0;
-    for (std::size_t at = 0; at + 8 <= bytes.size(); ++at)
-      if (std::memcmp(bytes.data() + at, &marker, 8) == 0) {
-        std::memcpy(bytes.data() + at, &bad, 8);
-        ++replaced;
+  // The bad value as x of the second point (in the checks' four-point blocks), or as y of the
+  // fifth of six (in the rest after them).
+  for (const bool in_rest : {false, true})
+    for (const double bad : {std::numeric_limits<double>::quiet_NaN(),
+                             std::numeric_limits<double>::infinity(), 1e200}) {
+      SCOPED_TRACE(in_rest ? "y in the rest" : "x in a block");
+      // GDAL refuses to write a non-finite coordinate: a marker value is written, then
+      // replaced in the file's bytes.
+      constexpr double marker = 123456.78125;
+      const std::string path = write_shapefile(
+          "bad", wkbPolygon, 6,
+          [&](int i, std::mt19937_64& rng) -> std::unique_ptr<OGRGeometry> {
+            if (i == 4 && in_rest) {
+              auto p = std::make_unique<OGRPolygon>();
+              OGRLinearRing ring;
+              for (const auto& [x, y] : {std::pair{0.0, 0.0},
+                                         {1.0, 0.0},
+                                         {2.0, 0.0},
+                                         {2.0, 2.0},
+                                         {0.0, marker},
+                                         {0.0, 0.0}})
+                ring.addPoint(x, y);
+              p->addRing(&ring);
+              return p;
+            }
+            auto p = random_polygon(rng, 1, false);
+            if (i == 4) p->getExteriorRing()->setPoint(1, marker, 3.0);
+            return p;
+          },
+          11);
+      std::vector<char> bytes(fs::file_size(path));
+      std::ifstream(path, std::ios::binary).read(bytes.data(), std::streamsize(bytes.size()));
+      int replaced = 0;
+      for (std::size_t at = 0; at + 8 <= bytes.size(); ++at)
+        if (std::memcmp(bytes.data() + at, &marker, 8) == 0) {
+          std::memcpy(bytes.data() + at, &bad, 8);
+          ++replaced;
+        }
+      ASSERT_GE(replaced, 1);  // the point, and the boxes of its record and of the file
+      std::ofstream(path, std::ios::binary | std::ios::trunc)
+          .write(bytes.data(), std::streamsize(bytes.size()));
+      std::string direct, gdal;
+      try {
+        loci::io::read_shapefile_boxes(path);
+      } catch (const loci::InvalidGeometry& e) {
+        direct = e.what();
       }
-    ASSERT_GE(replaced, 1);  // the point, and the boxes of its record and of the file
-    std::ofstream(path, std::ios::binary | std::ios::trunc)
-        .write(bytes.data(), std::streamsize(bytes.size()));
-    std::string direct, gdal;
-    try {
-      loci::io::read_shapefile_boxes(path);
-    } catch (const loci::InvalidGeometry& e) {
-      direct = e.what();
+      try {
+        loci::io::read_segments(path);
+      } catch (const loci::InvalidGeometry& e) {
+        gdal = e.what();
+      }
+      std::string segments;
+      try {
+        loci::io::read_shapefile_segments(path);
+      } catch (const loci::InvalidGeometry& e) {
+        segments = e.what();
+      }
+      EXPECT_NE(direct.find(": feature 4 has"), std::string::npos) << direct;
+      EXPECT_EQ(direct, gdal);
+      EXPECT_EQ(segments, gdal);
+      fs::remove(path);
     }
-    try {
-      loci::io::read_segments(path);
-    } catch (const loci::InvalidGeometry& e) {
-      gdal = e.what();
-    }
-    std::string segments;
-    try {
-      loci::io::read_shapefile_segments(path);
-    } catch (const loci::InvalidGeometry& e) {
-      segments = e.what();
-    }
-    EXPECT_NE(direct.find(": feature 4 has"), std::string::npos) << direct;
-    EXPECT_EQ(direct, gdal);
-    EXPECT_EQ(segments, gdal);
-    fs::remove(path);
-  }
 }
 
 // Flipped and truncated bytes: the direct reader hands the file to GDAL or refuses it with a
@@ -437,17 +508,22 @@ TEST(ShapefileBoxes, CorruptFilesNeverCrash) {
         .write(bytes.data(), std::streamsize(bytes.size()));
     const std::string copy = (dir() / (name + ".shp")).string();
     try {
-      if (const auto direct = loci::io::read_shapefile_boxes(copy)) {
+      const auto direct = loci::io::read_shapefile_boxes(copy);
+      const auto segments = loci::io::read_shapefile_segments(copy);
+      EXPECT_EQ(bool(direct), bool(segments)) << "round " << round;
+      if (direct && segments) {
         ++answered;
-        // A flipped coordinate is a different layer, not a wrong answer: compare with GDAL.
+        // A flipped coordinate is a different layer, not a wrong answer: compare with GDAL,
+        // which must read what the direct reader read.
         CPLPushErrorHandler(CPLQuietErrorHandler);
-        const Reference ref = gdal_reference(copy);
-        CPLPopErrorHandler();
-        EXPECT_EQ(direct->items.boxes, ref.boxes) << "round " << round;
-      }
-      if (const auto segments = loci::io::read_shapefile_segments(copy)) {
-        CPLPushErrorHandler(CPLQuietErrorHandler);
-        expect_segments_like_gdal(copy, *segments);
+        try {
+          const Reference ref = gdal_reference(copy);
+          EXPECT_EQ(direct->items.boxes, ref.boxes) << "round " << round;
+          expect_segments_like_gdal(copy, *segments);
+        } catch (const std::exception& e) {
+          ADD_FAILURE() << "round " << round
+                        << ": GDAL refused what was read directly: " << e.what();
+        }
         CPLPopErrorHandler();
       }
     } catch (const loci::Error&) {

@@ -48,8 +48,10 @@ std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
 // The per-segment items of the same shapefiles, read directly under the same rules: every
 // segment of every line and ring, with its flags, as read_items(path, layer, Per::segment)
 // gives through GDAL, parts numbered in the file's order (GDAL may regroup a polygon's
-// rings); each point of a point or multipoint shape as a zero-length segment. nullopt when
-// GDAL must read the file; throws as read_shapefile_boxes.
+// rings); each point of a point or multipoint shape as a zero-length segment. Every point is
+// checked, as per feature: a bad coordinate in a part of one point, which has no segment and
+// which the GDAL path does not look at, is refused too. nullopt when GDAL must read the file;
+// throws as read_shapefile_boxes.
 std::optional<LayerItems> read_shapefile_segments(const std::string& path,
                                                   const std::string& layer = {},
                                                   const Progress& progress = {});
