@@ -162,8 +162,9 @@ void read_layer_items(const std::string& path, const std::string& layer, const P
 
 LayerItems read_items(const std::string& path, const std::string& layer, Per per,
                       const Progress& progress, bool keep_geometries) {
-  // A shapefile's boxes come faster from its records than from GDAL's geometries (and GDAL
-  // reads a shapefile's features by FID in place: there are no geometries to keep).
+  // A shapefile's boxes and segments come faster from its records than from GDAL's
+  // geometries (and GDAL reads a shapefile's features by FID in place: there are no
+  // geometries to keep).
   if (per == Per::feature)
     if (auto direct = read_shapefile_boxes(path, layer, progress)) return std::move(direct->items);
   if (per == Per::segment)

@@ -105,12 +105,10 @@ LayerItems through_gdal(const std::string& path) {
 
 // Each feature's parts as lists of (box, flags), in any order and each sorted: GDAL may
 // regroup a polygon's rings (and so number them differently).
-using Parts = std::map<std::int64_t,
-                       std::vector<std::vector<std::pair<std::array<double, 4>, std::uint32_t>>>>;
+using Segment = std::pair<std::array<double, 4>, std::uint32_t>;
+using Parts = std::map<std::int64_t, std::vector<std::vector<Segment>>>;
 Parts parts_of(const LayerItems& items) {
-  std::map<std::int64_t,
-           std::map<std::int32_t, std::vector<std::pair<std::array<double, 4>, std::uint32_t>>>>
-      by;
+  std::map<std::int64_t, std::map<std::int32_t, std::vector<Segment>>> by;
   for (std::size_t i = 0; i < items.records.size(); ++i)
     by[items.records[i].fid][items.records[i].part].emplace_back(corners(items.boxes[i]),
                                                                  items.records[i].flags);
