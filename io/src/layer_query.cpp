@@ -300,7 +300,7 @@ struct LayerIndex::LazyFeatures {
 const LayerIndex::Features& LayerIndex::features() const {
   std::call_once(features_->once, [&] {
     Features& f = features_->value;
-    const auto records = this->records();
+    const auto records = f.records = this->records();
     f.of_item.resize(records.size());
     auto& number = f.number;
     std::int64_t last_fid = 0;
@@ -332,8 +332,10 @@ const LayerIndex::Features& LayerIndex::features() const {
       const std::size_t last = std::min<std::size_t>(first + kFanout, n);
       std::uint32_t seen[kFanout];
       int distinct = 0;
+      bool lost = false;  // an item of no feature (a corrupt record)
       for (std::size_t pos = first; pos < last; ++pos) {
         const std::uint32_t g = f.at[pos];
+        lost |= g == Features::none;
         if (g != Features::none && std::find(seen, seen + distinct, g) == seen + distinct)
           seen[distinct++] = g;
       }
@@ -347,7 +349,8 @@ const LayerIndex::Features& LayerIndex::features() const {
           box.expand(t->box_at(pos));
       }
       for (int i = 0; i < distinct; ++i)
-        leaves.push_back({box, seen[i], std::uint32_t(b), std::uint32_t(b)});
+        leaves.push_back(
+            {box, seen[i], std::uint32_t(b), std::uint32_t(b), distinct == 1 && !lost});
     }
     std::vector<std::uint32_t> start(features + 1, 0);
     for (const Features::Node& node : leaves)
@@ -370,9 +373,11 @@ const LayerIndex::Features& LayerIndex::features() const {
           f.roots.emplace_back(l, i);
         } else {
           for (std::uint32_t c = i; c < j; c += kFanout) {
-            Features::Node node{Box2::empty(), level[i].feature, c, std::min(c + kFanout, j)};
-            for (std::uint32_t k = node.first; k < node.last; ++k)
+            Features::Node node{Box2::empty(), level[i].feature, c, std::min(c + kFanout, j), true};
+            for (std::uint32_t k = node.first; k < node.last; ++k) {
               node.box.expand(level[k].box);
+              node.tight = node.tight && level[k].tight;
+            }
             up.push_back(node);
           }
         }
@@ -403,6 +408,69 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
   return out;
 }
 
+std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p,
+                                              const LayerIndex::Features& features) {
+  std::vector<std::int64_t> out;
+  const PackedRTree2* tree = index.packed();
+  if (!index.has_polygons() || !tree || tree->size() == 0) return out;
+  const auto records = features.records;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack;
+  // Only a feature whose box holds p can contain it. Its rings are counted along the axis
+  // direction that leaves its box soonest, through its own hierarchy: no other feature's
+  // segments are read. Each direction is a map that turns it into +x (reflections and swaps of
+  // coordinates are exact), and ray_crosses decides on the mapped points as it does for +x.
+  for (const auto& root : features.roots) {
+    const LayerIndex::Features::Node& top = features.levels[root.first][root.second];
+    const Box2& reach = top.box;
+    if (!intersects(reach, p)) continue;
+    const double length[4] = {reach.max[0] - p[0], p[0] - reach.min[0], reach.max[1] - p[1],
+                              p[1] - reach.min[1]};
+    const int dir = int(std::min_element(length, length + 4) - length);
+    auto map = [dir](const Point2& q) -> Point2 {
+      switch (dir) {
+        case 0:
+          return q;
+        case 1:
+          return {-q[0], q[1]};
+        case 2:
+          return {q[1], q[0]};
+        default:
+          return {-q[1], q[0]};
+      }
+    };
+    const Box2 ray = dir == 0   ? Box2{p, {reach.max[0], p[1]}}
+                     : dir == 1 ? Box2{{reach.min[0], p[1]}, p}
+                     : dir == 2 ? Box2{p, {p[0], reach.max[1]}}
+                                : Box2{{p[0], reach.min[1]}, p};
+    const Point2 mp = map(p);
+    bool odd = false;
+    stack.assign(1, root);
+    while (!stack.empty()) {
+      const auto [level, i] = stack.back();
+      stack.pop_back();
+      const LayerIndex::Features::Node& node = features.levels[level][i];
+      if (level > 0) {
+        for (std::uint32_t c = node.first; c < node.last; ++c)
+          if (intersects(features.levels[level - 1][c].box, ray)) stack.emplace_back(level - 1, c);
+        continue;
+      }
+      const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
+      const std::size_t last = std::min(first + PackedRTree2::node_size, tree->size());
+      for (std::size_t pos = first; pos < last; ++pos) {
+        if (features.at[pos] != top.feature) continue;
+        const Box2 b = tree->box_at(pos);
+        if (!intersects(b, ray)) continue;
+        const Id id = tree->item_at(pos);
+        if (id >= records.size() || !(records[id].flags & item_ring)) continue;
+        const Segment2 s = segment_of(b, records[id].flags);
+        odd ^= ray_crosses(map(s.a), map(s.b), mp);
+      }
+    }
+    if (odd) out.push_back(features.fid[top.feature]);
+  }
+  return out;
+}
+
 void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
                      std::vector<Answer>& out) {
   check_query(q);
@@ -419,12 +487,16 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       std::fill(state_.begin(), state_.end(), FeatureState{});
       generation_ = 1;
     }
-    // The state of feature f in this query (fresh: not seen, best infinite).
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    // The state of feature f in this query (fresh: not seen, best and bound infinite).
     auto state = [&](std::uint32_t f) -> FeatureState& {
       FeatureState& s = state_[f];
-      if (s.stamp != generation_) s = {generation_, false, std::numeric_limits<double>::infinity()};
+      if (s.stamp != generation_) s = {generation_, false, kInf, kInf};
       return s;
     };
+    // A squared upper bound on the distance to a tight node's segments, raised by far more
+    // than the rounding of it and of the lower bounds compared with it.
+    auto upper = [&](const Box2& b) { return squared_minmax_distance(p, b) * (1 + 1e-9); };
     using Pending = std::pair<double, std::uint32_t>;
     std::priority_queue<Pending, std::vector<Pending>, std::greater<>> pending;
     std::size_t found = 0;
@@ -447,9 +519,10 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
         ++found;
       }
     };
-    const ItemRecord* records = index_.records().data();
+    const ItemRecord* records = features.records.data();
     if (per_segment && !candidates_only) {
-      for (const auto fid : containing_polygons(index_, p))
+      for (const auto fid : features.roots.empty() ? containing_polygons(index_, p)
+                                                   : containing_polygons(index_, p, features))
         offer(features.number.at(fid), 0.0);
     }
     auto visit = [&](const ItemRecord& r, const Box2& b, double box_distance) {
@@ -469,13 +542,15 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       // Best first over the features' hierarchies (squared distances; level and node packed
       // in one key), from every feature's root.
       const PackedRTree2& tree = *index_.packed();
-      const auto all = index_.records();
+      const auto all = features.records;
       auto later = [](const auto& a, const auto& b) { return a.first > b.first; };
       auto& heap = walk_;
       heap.clear();
-      for (const auto& [l, i] : features.roots)
-        heap.emplace_back(squared_distance(p, features.levels[l][i].box),
-                          (std::uint64_t(l) << 32) | i);
+      for (const auto& [l, i] : features.roots) {
+        const LayerIndex::Features::Node& root = features.levels[l][i];
+        if (root.tight) state(root.feature).bound = upper(root.box);
+        heap.emplace_back(squared_distance(p, root.box), (std::uint64_t(l) << 32) | i);
+      }
       std::make_heap(heap.begin(), heap.end(), later);
       while (!heap.empty()) {
         std::pop_heap(heap.begin(), heap.end(), later);
@@ -486,8 +561,8 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
         if (found >= q.k) break;
         const auto level = std::uint32_t(key >> 32);
         const LayerIndex::Features::Node& node = features.levels[level][key & 0xffffffffu];
-        const FeatureState& s = state(node.feature);
-        if (s.done || s.best <= d) continue;  // nothing here can be nearer
+        FeatureState& s = state(node.feature);
+        if (s.done || s.best <= d || d2 > s.bound) continue;  // nothing here can be nearer
         if (level == 0) {
           double best = std::numeric_limits<double>::infinity();
           const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
@@ -503,12 +578,15 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
           if (best < std::numeric_limits<double>::infinity()) offer(node.feature, std::sqrt(best));
           continue;
         }
-        // Children that cannot improve their feature stay out.
-        const double limit = s.best * s.best;
+        // Children that cannot improve their feature stay out: those farther than the
+        // best distance found, or than a point of the feature the tight ones show.
         const auto& below = features.levels[level - 1];
+        for (std::uint32_t c = node.first; c < node.last; ++c)
+          if (below[c].tight) s.bound = std::min(s.bound, upper(below[c].box));
+        const double limit = s.best * s.best;
         for (std::uint32_t c = node.first; c < node.last; ++c) {
           const double c2 = squared_distance(p, below[c].box);
-          if (c2 < limit) {
+          if (c2 < limit && c2 <= s.bound) {
             heap.emplace_back(c2, (std::uint64_t(level - 1) << 32) | c);
             std::push_heap(heap.begin(), heap.end(), later);
           }

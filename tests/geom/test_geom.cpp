@@ -207,6 +207,47 @@ TEST(Distance, MatchesBoost) {
   EXPECT_DOUBLE_EQ(squared_distance(Point3{1, 2, 2}, s3), 9.0);
 }
 
+// MINMAXDIST bounds from above the distance to every point set whose bounding box is b, and
+// is reached: for the set of the far corners on each side (one per side), its nearest point is
+// exactly that far.
+TEST(Distance, MinMaxBoundsEverySetWithThatBox) {
+  std::mt19937_64 rng(16);
+  std::uniform_real_distribution<double> u(-50, 50), t(0, 1);
+  for (int i = 0; i < 5000; ++i) {
+    std::vector<Point2> set(1 + i % 6);
+    for (Point2& q : set)
+      q = {u(rng), u(rng)};
+    // Points on every side of the box: move one point onto each side now and then.
+    Box2 b = Box2::empty();
+    for (const Point2& q : set)
+      b.expand(q);
+    if (i % 2) b.expand(Point2{u(rng), u(rng)});  // widen, then put a point on each side
+    if (i % 2) {
+      set.push_back({b.min[0], b.min[1] + t(rng) * (b.max[1] - b.min[1])});
+      set.push_back({b.max[0], b.min[1] + t(rng) * (b.max[1] - b.min[1])});
+      set.push_back({b.min[0] + t(rng) * (b.max[0] - b.min[0]), b.min[1]});
+      set.push_back({b.min[0] + t(rng) * (b.max[0] - b.min[0]), b.max[1]});
+    }
+    const Point2 p = i % 3 ? Point2{u(rng), u(rng)} : Point2{u(rng) / 10, u(rng) / 10};
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Point2& q : set)
+      nearest = std::min(nearest, squared_distance(p, q));
+    const double bound = squared_minmax_distance(p, b);
+    ASSERT_LE(nearest, bound * (1 + 1e-12)) << i;
+    ASSERT_GE(bound, squared_distance(p, b));
+  }
+  // p = (1, 1) in [0, 4] x [0, 10]: nearer side in x is x = 0, its far corner (0, 10):
+  // 1 + 81 = 82; nearer side in y is y = 0, its far corner (4, 0): 9 + 1 = 10.
+  const Box2 b{{0, 0}, {4, 10}};
+  EXPECT_DOUBLE_EQ(squared_minmax_distance(Point2{1, 1}, b), 10.0);
+  const std::vector<Point2> corners{{4, 0}, {0, 10}, {4, 10}};  // one on every side
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Point2& q : corners)
+    nearest = std::min(nearest, squared_distance(Point2{1, 1}, q));
+  EXPECT_DOUBLE_EQ(nearest, 10.0);
+  EXPECT_DOUBLE_EQ(squared_minmax_distance(Point3{0, 0, 0}, Box3{{1, 1, 1}, {2, 2, 2}}), 9.0);
+}
+
 TEST(BoostAdapt, AlgorithmsAcceptLociTypes) {
   const Box2 a{{0, 0}, {2, 3}};
   EXPECT_DOUBLE_EQ(bg::area(a), 6.0);

@@ -10,11 +10,13 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "loci/geom/predicates.hpp"
+#include "loci/io/exact.hpp"
 #include "loci/io/layer_query.hpp"
 #include "loci/io/sidecar.hpp"
 
@@ -158,6 +160,111 @@ TEST(LayerNearest, InterleavedFeaturesFromASidecar) {
   LayerIndex index = LayerIndex::adopt(Sidecar::open(path));
   ::unlink(path.c_str());
   check(index, l, 13);
+}
+
+// Polygons per segment: features of one to three rings (star-shaped, vertices on an integer
+// grid so that rays from grid points run through vertices and along edges; a ring inside
+// another of the same feature is a hole by the even-odd rule), overlapping each other.
+struct Polygons {
+  LayerItems items;
+  std::vector<std::pair<std::int64_t, Segment2>> rings;  // (fid, segment)
+};
+
+Polygons star_polygons(int features, std::uint64_t seed) {
+  Polygons l;
+  l.items.per = Per::segment;
+  l.items.layer_name = "stars";
+  l.items.has_polygons = true;
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> centre(10, 90), radius(3, 25), corners(3, 12);
+  for (int f = 0; f < features; ++f) {
+    const std::int64_t fid = 5 * f + 1;
+    const int cx = centre(rng), cy = centre(rng);
+    const int rings = 1 + f % 3;
+    for (int r = 0; r < rings; ++r) {
+      // A hole inside the first ring when r = 1; another island for r = 2.
+      const int ox = r == 2 ? centre(rng) : cx, oy = r == 2 ? centre(rng) : cy;
+      const int size = r == 1 ? 2 : radius(rng);
+      const int n = corners(rng);
+      std::vector<Point2> ring;
+      for (int i = 0; i < n; ++i) {
+        const double a = 2 * std::numbers::pi * i / n;
+        const double len = r == 1 ? size : size * (0.5 + 0.5 * ((i * 7 + f) % 3) / 2.0);
+        ring.push_back({double(ox + int(std::lround(len * std::cos(a)))),
+                        double(oy + int(std::lround(len * std::sin(a))))});
+      }
+      for (int i = 0; i < n; ++i) {
+        const Point2 a = ring[i], b = ring[(i + 1) % n];
+        const Segment2 s{a, b};
+        l.items.boxes.push_back(s.box());
+        l.items.records.push_back({fid, 0, segment_flags(a, b, true)});
+        l.rings.emplace_back(fid, s);
+      }
+    }
+  }
+  return l;
+}
+
+TEST(LayerNearest, PolygonsHoldingThePointAreAtDistanceZero) {
+  const Polygons l = star_polygons(120, 21);
+  Polygons copy = l;
+  const LayerIndex index = LayerIndex::build(std::move(copy.items), Structure::packed_hilbert);
+  const LayerIndex::Features& features = index.features();
+  LayerQuery query(index, "", "");
+  std::mt19937_64 rng(22);
+  std::uniform_int_distribution<int> grid(0, 200);
+  std::uniform_real_distribution<double> any(-5, 105);
+  std::size_t inside = 0, compared = 0;
+  for (int i = 0; i < 3000; ++i) {
+    // Grid points and half-grid points (rays through vertices and along edges), and others.
+    const Point2 p = i % 3 == 2 ? Point2{any(rng), any(rng)}
+                                : Point2{grid(rng) / 2.0, grid(rng) / 2.0 + (i % 3) * 0.25};
+    std::map<std::int64_t, double> best;
+    std::map<std::int64_t, bool> odd;
+    for (const auto& [fid, s] : l.rings) {
+      const double d = std::sqrt(squared_distance(p, s));
+      const auto [it, fresh] = best.try_emplace(fid, d);
+      if (!fresh) it->second = std::min(it->second, d);
+      odd[fid] ^= ray_crosses(s.a, s.b, p);
+    }
+    bool on_a_ring = false;
+    for (const auto& [fid, d] : best)
+      on_a_ring |= d == 0;
+    if (on_a_ring) continue;  // on a ring a point may or may not count: distance 0 either way
+    std::vector<std::int64_t> expected;
+    for (auto& [fid, d] : best)
+      if (odd[fid]) {
+        expected.push_back(fid);
+        d = 0;
+      }
+    std::vector<std::int64_t> got = containing_polygons(index, p, features);
+    std::vector<std::int64_t> along_x = containing_polygons(index, p);
+    std::sort(got.begin(), got.end());
+    std::sort(along_x.begin(), along_x.end());
+    ASSERT_EQ(got, expected) << "point " << p[0] << ',' << p[1];
+    ASSERT_EQ(along_x, expected) << "point " << p[0] << ',' << p[1];
+    inside += !expected.empty();
+
+    std::vector<double> distances;
+    for (const auto& [fid, d] : best)
+      distances.push_back(d);
+    std::sort(distances.begin(), distances.end());
+    std::vector<Answer> answers;
+    Query q;
+    q.kind = Query::Kind::nearest;
+    q.point = p;
+    q.k = 6;
+    query.run(q, 1, false, answers);
+    ASSERT_EQ(answers.size(), 6u);
+    for (std::size_t r = 0; r < answers.size(); ++r) {
+      EXPECT_NEAR(answers[r].distance, distances[r], 1e-13 * (1 + distances[r]))
+          << "point " << p[0] << ',' << p[1] << " rank " << r;
+      EXPECT_NEAR(answers[r].distance, best[answers[r].fid], 1e-13 * (1 + distances[r]));
+      ++compared;
+    }
+  }
+  EXPECT_GT(inside, 300u);
+  EXPECT_GT(compared, 10000u);
 }
 
 }  // namespace

@@ -155,6 +155,29 @@ constexpr double squared_distance(const Point<D>& p, const Box<D>& b) {
   return s;
 }
 
+// Squared MINMAXDIST (Roussopoulos, Kelley, Vincent, SIGMOD 1995): when every face of b holds a
+// point of some set (b is that set's bounding box), the set has a point at most this far from
+// p. Per axis k, the face nearer to p along k, at its corner farthest from p; the least of
+// those. b must not be empty. Rounded like any sum of squares: a caller that prunes by it
+// allows a few units in the last place.
+template <int D>
+constexpr double squared_minmax_distance(const Point<D>& p, const Box<D>& b) {
+  double near[D], far[D];
+  for (int i = 0; i < D; ++i) {
+    const double lo = p[i] - b.min[i], hi = p[i] - b.max[i];
+    near[i] = std::min(lo * lo, hi * hi);
+    far[i] = std::max(lo * lo, hi * hi);
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < D; ++k) {
+    double s = 0;
+    for (int i = 0; i < D; ++i)
+      s += i == k ? near[i] : far[i];
+    best = std::min(best, s);
+  }
+  return best;
+}
+
 template <int D>
 std::string to_string(const Box<D>& b) {
   return "[" + to_string(b.min) + " .. " + to_string(b.max) + "]";

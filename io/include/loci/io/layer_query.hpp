@@ -145,7 +145,12 @@ class LayerIndex {
       Box2 box;
       std::uint32_t feature;
       std::uint32_t first, last;  // level 0: the leaf; above: its nodes one level down
+      // Every side of the box holds a point of the feature's segments below (the leaves
+      // below hold this feature only), so the farthest point of the nearest side bounds the
+      // feature's distance from above.
+      bool tight;
     };
+    std::span<const ItemRecord> records;  // every record, verified (records() once)
     loci::detail::LargeVector<std::uint32_t> of_item;
     std::vector<std::int64_t> fid;
     std::unordered_map<std::int64_t, std::uint32_t> number;  // fid -> feature
@@ -178,6 +183,11 @@ class LayerIndex {
 // of a feature; empty for a per-feature index or a layer without polygons. A point on a ring
 // may or may not count: callers test the rings themselves first.
 std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p);
+// The same answer, with the features' hierarchies at hand (LayerIndex::features() of a packed
+// per-segment index): only the features whose box holds p are counted, along whichever axis
+// direction leaves their boxes soonest.
+std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p,
+                                              const LayerIndex::Features& features);
 
 struct Query {
   enum class Kind : std::uint8_t { bbox, point, segment, within, nearest };
@@ -243,6 +253,7 @@ class LayerQuery {
     std::uint32_t stamp = 0;
     bool done = false;
     double best = 0;
+    double bound = 0;  // squared upper bound on the distance, from tight nodes
   };
   std::vector<FeatureState> state_;
   std::uint32_t generation_ = 0;

@@ -32,14 +32,17 @@ class LazyCheck {
 
   // Verifies the chunks holding [p, p + n) that were not verified yet. Bytes outside the
   // checked range are not this object's concern.
+  // The common case, bytes within one chunk verified already, costs a few instructions.
   void touch(const void* p, std::size_t n) const {
     const auto* b = static_cast<const std::byte*>(p);
     if (b < base_ || n == 0) return;
     const std::size_t off = std::size_t(b - base_);
     if (off >= size_) return;
-    const std::size_t last = std::min(off + n - 1, size_ - 1) >> shift_;
-    for (std::size_t c = off >> shift_; c <= last; ++c)
-      if (!verified_[c].load(std::memory_order_acquire)) verify_once(c);
+    const std::size_t c = off >> shift_;
+    if (off + n <= size_ && ((off + n - 1) >> shift_) == c &&
+        verified_[c].load(std::memory_order_acquire)) [[likely]]
+      return;
+    touch_range(off, n);
   }
   // Verifies every chunk (loci check).
   void touch_all() const {
@@ -59,6 +62,11 @@ class LazyCheck {
   virtual void verify(std::size_t c, const std::byte* data, std::size_t bytes) const = 0;
 
  private:
+  [[gnu::noinline]] void touch_range(std::size_t off, std::size_t n) const {
+    const std::size_t last = std::min(off + n - 1, size_ - 1) >> shift_;
+    for (std::size_t c = off >> shift_; c <= last; ++c)
+      if (!verified_[c].load(std::memory_order_acquire)) verify_once(c);
+  }
   void verify_once(std::size_t c) const {
     const std::size_t first = c << shift_;
     verify(c, base_ + first, std::min(size_ - first, std::size_t(1) << shift_));
