@@ -29,10 +29,9 @@ struct Layer {
 };
 
 void add_segment(Layer& l, std::int64_t fid, const Point2& a, const Point2& b) {
-  const bool anti = (a[0] < b[0]) != (a[1] < b[1]) && a[0] != b[0] && a[1] != b[1];
   const Segment2 s{a, b};
   l.items.boxes.push_back(s.box());
-  l.items.records.push_back({fid, 0, anti ? std::uint32_t(item_antidiagonal) : 0u});
+  l.items.records.push_back({fid, 0, segment_flags(a, b, false)});
   l.segments.emplace_back(fid, s);
 }
 
