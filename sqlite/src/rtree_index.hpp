@@ -68,31 +68,40 @@ class Window {
   // A constraint no row can meet (a NULL operand, or a number compared above every text).
   void make_empty() { never_ = true; }
 
+  // True when no box can match: a column bounded from both sides with nothing in between, or
+  // a box's min held above its max (min >= lo and max <= hi with lo > hi).
   bool empty() const {
     if (never_) return true;
-    const Box2 p = prune();
     for (int c = 0; c < 4; ++c)
       if (lo_[c] > hi_[c] || (lo_[c] == hi_[c] && (lo_strict_[c] || hi_strict_[c]))) return true;
-    return p.min[0] > p.max[0] || p.min[1] > p.max[1];
+    return lo_[0] > hi_[1] || lo_[2] > hi_[3];
   }
   bool unbounded() const { return !bounded_; }
 
   // A row's minx and maxx lie inside its box's x extent, so a lower bound on either needs
-  // box.max >= it and an upper bound on either needs box.min <= it.
+  // box.max >= it and an upper bound on either needs box.min <= it: the box meets [lo, hi] on
+  // that axis. When lo > hi ("minx <= 3 AND maxx >= 5": boxes holding [3, 5]) the condition
+  // box.min <= hi and box.max >= lo is still what the box must meet, but it is no window: the
+  // box returned is then [hi, lo], which every such box meets too, and matches() decides.
   Box2 prune() const {
     Box2 b;
     for (int a = 0; a < 2; ++a) {
-      b.min[a] = std::max({lo_[2 * a], lo_[2 * a + 1], -kMaxDouble});
-      b.max[a] = std::min({hi_[2 * a], hi_[2 * a + 1], kMaxDouble});
+      const auto [lo, hi] = meets(a);  // the trees take finite windows only
+      b.min[a] = std::clamp(std::min(lo, hi), -kMaxDouble, kMaxDouble);
+      b.max[a] = std::clamp(std::max(lo, hi), -kMaxDouble, kMaxDouble);
     }
     return b;
   }
   // True when every box meeting prune() (closed) matches: only "min <= v" and "max >= v"
-  // constraints, none strict, which is the window form of SQLite's rtree documentation.
+  // constraints, none strict, making a proper window (the form of SQLite's rtree
+  // documentation).
   bool prune_is_exact() const {
     for (int c = 0; c < 4; ++c)
       if (lo_strict_[c] || hi_strict_[c]) return false;
-    return lo_[0] == -kInf && hi_[1] == kInf && lo_[2] == -kInf && hi_[3] == kInf;
+    if (lo_[0] != -kInf || hi_[1] != kInf || lo_[2] != -kInf || hi_[3] != kInf) return false;
+    for (int a = 0; a < 2; ++a)
+      if (const auto [lo, hi] = meets(a); lo > hi) return false;
+    return true;
   }
   bool matches(const Box2& b) const {
     const double v[4] = {b.min[0], b.max[0], b.min[1], b.max[1]};
@@ -107,6 +116,12 @@ class Window {
  private:
   static constexpr double kMaxDouble = std::numeric_limits<double>::max();
   static constexpr double kInf = std::numeric_limits<double>::infinity();
+  // What a matching box's extent on axis a must meet: box.max >= lo and box.min <= hi (lo may
+  // be +inf and hi -inf, which no finite box meets).
+  std::pair<double, double> meets(int a) const {
+    return {std::max({lo_[2 * a], lo_[2 * a + 1], -kMaxDouble}),
+            std::min({hi_[2 * a], hi_[2 * a + 1], kMaxDouble})};
+  }
   void tighten_lo(int c, double v, bool strict) {
     if (v > lo_[c] || (v == lo_[c] && strict)) lo_[c] = v, lo_strict_[c] = strict;
   }

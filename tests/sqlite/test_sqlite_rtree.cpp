@@ -80,7 +80,22 @@ std::string random_where(std::mt19937_64& rng, const std::vector<Box<2>>& boxes)
         return real(u(rng));
     }
   };
-  const int form = int(rng() % 4);
+  const int form = int(rng() % 5);
+  if (form == 4) {  // boxes holding an interval: the bounds on min lie below those on max
+    const auto& b = boxes[rng() % boxes.size()];
+    std::uniform_real_distribution<double> t(-0.2, 1.2);
+    std::string w;
+    for (int a = 0; a < 2; ++a) {
+      if (a == 1 && rng() % 2) break;
+      double lo = b.min[a] + t(rng) * (b.max[a] - b.min[a]);
+      double hi = b.min[a] + t(rng) * (b.max[a] - b.min[a]);
+      if (lo > hi) std::swap(lo, hi);
+      if (a) w += " AND ";
+      w += std::string(cols[2 * a]) + (rng() % 2 ? " < " : " <= ") + real(lo) + " AND " +
+           cols[2 * a + 1] + (rng() % 2 ? " > " : " >= ") + real(hi);
+    }
+    return w;
+  }
   if (form == 0) {  // the window of SQLite's rtree documentation
     double x1 = u(rng), x2 = u(rng), y1 = u(rng), y2 = u(rng);
     if (x1 > x2) std::swap(x1, x2);
@@ -203,6 +218,11 @@ TEST(SqliteRtreeSql, ComparisonsFollowSqlRulesForEveryOperandType) {
                             "maxx > 9007199254740993",
                             "minx = 9007199254740993",
                             "minx <= 10 AND minx >= 12",
+                            "minx <= 3 AND maxx >= 3.25",
+                            "minx < 3.25 AND maxx > 3.25 AND maxx < 40",
+                            "minx <= 3 AND maxx >= 3.5 AND miny <= 3 AND maxy >= 4",
+                            "minx <= 3 AND maxx > 3.5",
+                            "minx >= 4 AND maxx <= 3.75",
                             "minx >= 1e999",
                             "minx <= -1e999",
                             "maxx < 1e999",
