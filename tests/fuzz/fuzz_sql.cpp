@@ -3,7 +3,8 @@
 // transaction control, loci_check, or raw SQL text from the input), later bytes its values,
 // among them the awkward ones (NULL, text, blobs, 1e999, integers past 2^53, inverted boxes).
 // Every write goes to the loci_rtree t and a plain table m alike; every query must answer as m
-// does and loci_check must say ok, until raw SQL has run (it may touch either table alone).
+// does (windows through SQL on m, nearest-n against every row of m by brute force) and
+// loci_check must say ok, until raw SQL has run (it may touch either table alone).
 // Fleet statements do the same with the loci_fleet f and a plain table of reports p: reports
 // inserted and objects deleted on both, windows at any time (before the latest report too)
 // through loci_fleet_window against the same question in SQL over p, conflicts and nearest with
@@ -11,6 +12,8 @@
 // SQL errors are expected; a crash, a sanitizer report or a disagreement is a finding.
 #include <sqlite3.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -68,6 +71,24 @@ std::vector<std::vector<std::string>> rows(sqlite3* db, const std::string& sql, 
       const unsigned char* t = sqlite3_column_text(s, i);
       r.push_back(t ? reinterpret_cast<const char*>(t) : "NULL");
     }
+    out.push_back(std::move(r));
+  }
+  ok = rc == SQLITE_DONE;
+  sqlite3_finalize(s);
+  return out;
+}
+
+// The rows of a query as doubles (ids too: they stay below 64 here).
+std::vector<std::vector<double>> numbers(sqlite3* db, const std::string& sql, bool& ok) {
+  std::vector<std::vector<double>> out;
+  sqlite3_stmt* s = nullptr;
+  ok = sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) == SQLITE_OK;
+  if (!ok) return out;
+  int rc;
+  while ((rc = sqlite3_step(s)) == SQLITE_ROW) {
+    std::vector<double> r;
+    for (int i = 0; i < sqlite3_column_count(s); ++i)
+      r.push_back(sqlite3_column_double(s, i));
     out.push_back(std::move(r));
   }
   ok = rc == SQLITE_DONE;
@@ -144,6 +165,40 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
              "SELECT * FROM loci_nearest('t', " + value(in) + ", " + value(in) + ", " + value(in) +
                  ")",
              ok);
+        continue;
+      }
+      case 10: {  // nearest-n checked against every row of m: the same distances, in order
+        const double x = int(in.byte()) - 128 + (in.byte() % 2 ? 0.5 : 0.0);
+        const double y = int(in.byte()) - 128;
+        const std::size_t k = in.byte() % 40;
+        if (!mirrored) continue;
+        bool ok1, ok2;
+        const auto got = numbers(db,
+                                 "SELECT id, distance FROM loci_nearest('t', " + std::to_string(x) +
+                                     ", " + std::to_string(y) + ", " + std::to_string(k) + ")",
+                                 ok1);
+        const auto all = numbers(db, "SELECT id, minx, maxx, miny, maxy FROM m", ok2);
+        if (!ok1 || !ok2) continue;
+        std::vector<std::pair<double, double>> brute;  // (distance, id)
+        for (const auto& r : all) {
+          const double dx = x < r[1] ? r[1] - x : x > r[2] ? x - r[2] : 0;
+          const double dy = y < r[3] ? r[3] - y : y > r[4] ? y - r[4] : 0;
+          brute.push_back({std::sqrt(dx * dx + dy * dy), r[0]});
+        }
+        std::sort(brute.begin(), brute.end());
+        if (got.size() != std::min(k, brute.size()))
+          finding("loci_nearest gave " + std::to_string(got.size()) +
+                  " rows for k = " + std::to_string(k) + " over " + std::to_string(brute.size()));
+        for (std::size_t i = 0; i < got.size(); ++i) {
+          if (got[i][1] != brute[i].first)
+            finding("loci_nearest rank " + std::to_string(i) + ": distance " +
+                    std::to_string(got[i][1]) + ", brute force " + std::to_string(brute[i].first));
+          // Ties may come in any order: an id must at least lie at its stated distance.
+          bool found = false;
+          for (const auto& [d, id] : brute)
+            found |= id == got[i][0] && d == got[i][1];
+          if (!found) finding("loci_nearest: id " + std::to_string(got[i][0]) + " misplaced");
+        }
         continue;
       }
       case 7: {
