@@ -238,6 +238,17 @@ LayerSummary summarize_layer(const std::string& path, const std::string& layer,
     const OGRFieldDefn* f = defn->GetFieldDefn(i);
     s.fields.emplace_back(f->GetNameRef(), OGRFieldDefn::GetFieldTypeName(f->GetType()));
   }
+  // A shapefile's types and extent come from its records, without GDAL's geometries (see
+  // read_shapefile_summary); a bad coordinate there is GDAL's to report, as for other formats.
+  try {
+    if (auto direct = read_shapefile_summary(path, layer, progress)) {
+      s.feature_count = direct->records;
+      s.geometry_types = std::move(direct->geometry_types);
+      s.extent = direct->extent;
+      return s;
+    }
+  } catch (const InvalidGeometry&) {
+  }
   std::map<std::string, std::int64_t> types;
   ProgressTicker ticker(progress, double(ol.layer->GetFeatureCount(FALSE)));
   const detail::ReadCheck read_check(path);

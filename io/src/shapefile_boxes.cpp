@@ -14,6 +14,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cstring>
+#include <map>
 #include <vector>
 
 #include "gdal_layer.hpp"
@@ -396,7 +397,69 @@ void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
   }
 }
 
+// GDAL's type for a polygon record of several rings (read and checked by read_record), from
+// the orientation of its rings: "Polygon" when exactly one runs clockwise (the outer ring;
+// GDAL then takes every other ring for a hole of it), "Multi Polygon" when more do; nullptr
+// when orientation cannot say: no ring clockwise, or a ring of zero area.
+const char* polygon_type(const unsigned char* c) {
+  const std::uint32_t parts = le32(c + 36), n = le32(c + 40);
+  const unsigned char* xy = c + 44 + 4 * std::uint64_t(parts);
+  const auto x = [&](std::uint32_t i) { return le_double(xy + 16 * std::uint64_t(i)); };
+  const auto y = [&](std::uint32_t i) { return le_double(xy + 16 * std::uint64_t(i) + 8); };
+  std::uint32_t outers = 0;
+  for (std::uint32_t k = 0; k < parts; ++k) {
+    const std::uint32_t begin = le32(c + 44 + 4 * std::uint64_t(k)),
+                        end = k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n;
+    // Twice the signed area (shoelace), relative to the ring's first point for precision.
+    double area = 0;
+    for (std::uint32_t i = begin + 1; i + 1 < end; ++i)
+      area += (x(i) - x(begin)) * (y(i + 1) - y(begin)) - (x(i + 1) - x(begin)) * (y(i) - y(begin));
+    if (!(area != 0)) return nullptr;
+    outers += area < 0;
+  }
+  if (outers == 0) return nullptr;
+  return outers == 1 ? "Polygon" : "Multi Polygon";
+}
+
 }  // namespace
+
+std::optional<ShapefileSummary> read_shapefile_summary(const std::string& path,
+                                                       const std::string& layer,
+                                                       const Progress& progress) {
+  ShapefileSummary out;
+  LayerItems items;
+  std::map<std::string, std::int64_t> types;
+  bool placed = true;
+  const bool read = scan_shapefile(
+      path, layer, progress, items,
+      [&](std::uint32_t, std::uint64_t records, std::uint64_t) {
+        out.records = std::int64_t(records);
+      },
+      [&](const RecordRead& r, std::int64_t, const unsigned char* c, std::uint32_t file_type) {
+        out.extent.expand(r.box);
+        const char* type = "Point";
+        if (kind_of(file_type) == Kind::multipoint) {
+          type = "Multi Point";
+        } else if (kind_of(file_type) == Kind::polyline_or_polygon) {
+          const bool single = le32(c + 36) == 1;
+          if (!is_polygon_type(file_type)) {
+            type = single ? "Line String" : "Multi Line String";
+          } else if (single) {
+            type = "Polygon";
+          } else {
+            type = polygon_type(c);
+            placed &= type != nullptr;
+            if (!type) return;
+          }
+        }
+        ++types[type];
+      });
+  if (!read || !placed) return std::nullopt;
+  if (const std::int64_t none = out.records - std::int64_t(items.features); none > 0)
+    types["(none)"] = none;
+  out.geometry_types.assign(types.begin(), types.end());
+  return out;
+}
 
 std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
                                                    const std::string& layer,

@@ -146,8 +146,55 @@ void expect_segments_like_gdal(const std::string& path, const LayerItems& direct
       EXPECT_GE(direct.records[i].part, direct.records[i - 1].part);
 }
 
+// What `loci info` reads of the file directly is what GDAL's geometries say: per record a
+// type name ("(none)" without geometry) and the extent.
+// `direct`: whether the file is one the direct summary takes (else GDAL answers for it).
+void expect_summary_like_gdal(const std::string& path, bool direct_read = true) {
+  const auto direct = loci::io::read_shapefile_summary(path);
+  ASSERT_EQ(bool(direct), direct_read) << "summary read directly";
+  std::map<std::string, std::int64_t> types;
+  loci::Box2 extent = loci::Box2::empty();
+  std::int64_t records = 0;
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+  for (auto& f : *ds->GetLayer(0)) {
+    ++records;
+    const OGRGeometry* g = f->GetGeometryRef();
+    if (!g || g->IsEmpty()) {
+      ++types["(none)"];
+      continue;
+    }
+    ++types[OGRGeometryTypeToName(wkbFlatten(g->getGeometryType()))];
+    OGREnvelope e;
+    g->getEnvelope(&e);
+    extent.expand(loci::Box2{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}});
+  }
+  const std::vector<std::pair<std::string, std::int64_t>> expected(types.begin(), types.end());
+  if (direct) {
+    EXPECT_EQ(direct->records, records);
+    EXPECT_EQ(direct->geometry_types, expected);
+    EXPECT_EQ(direct->extent, extent);
+  }
+  const loci::io::LayerSummary summary = loci::io::summarize_layer(path, "", {});
+  EXPECT_EQ(summary.feature_count, records);
+  EXPECT_EQ(summary.geometry_types, expected);
+  EXPECT_EQ(summary.extent, extent);
+}
+
+OGRLinearRing ring_of(std::initializer_list<std::pair<double, double>> points) {
+  OGRLinearRing r;
+  for (const auto& [x, y] : points)
+    r.addPoint(x, y);
+  r.closeRings();
+  return r;
+}
+
+void add_ring(OGRPolygon& p, OGRLinearRing r) {
+  p.addRing(&r);
+}
+
 void expect_like_gdal(const std::string& path) {
   SCOPED_TRACE(path);
+  expect_summary_like_gdal(path);
   const auto direct = loci::io::read_shapefile_boxes(path);
   ASSERT_TRUE(direct) << "handed back to GDAL";
   const Reference ref = gdal_reference(path);
@@ -259,6 +306,118 @@ TEST(ShapefileBoxes, EveryShapeFamilyMatchesGdal) {
         },
         4));
   }
+}
+
+TEST(ShapefileBoxes, PolygonTypesFollowRingOrientationAsGdalSortsRings) {
+  // Rings as GDAL writes them (outer clockwise, holes counter-clockwise), read back: holes
+  // inside, a hole outside its outer ring, islands, an island in a lake, a hole sharing
+  // vertices with the outer ring, a concave outer ring, one ring only.
+  const auto square = [](double x, double y, double s) {
+    return ring_of({{x, y}, {x + s, y}, {x + s, y + s}, {x, y + s}});
+  };
+  const auto make = [&](int i, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
+    auto p = std::make_unique<OGRPolygon>();
+    auto m = std::make_unique<OGRMultiPolygon>();
+    switch (i) {
+      case 0:  // one ring
+        add_ring(*p, square(0, 0, 10));
+        return p;
+      case 1:  // two holes inside
+        add_ring(*p, square(0, 0, 10));
+        add_ring(*p, square(1, 1, 2));
+        add_ring(*p, square(5, 5, 3));
+        return p;
+      case 2:  // a "hole" outside the outer ring
+        add_ring(*p, square(0, 0, 10));
+        add_ring(*p, square(20, 20, 2));
+        return p;
+      case 3: {  // two islands
+        OGRPolygon a, b;
+        add_ring(a, square(0, 0, 1));
+        add_ring(b, square(5, 5, 1));
+        m->addGeometry(&a);
+        m->addGeometry(&b);
+        return m;
+      }
+      case 4: {  // an island in a lake of an island
+        OGRPolygon a, b;
+        add_ring(a, square(0, 0, 10));
+        add_ring(a, square(2, 2, 6));
+        add_ring(b, square(4, 4, 2));
+        m->addGeometry(&a);
+        m->addGeometry(&b);
+        return m;
+      }
+      case 5: {  // a hole whose vertices, but not its first, touch the outer ring
+        add_ring(*p, square(0, 0, 10));
+        add_ring(*p, ring_of({{5, 5}, {10, 4}, {10, 6}}));
+        return p;
+      }
+      default: {  // a concave outer ring with a hole in its notch's shadow
+        add_ring(*p,
+                 ring_of({{0, 0}, {10, 0}, {10, 10}, {6, 10}, {6, 3}, {4, 3}, {4, 10}, {0, 10}}));
+        add_ring(*p, square(1, 5, 1));
+        return p;
+      }
+    }
+  };
+  const std::string path = write_shapefile("ring_types", wkbPolygon, 7, make, 8);
+  expect_summary_like_gdal(path);
+  const auto direct = loci::io::read_shapefile_summary(path);
+  ASSERT_TRUE(direct);
+  // Both answers occur: the test would not pass on a rule that always says one.
+  EXPECT_EQ(direct->geometry_types, (std::vector<std::pair<std::string, std::int64_t>>{
+                                        {"Multi Polygon", 3}, {"Polygon", 4}}));
+
+  // A counter-clockwise ring outside the clockwise one, which GDAL's writer never makes but
+  // other writers may: the first record's hole moved 20 units east in the .shp's bytes.
+  const std::string moved = write_shapefile(
+      "moved_hole", wkbPolygon, 2,
+      [&](int, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
+        auto p = std::make_unique<OGRPolygon>();
+        add_ring(*p, square(0, 0, 10));
+        add_ring(*p, square(1, 1, 2));
+        return p;
+      },
+      11);
+  {
+    std::vector<char> bytes(fs::file_size(moved));
+    std::ifstream(moved, std::ios::binary).read(bytes.data(), std::streamsize(bytes.size()));
+    // Record 0: 8 bytes of header, 44 of content header, 2 part starts, then x,y pairs; the
+    // hole's five points follow the outer ring's five.
+    for (int i = 5; i < 10; ++i) {
+      double x;
+      char* at = bytes.data() + 100 + 8 + 44 + 8 + 16 * i;
+      std::memcpy(&x, at, 8);
+      x += 20;
+      std::memcpy(at, &x, 8);
+    }
+    std::ofstream(moved, std::ios::binary | std::ios::trunc)
+        .write(bytes.data(), std::streamsize(bytes.size()));
+  }
+  expect_summary_like_gdal(moved);  // GDAL keeps it as a hole of the one outer ring
+
+  // A hole starting on the outer ring is still a hole; a hole of zero area has no
+  // orientation: GDAL answers for that file.
+  expect_summary_like_gdal(write_shapefile(
+      "ring_on_outer", wkbPolygon, 2,
+      [&](int i, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
+        auto p = std::make_unique<OGRPolygon>();
+        add_ring(*p, square(0, 0, 10));
+        if (i == 1) add_ring(*p, ring_of({{10, 5}, {8, 4}, {8, 6}}));
+        return p;
+      },
+      9));
+  expect_summary_like_gdal(write_shapefile(
+                               "flat_hole", wkbPolygon, 1,
+                               [&](int, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
+                                 auto p = std::make_unique<OGRPolygon>();
+                                 add_ring(*p, square(0, 0, 10));
+                                 add_ring(*p, ring_of({{2, 2}, {3, 3}, {4, 4}}));
+                                 return p;
+                               },
+                               10),
+                           false);
 }
 
 TEST(ShapefileBoxes, DegenerateShapes) {
