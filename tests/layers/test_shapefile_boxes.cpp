@@ -88,9 +88,9 @@ std::array<double, 4> corners(const loci::Box2& b) {
   return {b.min[0], b.min[1], b.max[0], b.max[1]};
 }
 
-// GDAL's own per-segment reading, through read_items: the same .shp and .shx without their
-// .dbf, which the direct reader hands to GDAL.
-LayerItems through_gdal(const std::string& path) {
+// The copy of a shapefile without its .dbf, in dir()/no_dbf: the direct reader hands it to
+// GDAL, so what loci reads of it is GDAL's answer.
+std::string without_dbf(const std::string& path) {
   const fs::path sub = dir() / "no_dbf";
   fs::create_directories(sub);
   const fs::path stem = fs::path(path).replace_extension();
@@ -98,7 +98,13 @@ LayerItems through_gdal(const std::string& path) {
   fs::remove(sub / (name + ".dbf"));
   for (const char* ext : {".shp", ".shx"})
     fs::copy_file(stem.string() + ext, sub / (name + ext), fs::copy_options::overwrite_existing);
-  const std::string copy = (sub / (name + ".shp")).string();
+  return (sub / (name + ".shp")).string();
+}
+
+// GDAL's own per-segment reading, through read_items: the same .shp and .shx without their
+// .dbf, which the direct reader hands to GDAL.
+LayerItems through_gdal(const std::string& path) {
+  const std::string copy = without_dbf(path);
   EXPECT_FALSE(loci::io::read_shapefile_segments(copy)) << "no .dbf: GDAL reads it";
   return loci::io::read_items(copy, "", Per::segment);
 }
@@ -147,37 +153,23 @@ void expect_segments_like_gdal(const std::string& path, const LayerItems& direct
 }
 
 // What `loci info` reads of the file directly is what GDAL's geometries say: per record a
-// type name ("(none)" without geometry) and the extent.
-// `direct`: whether the file is one the direct summary takes (else GDAL answers for it).
+// type name ("(none)" without geometry) and the extent. `direct_read`: whether the file is
+// one the direct summary takes (else GDAL answers for it).
 void expect_summary_like_gdal(const std::string& path, bool direct_read = true) {
   const auto direct = loci::io::read_shapefile_summary(path);
   ASSERT_EQ(bool(direct), direct_read) << "summary read directly";
-  std::map<std::string, std::int64_t> types;
-  loci::Box2 extent = loci::Box2::empty();
-  std::int64_t records = 0;
-  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
-  for (auto& f : *ds->GetLayer(0)) {
-    ++records;
-    const OGRGeometry* g = f->GetGeometryRef();
-    if (!g || g->IsEmpty()) {
-      ++types["(none)"];
-      continue;
-    }
-    ++types[OGRGeometryTypeToName(wkbFlatten(g->getGeometryType()))];
-    OGREnvelope e;
-    g->getEnvelope(&e);
-    extent.expand(loci::Box2{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}});
-  }
-  const std::vector<std::pair<std::string, std::int64_t>> expected(types.begin(), types.end());
+  const std::string copy = without_dbf(path);
+  ASSERT_FALSE(loci::io::read_shapefile_summary(copy)) << "no .dbf: GDAL reads it";
+  const loci::io::LayerSummary gdal = loci::io::summarize_layer(copy, "", {});
   if (direct) {
-    EXPECT_EQ(direct->records, records);
-    EXPECT_EQ(direct->geometry_types, expected);
-    EXPECT_EQ(direct->extent, extent);
+    EXPECT_EQ(direct->records, gdal.feature_count);
+    EXPECT_EQ(direct->geometry_types, gdal.geometry_types);
+    EXPECT_EQ(direct->extent, gdal.extent);
   }
   const loci::io::LayerSummary summary = loci::io::summarize_layer(path, "", {});
-  EXPECT_EQ(summary.feature_count, records);
-  EXPECT_EQ(summary.geometry_types, expected);
-  EXPECT_EQ(summary.extent, extent);
+  EXPECT_EQ(summary.feature_count, gdal.feature_count);
+  EXPECT_EQ(summary.geometry_types, gdal.geometry_types);
+  EXPECT_EQ(summary.extent, gdal.extent);
 }
 
 OGRLinearRing ring_of(std::initializer_list<std::pair<double, double>> points) {
