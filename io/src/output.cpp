@@ -49,6 +49,10 @@ void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
 void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
                bool with_distance, bool with_point, std::FILE* out) {
   auto ol = detail::open_layer(src.layer_path, src.layer_name);
+  // The rows hold attributes only: GDAL need not build the geometries (for a shapefile of
+  // countries with thousands of islands, sorting their rings takes minutes).
+  const char* no_geometry[] = {"OGR_GEOMETRY", nullptr};
+  ol.layer->SetIgnoredFields(no_geometry);
   const OGRFeatureDefn* defn = ol.layer->GetLayerDefn();
   std::string line = numbered ? "query,fid" : "fid";
   if (with_distance) line += ",distance";
