@@ -13,9 +13,12 @@
 #include <bit>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <vector>
+
+#include <cpl_conv.h>
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
@@ -398,27 +401,71 @@ void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
 }
 
 // GDAL's type for a polygon record of several rings (read and checked by read_record), from
-// the orientation of its rings: "Polygon" when exactly one runs clockwise (the outer ring;
-// GDAL then takes every other ring for a hole of it), "Multi Polygon" when more do; nullptr
-// when orientation cannot say: no ring clockwise, or a ring of zero area.
+// the orientation of its rings: "Polygon" when exactly one runs clockwise (the outer ring)
+// and every other ring's first point lies inside it, "Multi Polygon" when more run clockwise;
+// A ring's orientation is decided as GDAL decides it: by the turn at its lowest rightmost
+// vertex, or by its signed area when that vertex is there twice or has a neighbour within
+// 1e-5. nullptr, for GDAL to answer, whenever a record is unusual: a ring of fewer than 4
+// points, unclosed or of zero area, no clockwise ring, or a hole not plainly inside the outer
+// ring (GDAL versions differ there).
 const char* polygon_type(const unsigned char* c) {
   const std::uint32_t parts = le32(c + 36), n = le32(c + 40);
   const unsigned char* xy = c + 44 + 4 * std::uint64_t(parts);
+  const auto range = [&](std::uint32_t k) {
+    return std::pair{le32(c + 44 + 4 * std::uint64_t(k)),
+                     k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n};
+  };
   const auto x = [&](std::uint32_t i) { return le_double(xy + 16 * std::uint64_t(i)); };
   const auto y = [&](std::uint32_t i) { return le_double(xy + 16 * std::uint64_t(i) + 8); };
-  std::uint32_t outers = 0;
+  std::uint32_t outer = 0, outers = 0;
   for (std::uint32_t k = 0; k < parts; ++k) {
-    const std::uint32_t begin = le32(c + 44 + 4 * std::uint64_t(k)),
-                        end = k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n;
+    const auto [begin, end] = range(k);
+    if (end - begin < 4 || x(begin) != x(end - 1) || y(begin) != y(end - 1)) return nullptr;
     // Twice the signed area (shoelace), relative to the ring's first point for precision.
     double area = 0;
     for (std::uint32_t i = begin + 1; i + 1 < end; ++i)
       area += (x(i) - x(begin)) * (y(i + 1) - y(begin)) - (x(i + 1) - x(begin)) * (y(i) - y(begin));
+    // The turn at the lowest rightmost vertex, GDAL's test of orientation.
+    std::uint32_t v = begin;
+    bool twice = false;
+    for (std::uint32_t i = begin + 1; i + 1 < end; ++i) {
+      if (y(i) < y(v) || (y(i) == y(v) && x(i) > x(v)))
+        v = i, twice = false;
+      else if (y(i) == y(v) && x(i) == x(v))
+        twice = true;
+    }
+    const std::uint32_t prev = v == begin ? end - 2 : v - 1, next = v + 2 == end ? begin : v + 1;
+    const double turn = (x(v) - x(prev)) * (y(next) - y(v)) - (y(v) - y(prev)) * (x(next) - x(v));
+    // GDAL goes by the signed area when that vertex is there twice (a ring touching itself)
+    // or a neighbour lies within 1e-5 of it on both axes, else by the turn.
+    const auto near = [&](std::uint32_t i) {
+      return std::abs(x(i) - x(v)) < 1e-5 && std::abs(y(i) - y(v)) < 1e-5;
+    };
+    const bool by_area = twice || near(prev) || near(next) || !(turn != 0);
     if (!(area != 0)) return nullptr;
-    outers += area < 0;
+    const bool clockwise = by_area ? area < 0 : turn < 0;
+    if (clockwise) outer = k, ++outers;
   }
   if (outers == 0) return nullptr;
-  return outers == 1 ? "Polygon" : "Multi Polygon";
+  if (outers > 1) return "Multi Polygon";
+  // Each hole's first point strictly inside the outer ring, by crossings (even-odd).
+  const auto [begin, end] = range(outer);
+  for (std::uint32_t k = 0; k < parts; ++k) {
+    if (k == outer) continue;
+    const std::uint32_t first = range(k).first;
+    const double px = x(first), py = y(first);
+    bool inside = false;
+    for (std::uint32_t i = begin, j = end - 1; i < end; j = i++) {
+      const double xi = x(i), yi = y(i), xj = x(j), yj = y(j);
+      const double cross = (xj - xi) * (py - yi) - (px - xi) * (yj - yi);
+      if (cross == 0 && std::min(xi, xj) <= px && px <= std::max(xi, xj) &&
+          std::min(yi, yj) <= py && py <= std::max(yi, yj))
+        return nullptr;  // on the outer ring
+      if ((yi > py) != (yj > py) && (cross > 0) == (yj > yi)) inside = !inside;
+    }
+    if (!inside) return nullptr;
+  }
+  return "Polygon";
 }
 
 }  // namespace
@@ -426,6 +473,8 @@ const char* polygon_type(const unsigned char* c) {
 std::optional<ShapefileSummary> read_shapefile_summary(const std::string& path,
                                                        const std::string& layer,
                                                        const Progress& progress) {
+  // A user's OGR_ORGANIZE_POLYGONS changes how GDAL sorts rings: then GDAL answers.
+  if (CPLGetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr)) return std::nullopt;
   ShapefileSummary out;
   LayerItems items;
   std::map<std::string, std::int64_t> types;

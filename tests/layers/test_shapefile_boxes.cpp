@@ -387,19 +387,36 @@ TEST(ShapefileBoxes, PolygonTypesFollowRingOrientationAsGdalSortsRings) {
     std::ofstream(moved, std::ios::binary | std::ios::trunc)
         .write(bytes.data(), std::streamsize(bytes.size()));
   }
-  expect_summary_like_gdal(moved);  // GDAL keeps it as a hole of the one outer ring
+  // GDAL 3.6 keeps it as a hole of the one outer ring, later versions make it a polygon of
+  // its own: GDAL answers for such a file.
+  expect_summary_like_gdal(moved, false);
 
-  // A hole starting on the outer ring is still a hole; a hole of zero area has no
-  // orientation: GDAL answers for that file.
+  // A self-intersecting hole, whose signed area and lowest turn disagree on its orientation:
+  // read as GDAL reads it, by the turn.
+  expect_summary_like_gdal(
+      write_shapefile(
+          "bowtie_hole", wkbPolygon, 1,
+          [&](int, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
+            auto p = std::make_unique<OGRPolygon>();
+            add_ring(*p, square(-5, -5, 20));
+            add_ring(*p, ring_of({{0, 0}, {10, 1}, {0, 2}, {0, 10}, {10, 10}, {10, 2.5}}));
+            return p;
+          },
+          12),
+      true);
+
+  // A hole starting on the outer ring, and a hole of zero area: orientation cannot place
+  // them plainly, GDAL answers for those files.
   expect_summary_like_gdal(write_shapefile(
-      "ring_on_outer", wkbPolygon, 2,
-      [&](int i, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
-        auto p = std::make_unique<OGRPolygon>();
-        add_ring(*p, square(0, 0, 10));
-        if (i == 1) add_ring(*p, ring_of({{10, 5}, {8, 4}, {8, 6}}));
-        return p;
-      },
-      9));
+                               "ring_on_outer", wkbPolygon, 2,
+                               [&](int i, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
+                                 auto p = std::make_unique<OGRPolygon>();
+                                 add_ring(*p, square(0, 0, 10));
+                                 if (i == 1) add_ring(*p, ring_of({{10, 5}, {8, 4}, {8, 6}}));
+                                 return p;
+                               },
+                               9),
+                           false);
   expect_summary_like_gdal(write_shapefile(
                                "flat_hole", wkbPolygon, 1,
                                [&](int, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
@@ -410,6 +427,24 @@ TEST(ShapefileBoxes, PolygonTypesFollowRingOrientationAsGdalSortsRings) {
                                },
                                10),
                            false);
+}
+
+TEST(ShapefileBoxes, ARingSortingMethodChosenByTheUserGoesToGdal) {
+  const std::string path = write_shapefile(
+      "islands", wkbMultiPolygon, 3,
+      [](int, std::mt19937_64& rng) -> std::unique_ptr<OGRGeometry> {
+        auto m = std::make_unique<OGRMultiPolygon>();
+        for (int k = 0; k < 3; ++k)
+          m->addGeometryDirectly(random_polygon(rng, 1, false).release());
+        return m;
+      },
+      13);
+  expect_summary_like_gdal(path);
+  CPLSetConfigOption("OGR_ORGANIZE_POLYGONS", "SKIP");
+  CPLPushErrorHandler(CPLQuietErrorHandler);  // GDAL warns of every record it leaves unsorted
+  expect_summary_like_gdal(path, false);
+  CPLPopErrorHandler();
+  CPLSetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr);
 }
 
 TEST(ShapefileBoxes, DegenerateShapes) {

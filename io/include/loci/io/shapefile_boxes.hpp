@@ -63,12 +63,13 @@ std::optional<LayerItems> read_shapefile_segments(const std::string& path,
 // them, and the extent. Points are Point, multipoints Multi Point, lines of one part Line
 // String and of more Multi Line String; a polygon record of one ring is a Polygon, and of more
 // a Polygon when exactly one ring is an outer ring (clockwise, the format's rule: holes run
-// counter-clockwise; GDAL then takes every other ring for a hole of it), else a Multi
-// Polygon. GDAL sorts the rings of a record with several outer rings into polygons by testing
+// counter-clockwise) and the others start inside it, a Multi Polygon when more rings are
+// outer. GDAL sorts the rings of a record with several outer rings into polygons by testing
 // which holds which, all against all, which takes minutes on a layer of countries with
-// thousands of islands; the orientation of the rings gives the type in linear time. nullopt
-// when GDAL must read the file, also when a record of several rings has no clockwise ring or
-// a ring of zero area; throws as read_shapefile_boxes.
+// thousands of islands; the orientation of the rings gives the type in linear time. nullopt,
+// for GDAL to answer, when the file is not one the direct reader takes, when
+// OGR_ORGANIZE_POLYGONS is set, and when a record holds a ring orientation cannot place
+// plainly (see polygon_type in the source); throws as read_shapefile_boxes.
 struct ShapefileSummary {
   std::int64_t records = 0;                                          // null shapes included
   std::vector<std::pair<std::string, std::int64_t>> geometry_types;  // GDAL's names, "(none)"
