@@ -22,6 +22,7 @@
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
+#include "loci/io/exact.hpp"
 
 namespace loci::io {
 
@@ -402,7 +403,7 @@ void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
 
 // GDAL's type for a polygon record of several rings (read and checked by read_record), from
 // the orientation of its rings: "Polygon" when exactly one runs clockwise (the outer ring)
-// and every other ring's first point lies inside it, "Multi Polygon" when more run clockwise;
+// and every other ring's first point lies inside it, "Multi Polygon" when more run clockwise.
 // A ring's orientation is decided as GDAL decides it: by the turn at its lowest rightmost
 // vertex, or by its signed area when that vertex is there twice or has a neighbour within
 // 1e-5. nullptr, for GDAL to answer, whenever a record is unusual: a ring of fewer than 4
@@ -448,22 +449,19 @@ const char* polygon_type(const unsigned char* c) {
   }
   if (outers == 0) return nullptr;
   if (outers > 1) return "Multi Polygon";
-  // Each hole's first point strictly inside the outer ring, by crossings (even-odd).
+  // Each hole's first point strictly inside the outer ring, located exactly through the
+  // ring prepared once (linear in the points, however many holes).
   const auto [begin, end] = range(outer);
+  FlatGeometry ring;
+  ring.points.reserve(end - begin);
+  for (std::uint32_t i = begin; i < end; ++i)
+    ring.points.push_back({x(i), y(i)});
+  ring.parts.push_back({0, end - begin, PartKind::ring, 0});
+  ring.polygons = 1;
+  const PreparedGeometry prepared(ring);
   for (std::uint32_t k = 0; k < parts; ++k) {
-    if (k == outer) continue;
     const std::uint32_t first = range(k).first;
-    const double px = x(first), py = y(first);
-    bool inside = false;
-    for (std::uint32_t i = begin, j = end - 1; i < end; j = i++) {
-      const double xi = x(i), yi = y(i), xj = x(j), yj = y(j);
-      const double cross = (xj - xi) * (py - yi) - (px - xi) * (yj - yi);
-      if (cross == 0 && std::min(xi, xj) <= px && px <= std::max(xi, xj) &&
-          std::min(yi, yj) <= py && py <= std::max(yi, yj))
-        return nullptr;  // on the outer ring
-      if ((yi > py) != (yj > py) && (cross > 0) == (yj > yi)) inside = !inside;
-    }
-    if (!inside) return nullptr;
+    if (k != outer && prepared.locate({x(first), y(first)}) != Location::inside) return nullptr;
   }
   return "Polygon";
 }
