@@ -18,6 +18,7 @@
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
+#include "shapefile_polygons.hpp"
 
 namespace loci::io {
 
@@ -83,6 +84,58 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o) {
   return w;
 }
 
+// What of `g` can meet the window, or nullptr when that is all of it: of a collection (a
+// multi-polygon of islands...) the members, of a polygon the rings, whose envelope meets the
+// window's. No ring left out encloses a point of the window, so leaving them out changes
+// neither the repaired geometry inside the window nor the cut, and spares GEOS repairing and
+// cutting a country's thousands of far islands and lakes.
+std::unique_ptr<OGRGeometry> near_window(const OGRGeometry& g, const OGREnvelope& window) {
+  const auto meets = [&](const OGRGeometry& m) {
+    OGREnvelope e;
+    m.getEnvelope(&e);
+    return e.Intersects(window);
+  };
+  std::unique_ptr<OGRGeometry> out;
+  const auto type = g.getGeometryType();
+  if (wkbFlatten(type) == wkbPolygon) {
+    const OGRPolygon& p = *g.toPolygon();
+    int holes = 0;
+    for (int i = 0; i < p.getNumInteriorRings(); ++i)
+      holes += meets(*p.getInteriorRing(i));
+    if (holes == p.getNumInteriorRings()) return nullptr;
+    auto q = std::make_unique<OGRPolygon>();
+    q->addRingDirectly(p.getExteriorRing()->clone());
+    for (int i = 0; i < p.getNumInteriorRings(); ++i)
+      if (meets(*p.getInteriorRing(i))) q->addRingDirectly(p.getInteriorRing(i)->clone());
+    out = std::move(q);
+  } else if (OGR_GT_IsSubClassOf(type, wkbGeometryCollection)) {
+    const OGRGeometryCollection& c = *g.toGeometryCollection();
+    bool all = true;
+    std::vector<std::unique_ptr<OGRGeometry>> near;  // nullptr: the member whole
+    for (const OGRGeometry* m : c) {
+      if (!meets(*m)) {
+        all = false;
+        continue;
+      }
+      near.push_back(near_window(*m, window));
+      all &= !near.back();
+    }
+    if (all) return nullptr;
+    out.reset(OGRGeometryFactory::createGeometry(type));
+    std::size_t j = 0;
+    for (const OGRGeometry* m : c) {
+      if (!meets(*m)) continue;
+      const OGRGeometry* keep = near[j] ? near[j].get() : m;
+      ++j;
+      if (out->toGeometryCollection()->addGeometry(keep) != OGRERR_NONE) return nullptr;
+    }
+  } else {
+    return nullptr;
+  }
+  out->assignSpatialReference(g.getSpatialReference());
+  return out;
+}
+
 }  // namespace
 
 std::size_t clip_layer(const ClipOptions& options) {
@@ -127,13 +180,18 @@ std::size_t clip_layer(const ClipOptions& options) {
     const OGRwkbGeometryType source_type = src.layer->GetGeomType();
     const bool mixed_ok = std::string(driver->GetDescription()) != "ESRI Shapefile";
     bool degenerate = false;
+    detail::ShapefilePolygons polygons(options.load.layer_path, *src.layer);
+    OGREnvelope window_envelope;
+    window->getEnvelope(&window_envelope);
     for (const auto& a : answers) {
-      OGRFeatureUniquePtr f(src.layer->GetFeature(a.fid));
+      OGRFeatureUniquePtr f(polygons.fetch(a.fid));
       if (!f || !f->GetGeometryRef()) continue;
       const OGRGeometry* g = f->GetGeometryRef();
       if (!rectangle &&
           !meets(detail::flatten(g, detail::where(options.load.layer_path, a.fid)), window_flat))
         continue;
+      const std::unique_ptr<OGRGeometry> near = near_window(*g, window_envelope);
+      if (near) g = near.get();
       std::unique_ptr<OGRGeometry> valid;
       if (!g->IsValid()) {
         valid.reset(g->MakeValid());

@@ -13,6 +13,7 @@
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/exact.hpp"
+#include "shapefile_polygons.hpp"
 
 namespace loci::io {
 
@@ -135,13 +136,17 @@ struct LayerQuery::Geometries {
   std::string name;
   std::shared_ptr<LayerGeometries> shared;
   std::optional<detail::OpenLayer> layer;
+  std::unique_ptr<detail::ShapefilePolygons> polygons;  // of `layer`
   std::unordered_map<std::int64_t, FlatGeometry> cache;
 
   const FlatGeometry& get(std::int64_t fid) {
     if (const FlatGeometry* g = shared->find(fid)) return *g;
     if (auto it = cache.find(fid); it != cache.end()) return it->second;
-    if (!layer) layer = detail::open_layer(path, name);
-    OGRFeatureUniquePtr f(layer->layer->GetFeature(fid));
+    if (!layer) {
+      layer = detail::open_layer(path, name);
+      polygons = std::make_unique<detail::ShapefilePolygons>(path, *layer->layer);
+    }
+    OGRFeatureUniquePtr f(polygons->fetch(fid));
     if (!f)
       throw Error(detail::where(path, fid) + " is not in the layer: the index does not match it");
     return cache.emplace(fid, detail::flatten(f->GetGeometryRef(), detail::where(path, fid)))

@@ -11,6 +11,7 @@
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
+#include "shapefile_polygons.hpp"
 
 namespace loci::io {
 namespace {
@@ -31,10 +32,12 @@ std::string number(double d) {
   return buf;
 }
 
-OGRFeatureUniquePtr fetch(detail::OpenLayer& ol, const AnswerSource& src, std::int64_t fid) {
-  OGRFeatureUniquePtr f(ol.layer->GetFeature(fid));
+OGRFeatureUniquePtr found(OGRFeatureUniquePtr f, const AnswerSource& src, std::int64_t fid) {
   if (!f) throw Error(detail::where(src.layer_path, fid) + " is not in the layer");
   return f;
+}
+OGRFeatureUniquePtr fetch(detail::OpenLayer& ol, const AnswerSource& src, std::int64_t fid) {
+  return found(OGRFeatureUniquePtr(ol.layer->GetFeature(fid)), src, fid);
 }
 
 void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
@@ -109,8 +112,10 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
     if (layer->CreateField(&copy) != OGRERR_NONE) throw Error("cannot create field " + name);
     copied.emplace_back(i, out_index++);
   }
+  // A shapefile's polygons of many rings are built without GDAL's sorting of rings.
+  detail::ShapefilePolygons polygons(src.layer_path, *ol.layer);
   for (const auto& a : answers) {
-    const auto f = fetch(ol, src, a.fid);
+    const auto f = found(polygons.fetch(a.fid), src, a.fid);
     OGRFeature out(layer->GetLayerDefn());
     if (query_field >= 0) out.SetField(query_field, static_cast<GIntBig>(a.query));
     out.SetField(fid_field, static_cast<GIntBig>(a.fid));

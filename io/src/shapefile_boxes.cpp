@@ -22,7 +22,9 @@
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
+#include "loci/index/packed_rtree.hpp"
 #include "loci/io/exact.hpp"
+#include "shapefile_polygons.hpp"
 
 namespace loci::io {
 
@@ -50,8 +52,10 @@ class ChunkReader {
  public:
   // With `hash`, the bytes read are hashed as they pass, as long as each read starts within
   // what was read before (records in file order); hash_rest() then reads and hashes the rest.
-  explicit ChunkReader(const std::string& path, StreamHash* hash = nullptr)
-      : path_(path), hash_(hash) {
+  // `chunk`: how much a read that misses fetches (small for reads in random order).
+  explicit ChunkReader(const std::string& path, StreamHash* hash = nullptr,
+                       std::uint64_t chunk = kChunk)
+      : path_(path), hash_(hash), chunk_(chunk) {
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd_ < 0) return;
     struct stat st {};
@@ -75,7 +79,7 @@ class ChunkReader {
   const unsigned char* get(std::uint64_t offset, std::uint64_t n) {
     if (offset > size_ || n > size_ - offset) return nullptr;
     if (offset >= at_ && offset + n <= at_ + held_) return buffer_.data() + (offset - at_);
-    const std::uint64_t want = std::min(size_ - offset, std::max<std::uint64_t>(n, kChunk));
+    const std::uint64_t want = std::min(size_ - offset, std::max<std::uint64_t>(n, chunk_));
     if (buffer_.size() < want) buffer_.resize(want);
     std::uint64_t done = 0;
     while (done < want) {
@@ -110,6 +114,7 @@ class ChunkReader {
   static constexpr std::uint64_t kBroken = ~std::uint64_t(0);
   std::string path_;
   StreamHash* hash_;
+  std::uint64_t chunk_;
   std::uint64_t hashed_ = 0;
   int fd_ = -1;
   std::uint64_t size_ = 0;
@@ -401,32 +406,31 @@ void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
   }
 }
 
-// GDAL's type for a polygon record of several rings (read and checked by read_record), from
-// the orientation of its rings: "Polygon" when exactly one runs clockwise (the outer ring)
-// and every other ring's first point lies inside it, "Multi Polygon" when more run clockwise.
-// A ring's orientation is decided as GDAL decides it: by the turn at its lowest rightmost
-// vertex, or by its signed area when that vertex is there twice or has a neighbour within
-// 1e-5. nullptr, for GDAL to answer, whenever a record is unusual: a ring of fewer than 4
-// points, unclosed or of zero area, no clockwise ring, or a hole not plainly inside the outer
-// ring (GDAL versions differ there).
-const char* polygon_type(const unsigned char* c) {
-  const std::uint32_t parts = le32(c + 36), n = le32(c + 40);
-  const unsigned char* xy = c + 44 + 4 * std::uint64_t(parts);
-  const auto range = [&](std::uint32_t k) {
-    return std::pair{le32(c + 44 + 4 * std::uint64_t(k)),
-                     k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n};
-  };
-  const auto x = [&](std::uint32_t i) { return le_double(xy + 16 * std::uint64_t(i)); };
-  const auto y = [&](std::uint32_t i) { return le_double(xy + 16 * std::uint64_t(i) + 8); };
-  std::uint32_t outer = 0, outers = 0;
-  for (std::uint32_t k = 0; k < parts; ++k) {
+// The rings of a polygon record (read and checked by read_record): ring k runs over points
+// [range(k).first, range(k).second).
+struct PolygonRings {
+  explicit PolygonRings(const unsigned char* content)
+      : c(content), parts(le32(c + 36)), n(le32(c + 40)), xy(c + 44 + 4 * std::uint64_t(parts)) {}
+  std::pair<std::uint32_t, std::uint32_t> range(std::uint32_t k) const {
+    return {le32(c + 44 + 4 * std::uint64_t(k)),
+            k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n};
+  }
+  double x(std::uint32_t i) const { return le_double(xy + 16 * std::uint64_t(i)); }
+  double y(std::uint32_t i) const { return le_double(xy + 16 * std::uint64_t(i) + 8); }
+  Point2 point(std::uint32_t i) const { return {x(i), y(i)}; }
+
+  // Ring k's orientation as GDAL decides it: by the turn at its lowest rightmost vertex, or
+  // by its signed area when that vertex is there twice or has a neighbour within 1e-5.
+  // 1 clockwise, 0 counter-clockwise, -1 for a ring GDAL places otherwise: fewer than 4
+  // points, unclosed, or of zero area.
+  int clockwise(std::uint32_t k) const {
     const auto [begin, end] = range(k);
-    if (end - begin < 4 || x(begin) != x(end - 1) || y(begin) != y(end - 1)) return nullptr;
+    if (end - begin < 4 || x(begin) != x(end - 1) || y(begin) != y(end - 1)) return -1;
     // Twice the signed area (shoelace), relative to the ring's first point for precision.
     double area = 0;
     for (std::uint32_t i = begin + 1; i + 1 < end; ++i)
       area += (x(i) - x(begin)) * (y(i + 1) - y(begin)) - (x(i + 1) - x(begin)) * (y(i) - y(begin));
-    // The turn at the lowest rightmost vertex, GDAL's test of orientation.
+    if (!(area != 0)) return -1;
     std::uint32_t v = begin;
     bool twice = false;
     for (std::uint32_t i = begin + 1; i + 1 < end; ++i) {
@@ -437,33 +441,218 @@ const char* polygon_type(const unsigned char* c) {
     }
     const std::uint32_t prev = v == begin ? end - 2 : v - 1, next = v + 2 == end ? begin : v + 1;
     const double turn = (x(v) - x(prev)) * (y(next) - y(v)) - (y(v) - y(prev)) * (x(next) - x(v));
-    // GDAL goes by the signed area when that vertex is there twice (a ring touching itself)
-    // or a neighbour lies within 1e-5 of it on both axes, else by the turn.
     const auto near = [&](std::uint32_t i) {
       return std::abs(x(i) - x(v)) < 1e-5 && std::abs(y(i) - y(v)) < 1e-5;
     };
     const bool by_area = twice || near(prev) || near(next) || !(turn != 0);
-    if (!(area != 0)) return nullptr;
-    const bool clockwise = by_area ? area < 0 : turn < 0;
-    if (clockwise) outer = k, ++outers;
+    return (by_area ? area < 0 : turn < 0) ? 1 : 0;
+  }
+
+  // Ring k's area as GDAL computes it (Green's theorem, the same sum in the same order), by
+  // which it ranks the rings that may hold a hole.
+  double gdal_area(std::uint32_t k) const {
+    const auto [begin, end] = range(k);
+    double sum = x(begin) * (y(begin + 1) - y(end - 1));
+    for (std::uint32_t i = begin + 1; i + 1 < end; ++i)
+      sum += x(i) * (y(i + 1) - y(i - 1));
+    sum += x(end - 1) * (y(begin) - y(end - 2));
+    return 0.5 * std::fabs(sum);
+  }
+
+  Box2 envelope(std::uint32_t k) const {
+    const auto [begin, end] = range(k);
+    Box2 b = Box2::empty();
+    for (std::uint32_t i = begin; i < end; ++i)
+      b.expand(point(i));
+    return b;
+  }
+
+  // Ring k alone, for exact point location.
+  FlatGeometry ring(std::uint32_t k) const {
+    const auto [begin, end] = range(k);
+    FlatGeometry g;
+    g.points.reserve(end - begin);
+    for (std::uint32_t i = begin; i < end; ++i)
+      g.points.push_back(point(i));
+    g.parts.push_back({0, end - begin, PartKind::ring, 0});
+    g.polygons = 1;
+    return g;
+  }
+
+  const unsigned char* c;
+  std::uint32_t parts, n;
+  const unsigned char* xy;
+};
+
+// A ring prepared for exact point location (the geometry outlives its preparation).
+struct PreparedRing {
+  explicit PreparedRing(FlatGeometry g) : ring(std::move(g)), prepared(ring) {}
+  FlatGeometry ring;
+  PreparedGeometry prepared;
+};
+
+// GDAL's type for a polygon record of several rings (read and checked by read_record), from
+// the orientation of its rings: "Polygon" when exactly one runs clockwise (the outer ring)
+// and every other ring's first point lies inside it, "Multi Polygon" when more run clockwise.
+// nullptr, for GDAL to answer, whenever a record is unusual: a ring orientation cannot place
+// (PolygonRings::clockwise), no clockwise ring, or a hole not plainly inside the outer ring
+// (GDAL versions differ there).
+const char* polygon_type(const unsigned char* c) {
+  const PolygonRings r(c);
+  std::uint32_t outer = 0, outers = 0;
+  for (std::uint32_t k = 0; k < r.parts; ++k) {
+    const int cw = r.clockwise(k);
+    if (cw < 0) return nullptr;
+    if (cw) outer = k, ++outers;
   }
   if (outers == 0) return nullptr;
   if (outers > 1) return "Multi Polygon";
   // Each hole's first point strictly inside the outer ring, located exactly through the
   // ring prepared once (linear in the points, however many holes).
-  const auto [begin, end] = range(outer);
-  FlatGeometry ring;
-  ring.points.reserve(end - begin);
-  for (std::uint32_t i = begin; i < end; ++i)
-    ring.points.push_back({x(i), y(i)});
-  ring.parts.push_back({0, end - begin, PartKind::ring, 0});
-  ring.polygons = 1;
-  const PreparedGeometry prepared(ring);
-  for (std::uint32_t k = 0; k < parts; ++k) {
-    const std::uint32_t first = range(k).first;
-    if (k != outer && prepared.locate({x(first), y(first)}) != Location::inside) return nullptr;
-  }
+  const PreparedRing prepared(r.ring(outer));
+  for (std::uint32_t k = 0; k < r.parts; ++k)
+    if (k != outer && prepared.prepared.locate(r.point(r.range(k).first)) != Location::inside)
+      return nullptr;
   return "Polygon";
+}
+
+// The geometry GDAL's shapefile driver makes of a 2D polygon record of several rings (read
+// and checked by read_record), built without its all-against-all sorting of rings. The
+// driver sorts with organizePolygons' ONLY_CCW method: clockwise rings are outer rings, each
+// counter-clockwise ring (a hole) goes to the smallest (by GDAL's area) clockwise ring of
+// larger area whose envelope holds the hole's and which holds the hole's first point (when
+// that lies on the ring, the first of its points, then of its edges' midpoints, off it); the
+// polygons keep the order of their outer rings, the holes their order in the record. Here
+// the candidates come from a packed R-tree of the outer rings' envelopes and each test is an
+// exact point location, so a record of thousands of islands and lakes costs about linear
+// time instead of holes times rings. nullptr, for GDAL to build it, whenever the record is
+// not plain: a ring orientation cannot place, no outer ring, a tie in area, a hole not
+// starting strictly inside the one outer ring (GDAL versions differ there; GDAL needs no
+// sorting then). As in GDAL, the largest ring of all, when clockwise, holds every hole inside
+// its envelope that no smaller outer ring holds, and a counter-clockwise ring no outer ring
+// holds is a polygon of its own.
+std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
+  const PolygonRings r(c);
+  std::vector<std::uint32_t> outers;
+  std::vector<std::uint8_t> cw(r.parts);
+  for (std::uint32_t k = 0; k < r.parts; ++k) {
+    const int o = r.clockwise(k);
+    if (o < 0) return nullptr;
+    cw[k] = std::uint8_t(o);
+    if (o) outers.push_back(k);
+  }
+  if (outers.empty() || r.parts < 2) return nullptr;
+  std::vector<std::unique_ptr<PreparedRing>> prepared(r.parts);
+  const auto at = [&](std::uint32_t outer, const Point2& p) {
+    if (!prepared[outer]) prepared[outer] = std::make_unique<PreparedRing>(r.ring(outer));
+    return prepared[outer]->prepared.locate(p);
+  };
+  // Where hole k lies for GDAL: where its first point lies in the outer ring; when that is
+  // on the ring, where the first of its next points off the ring lies (repeats skipped), and
+  // when all are on it, the first midpoint of its edges off it; outside if none is.
+  const auto locate = [&](std::uint32_t outer, std::uint32_t k) {
+    const auto [begin, end] = r.range(k);
+    const Location first = at(outer, r.point(begin));
+    if (first != Location::boundary) return first;
+    Point2 previous = r.point(begin);
+    for (std::uint32_t i = begin + 1; i < end; ++i) {
+      const Point2 p = r.point(i);
+      if (p == previous) continue;
+      if (const Location l = at(outer, p); l != Location::boundary) return l;
+      previous = p;
+    }
+    previous = r.point(begin);
+    for (std::uint32_t i = begin + 1; i < end; ++i) {
+      const Point2 p = r.point(i);
+      if (p == previous) continue;
+      const Point2 middle{(p[0] + previous[0]) / 2, (p[1] + previous[1]) / 2};
+      if (const Location l = at(outer, middle); l != Location::boundary) return l;
+      previous = p;
+    }
+    return Location::outside;
+  };
+  std::vector<std::uint32_t> owner(r.parts, kNone);  // the outer ring of each hole
+  std::vector<std::uint32_t> top = outers;           // the rings that start a polygon
+  if (outers.size() == 1) {
+    // GDAL makes every other ring a hole of the one outer ring (later versions test them):
+    // taken here when each starts inside it, where all versions agree.
+    for (std::uint32_t k = 0; k < r.parts; ++k) {
+      if (k == outers[0]) continue;
+      if (at(outers[0], r.point(r.range(k).first)) != Location::inside) return nullptr;
+      owner[k] = outers[0];
+    }
+  } else {
+    std::vector<double> area(r.parts);
+    std::vector<Box2> envelope(r.parts);
+    std::uint32_t largest = 0;  // GDAL's first ring after sorting by area
+    for (std::uint32_t k = 0; k < r.parts; ++k) {
+      area[k] = r.gdal_area(k);
+      envelope[k] = r.envelope(k);
+      if (area[k] > area[largest]) largest = k;
+    }
+    for (std::uint32_t k = 0; k < r.parts; ++k)
+      if (k != largest && area[k] == area[largest]) return nullptr;  // GDAL's order unknown
+    std::vector<Box2> outer_boxes;
+    outer_boxes.reserve(outers.size());
+    for (const std::uint32_t k : outers)
+      outer_boxes.push_back(envelope[k]);
+    const PackedRTree2 tree = PackedRTree2::build(outer_boxes);
+    std::vector<std::uint32_t> candidates;
+    for (std::uint32_t k = 0; k < r.parts; ++k) {
+      if (cw[k]) continue;
+      candidates.clear();
+      bool tie = false;
+      tree.query(
+          envelope[k],
+          [&](Id i, const Box2&) {
+            const std::uint32_t o = outers[i];
+            if (area[o] == area[k]) tie = true;
+            if (area[o] > area[k]) candidates.push_back(o);
+            return true;
+          },
+          Relation::contains);
+      if (tie) return nullptr;
+      std::sort(candidates.begin(), candidates.end(),
+                [&](std::uint32_t a, std::uint32_t b) { return area[a] < area[b]; });
+      for (std::size_t j = 0; j < candidates.size() && owner[k] == kNone; ++j) {
+        const std::uint32_t o = candidates[j];
+        if (j + 1 < candidates.size() && area[candidates[j + 1]] == area[o]) return nullptr;
+        // GDAL takes the largest ring of all on its envelope alone.
+        if (o == largest || locate(o, k) == Location::inside) owner[k] = o;
+      }
+      // Held by no outer ring: a polygon of its own (outer ring counter-clockwise).
+      if (owner[k] == kNone) top.push_back(k);
+    }
+  }
+  const auto ring = [&](std::uint32_t k) {
+    const auto [begin, end] = r.range(k);
+    auto g = std::make_unique<OGRLinearRing>();
+    g->setNumPoints(int(end - begin), FALSE);
+    for (std::uint32_t i = begin; i < end; ++i)
+      g->setPoint(int(i - begin), r.x(i), r.y(i));
+    return g;
+  };
+  // Each outer ring's holes, in the record's order: a list threaded through `next`.
+  std::vector<std::uint32_t> head(r.parts, kNone), tail(r.parts, kNone), next(r.parts, kNone);
+  for (std::uint32_t k = 0; k < r.parts; ++k) {
+    const std::uint32_t o = owner[k];
+    if (o == kNone) continue;
+    (head[o] == kNone ? head[o] : next[tail[o]]) = k;
+    tail[o] = k;
+  }
+  const auto polygon = [&](std::uint32_t outer) {
+    auto p = std::make_unique<OGRPolygon>();
+    p->addRingDirectly(ring(outer).release());
+    for (std::uint32_t k = head[outer]; k != kNone; k = next[k])
+      p->addRingDirectly(ring(k).release());
+    return p;
+  };
+  if (top.size() == 1) return polygon(top[0]);
+  std::sort(top.begin(), top.end());  // the polygons in the order of their outer rings
+  auto m = std::make_unique<OGRMultiPolygon>();
+  for (const std::uint32_t k : top)
+    m->addGeometryDirectly(polygon(k).release());
+  return m;
 }
 
 }  // namespace
@@ -549,5 +738,74 @@ std::optional<LayerItems> read_shapefile_segments(const std::string& path, const
   if (!read) return std::nullopt;
   return items;
 }
+
+namespace detail {
+
+struct ShapefilePolygons::Files {
+  Files(const std::string& shp_path, const std::string& shx_path)
+      : path(shp_path), shx(shx_path, nullptr, 4096), shp(shp_path, nullptr, 64u << 10) {}
+  std::string path;
+  ChunkReader shx, shp;
+  std::uint64_t count = 0;
+};
+
+ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) : layer_(&layer) {
+  if constexpr (std::endian::native != std::endian::little) return;
+  if (CPLGetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr) || !is_shp_path(path)) return;
+  const std::string shx_path = sibling(path, ".shx", ".SHX");
+  const std::string dbf_path = sibling(path, ".dbf", ".DBF");
+  if (shx_path.empty() || dbf_path.empty()) return;
+  auto f = std::make_unique<Files>(path, shx_path);
+  if (!f->shx.is_open() || !f->shp.is_open()) return;
+  const unsigned char* sh = f->shx.get(0, 100);
+  const unsigned char* ph = f->shp.get(0, 100);
+  if (!sh || !ph || be32(sh) != 9994 || be32(ph) != 9994 || le32(sh + 28) != 1000 ||
+      le32(ph + 28) != 1000 || le32(ph + 32) != 5 || le32(sh + 32) != 5)
+    return;
+  if (2 * std::uint64_t(be32(sh + 24)) != f->shx.size() || (f->shx.size() - 100) % 8 != 0) return;
+  f->count = (f->shx.size() - 100) / 8;
+  if (layer.GetFeatureCount(FALSE) != GIntBig(f->count)) return;
+  if (!plain_attributes(dbf_path, f->count)) return;
+  srs_ = layer.GetSpatialRef();
+  files_ = std::move(f);
+}
+
+ShapefilePolygons::~ShapefilePolygons() = default;
+
+std::unique_ptr<OGRGeometry> ShapefilePolygons::read(std::int64_t fid) {
+  if (!files_ || fid < 0 || std::uint64_t(fid) >= files_->count) return nullptr;
+  const unsigned char* e = files_->shx.get(100 + 8 * std::uint64_t(fid), 8);
+  if (!e) return nullptr;
+  const std::uint64_t offset = 2 * std::uint64_t(be32(e)), length = 2 * std::uint64_t(be32(e + 4));
+  if (offset < 100 || length < 44) return nullptr;
+  // Only the record's header first: most records are not several rings.
+  const unsigned char* head = files_->shp.get(offset, 8 + 44);
+  if (!head || be32(head + 4) != be32(e + 4) || le32(head + 8) != 5 || le32(head + 8 + 36) < 2)
+    return nullptr;
+  const unsigned char* record = files_->shp.get(offset, 8 + length);
+  if (!record) return nullptr;
+  try {
+    if (!read_record(record + 8, length, 5, files_->path, fid).ok) return nullptr;
+  } catch (const Error&) {
+    return nullptr;  // a bad coordinate: GDAL's geometry, as before
+  }
+  auto g = build_polygons(record + 8);
+  if (g && srs_) g->assignSpatialReference(srs_);
+  return g;
+}
+
+OGRFeatureUniquePtr ShapefilePolygons::fetch(std::int64_t fid) {
+  std::unique_ptr<OGRGeometry> g = read(fid);
+  if (bool(g) != geometry_ignored_) {
+    const char* no_geometry[] = {"OGR_GEOMETRY", nullptr};
+    if (layer_->SetIgnoredFields(g ? no_geometry : nullptr) != OGRERR_NONE) g.reset();
+    geometry_ignored_ = bool(g);
+  }
+  OGRFeatureUniquePtr f(layer_->GetFeature(fid));
+  if (f && g) f->SetGeometryDirectly(g.release());
+  return f;
+}
+
+}  // namespace detail
 
 }  // namespace loci::io

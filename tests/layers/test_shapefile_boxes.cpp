@@ -25,6 +25,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/io/layer_reader.hpp"
 #include "loci/io/sidecar.hpp"
+#include "shapefile_polygons.hpp"
 
 namespace {
 
@@ -427,6 +428,169 @@ TEST(ShapefileBoxes, PolygonTypesFollowRingOrientationAsGdalSortsRings) {
                                },
                                10),
                            false);
+}
+
+// Feature by feature, the polygons built from the records are GDAL's to the byte (polygons,
+// rings and points in GDAL's order), and fetch() gives GDAL's features; `built`: how many
+// were built rather than left to GDAL.
+void expect_polygons_like_gdal(const std::string& path, int* built_out) {
+  SCOPED_TRACE(path);
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+  ASSERT_TRUE(ds);
+  OGRLayer* layer = ds->GetLayer(0);
+  loci::io::detail::ShapefilePolygons polygons(path, *layer);
+  GDALDatasetUniquePtr again(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+  loci::io::detail::ShapefilePolygons fetching(path, *again->GetLayer(0));
+  const auto wkb = [](const OGRGeometry& g) {
+    std::vector<unsigned char> b(g.WkbSize());
+    g.exportToWkb(wkbNDR, b.data(), wkbVariantIso);
+    return b;
+  };
+  int built = 0;
+  for (GIntBig fid = 0; fid < layer->GetFeatureCount(); ++fid) {
+    OGRFeatureUniquePtr f(layer->GetFeature(fid));
+    const OGRGeometry* ref = f ? f->GetGeometryRef() : nullptr;
+    const auto ours = polygons.read(fid);
+    if (ours) {
+      ++built;
+      EXPECT_TRUE(ref) << "feature " << fid;
+      if (!ref) continue;
+      EXPECT_EQ(wkb(*ours), wkb(*ref)) << "feature " << fid;
+    }
+    // fetch() gives the same feature, attributes included, whichever builds the geometry.
+    OGRFeatureUniquePtr fetched = fetching.fetch(fid);
+    ASSERT_TRUE(fetched && f) << "feature " << fid;
+    EXPECT_EQ(fetched->GetFID(), fid);
+    EXPECT_EQ(fetched->GetFieldAsInteger(0), f->GetFieldAsInteger(0)) << "feature " << fid;
+    const OGRGeometry* g = fetched->GetGeometryRef();
+    EXPECT_EQ(bool(g), bool(ref)) << "feature " << fid;
+    if (g && ref) EXPECT_EQ(wkb(*g), wkb(*ref)) << "feature " << fid;
+  }
+  *built_out = built;
+}
+
+TEST(ShapefileBoxes, PolygonsOfManyRingsAreBuiltAsGdalBuildsThem) {
+  // Archipelagos: islands with lakes, islands in those lakes with lakes of their own (so a
+  // lake has two islands around it and belongs to the smaller), lakes starting on their
+  // island's shore, polygons in random order, a few single polygons and lines of one ring.
+  const auto square = [](double x, double y, double s) {
+    return ring_of({{x, y}, {x + s, y}, {x + s, y + s}, {x, y + s}});
+  };
+  const auto make = [&](int i, std::mt19937_64& rng) -> std::unique_ptr<OGRGeometry> {
+    if (i % 7 == 6) return nullptr;
+    std::uniform_real_distribution<double> u(0, 1);
+    auto m = std::make_unique<OGRMultiPolygon>();
+    std::vector<std::unique_ptr<OGRPolygon>> parts;
+    const int systems = 1 + int(rng() % 6);
+    for (int k = 0; k < systems; ++k) {
+      const double x = 100.0 * k + 3 * u(rng), y = 100.0 * double(i) + 3 * u(rng);
+      auto island = std::make_unique<OGRPolygon>();
+      add_ring(*island, square(x, y, 90));
+      const int depth = int(rng() % 4);  // 0: none, 1: a lake, 2: an island in it, 3: its lake
+      const bool pond = rng() % 2 == 0;  // a second, small lake, before or after the first
+      if (pond && rng() % 2) add_ring(*island, square(x + 2, y + 2, 5));
+      if (depth >= 1) {
+        if (rng() % 3 == 0)  // a lake starting on the shore, its other points inside
+          add_ring(*island,
+                   ring_of({{x, y + 40}, {x + 80, y + 5}, {x + 85, y + 85}, {x + 5, y + 80}}));
+        else
+          add_ring(*island, square(x + 10, y + 10, 70));
+      }
+      if (pond && island->getNumInteriorRings() == (depth >= 1 ? 1 : 0))
+        add_ring(*island, square(x + 2, y + 2, 5));
+      parts.push_back(std::move(island));
+      if (depth >= 2) {
+        auto inner = std::make_unique<OGRPolygon>();
+        add_ring(*inner, square(x + 25, y + 25, 40));
+        if (depth >= 3) add_ring(*inner, square(x + 30 + 10 * u(rng), y + 30, 10));
+        parts.push_back(std::move(inner));
+      }
+    }
+    std::shuffle(parts.begin(), parts.end(), rng);
+    for (auto& p : parts)
+      m->addGeometryDirectly(p.release());
+    return m;
+  };
+  const std::string path = write_shapefile("archipelagos", wkbMultiPolygon, 60, make, 21);
+  int built = 0;
+  expect_polygons_like_gdal(path, &built);
+  EXPECT_GT(built, 20);  // most multi-ring records are built here, not left to GDAL
+
+  // The layouts of the type test (a hole outside its one outer ring, holes touching) and
+  // random overlapping rings, which GDAL sorts however it sorts them: built alike or left to
+  // GDAL, never different.
+  const std::string random = write_shapefile(
+      "overlapping_rings", wkbMultiPolygon, 40,
+      [](int, std::mt19937_64& rng) -> std::unique_ptr<OGRGeometry> {
+        auto m = std::make_unique<OGRMultiPolygon>();
+        for (int k = 0, n = 2 + int(rng() % 5); k < n; ++k)
+          m->addGeometryDirectly(random_polygon(rng, 1 + int(rng() % 3), false).release());
+        return m;
+      },
+      22);
+  expect_polygons_like_gdal(random, &built);
+  EXPECT_GT(built, 0);
+
+  // Rings a writer oriented against the rule, made by reversing rings in the .shp's bytes: a
+  // counter-clockwise island far from the others (a polygon of its own for GDAL) and one in
+  // the notch of a concave island, inside that island's envelope but not the island (GDAL
+  // makes it a hole of the largest ring, on its envelope alone).
+  const std::string reversed = write_shapefile(
+      "reversed_rings", wkbMultiPolygon, 1,
+      [&](int, std::mt19937_64&) -> std::unique_ptr<OGRGeometry> {
+        auto m = std::make_unique<OGRMultiPolygon>();
+        OGRPolygon c, notch, far, other;
+        add_ring(c,
+                 ring_of({{0, 0}, {10, 0}, {10, 10}, {6, 10}, {6, 3}, {4, 3}, {4, 10}, {0, 10}}));
+        add_ring(notch, square(4.5, 5, 1));
+        add_ring(far, square(20, 20, 1));
+        add_ring(other, square(30, 0, 2));
+        for (OGRPolygon* p : {&c, &notch, &far, &other})
+          m->addGeometry(p);
+        return m;
+      },
+      24);
+  {
+    std::vector<char> bytes(fs::file_size(reversed));
+    std::ifstream(reversed, std::ios::binary).read(bytes.data(), std::streamsize(bytes.size()));
+    // Record 0: 8 bytes of header, 44 of content header, 4 part starts, then x,y pairs: the
+    // concave ring's 9 points, then the rings of 5 points; rings 1 and 2 are reversed.
+    char* xy = bytes.data() + 100 + 8 + 44 + 4 * 4;
+    for (const int first : {9, 14})
+      for (int i = 0; i < 2; ++i)
+        std::swap_ranges(xy + 16 * (first + 1 + i), xy + 16 * (first + 2 + i),
+                         xy + 16 * (first + 3 - i));
+    std::ofstream(reversed, std::ios::binary | std::ios::trunc)
+        .write(bytes.data(), std::streamsize(bytes.size()));
+  }
+  expect_polygons_like_gdal(reversed, &built);
+  EXPECT_EQ(built, 1);
+  {
+    GDALDatasetUniquePtr ds(GDALDataset::Open(reversed.c_str(), GDAL_OF_VECTOR));
+    OGRFeatureUniquePtr f(ds->GetLayer(0)->GetFeature(0));
+    const auto* m = f->GetGeometryRef()->toMultiPolygon();
+    ASSERT_EQ(m->getNumGeometries(), 3);                        // the notch is a hole
+    EXPECT_EQ(m->getGeometryRef(0)->getNumInteriorRings(), 1);  // of the concave ring
+  }
+
+  // A user's ring sorting method: GDAL builds everything.
+  CPLSetConfigOption("OGR_ORGANIZE_POLYGONS", "DEFAULT");
+  {
+    GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+    loci::io::detail::ShapefilePolygons polygons(path, *ds->GetLayer(0));
+    for (GIntBig fid = 0; fid < 10; ++fid)
+      EXPECT_FALSE(polygons.read(fid));
+  }
+  CPLSetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr);
+  // Not a shapefile of polygons: nothing is built.
+  const std::string lines = write_shapefile(
+      "some_lines", wkbLineString, 3,
+      [](int, std::mt19937_64& rng) -> std::unique_ptr<OGRGeometry> {
+        return random_line(rng, 5, false);
+      },
+      23);
+  expect_polygons_like_gdal(lines, &built);
+  EXPECT_EQ(built, 0);
 }
 
 TEST(ShapefileBoxes, ARingSortingMethodChosenByTheUserGoesToGdal) {
