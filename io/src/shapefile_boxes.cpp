@@ -742,11 +742,15 @@ std::optional<LayerItems> read_shapefile_segments(const std::string& path, const
 namespace detail {
 
 struct ShapefilePolygons::Files {
-  Files(const std::string& shp_path, const std::string& shx_path)
-      : path(shp_path), shx(shx_path, nullptr, 4096), shp(shp_path, nullptr, 64u << 10) {}
+  Files(const std::string& shp_path, const std::string& shx_path, const std::string& dbf_path)
+      : path(shp_path),
+        shx(shx_path, nullptr, 4096),
+        shp(shp_path, nullptr, 64u << 10),
+        dbf(dbf_path, nullptr, 512) {}
   std::string path;
-  ChunkReader shx, shp;
+  ChunkReader shx, shp, dbf;
   std::uint64_t count = 0;
+  std::uint64_t dbf_header = 0, dbf_record = 0;  // .dbf header and record lengths
 };
 
 ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) : layer_(&layer) {
@@ -755,8 +759,8 @@ ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) :
   const std::string shx_path = sibling(path, ".shx", ".SHX");
   const std::string dbf_path = sibling(path, ".dbf", ".DBF");
   if (shx_path.empty() || dbf_path.empty()) return;
-  auto f = std::make_unique<Files>(path, shx_path);
-  if (!f->shx.is_open() || !f->shp.is_open()) return;
+  auto f = std::make_unique<Files>(path, shx_path, dbf_path);
+  if (!f->shx.is_open() || !f->shp.is_open() || !f->dbf.is_open()) return;
   const unsigned char* sh = f->shx.get(0, 100);
   const unsigned char* ph = f->shp.get(0, 100);
   if (!sh || !ph || be32(sh) != 9994 || be32(ph) != 9994 || le32(sh + 28) != 1000 ||
@@ -765,7 +769,15 @@ ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) :
   if (2 * std::uint64_t(be32(sh + 24)) != f->shx.size() || (f->shx.size() - 100) % 8 != 0) return;
   f->count = (f->shx.size() - 100) / 8;
   if (layer.GetFeatureCount(FALSE) != GIntBig(f->count)) return;
-  if (!plain_attributes(dbf_path, f->count)) return;
+  // The .dbf's header only: opening costs the same however big the files (each read checks
+  // its record's deletion flag).
+  const unsigned char* dh = f->dbf.get(0, 32);
+  if (!dh || le32(dh + 4) != f->count) return;
+  f->dbf_header = le16(dh + 8);
+  f->dbf_record = le16(dh + 10);
+  if (f->dbf_record == 0 || f->dbf_header < 32 ||
+      f->dbf.size() < f->dbf_header + f->count * f->dbf_record)
+    return;
   srs_ = layer.GetSpatialRef();
   files_ = std::move(f);
 }
@@ -774,6 +786,9 @@ ShapefilePolygons::~ShapefilePolygons() = default;
 
 std::unique_ptr<OGRGeometry> ShapefilePolygons::read(std::int64_t fid) {
   if (!files_ || fid < 0 || std::uint64_t(fid) >= files_->count) return nullptr;
+  const unsigned char* deleted =
+      files_->dbf.get(files_->dbf_header + std::uint64_t(fid) * files_->dbf_record, 1);
+  if (!deleted || *deleted == '*') return nullptr;  // GDAL has no such feature
   const unsigned char* e = files_->shx.get(100 + 8 * std::uint64_t(fid), 8);
   if (!e) return nullptr;
   const std::uint64_t offset = 2 * std::uint64_t(be32(e)), length = 2 * std::uint64_t(be32(e + 4));

@@ -20,9 +20,9 @@ namespace loci::io::detail {
 
 class ShapefilePolygons {
  public:
-  // Takes the file at `path` when the direct reader would (a .shp of 2D polygons with its .shx
-  // and a .dbf without deleted records, the count GDAL's `layer` gives, no
-  // OGR_ORGANIZE_POLYGONS set); otherwise every read() answers nullptr.
+  // Takes the file at `path` when it is a .shp of 2D polygons with its .shx and .dbf, holding
+  // the count of records GDAL's `layer` gives, and OGR_ORGANIZE_POLYGONS is not set;
+  // otherwise every read() answers nullptr. Reads the files' headers only.
   // `layer` is GDAL's layer of the file, used by fetch() (which sets its ignored fields).
   ShapefilePolygons(const std::string& path, OGRLayer& layer);
   ~ShapefilePolygons();
@@ -31,7 +31,7 @@ class ShapefilePolygons {
 
   // The geometry of feature `fid` as GDAL would give it, with the layer's spatial reference,
   // when it is a polygon record of several rings placed plainly; nullptr when GDAL must build
-  // it (any other record, an unusual or unreadable one).
+  // it (any other record, an unusual or unreadable one, a deleted one).
   std::unique_ptr<OGRGeometry> read(std::int64_t fid);
 
   // Feature `fid` of the layer, as its GetFeature gives it (nullptr when there is none), its

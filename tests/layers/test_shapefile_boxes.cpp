@@ -451,6 +451,11 @@ void expect_polygons_like_gdal(const std::string& path, int* built_out) {
     OGRFeatureUniquePtr f(layer->GetFeature(fid));
     const OGRGeometry* ref = f ? f->GetGeometryRef() : nullptr;
     const auto ours = polygons.read(fid);
+    if (!f) {  // a deleted record
+      EXPECT_FALSE(ours) << "feature " << fid;
+      EXPECT_FALSE(fetching.fetch(fid)) << "feature " << fid;
+      continue;
+    }
     if (ours) {
       ++built;
       EXPECT_TRUE(ref) << "feature " << fid;
@@ -571,6 +576,34 @@ TEST(ShapefileBoxes, PolygonsOfManyRingsAreBuiltAsGdalBuildsThem) {
     const auto* m = f->GetGeometryRef()->toMultiPolygon();
     ASSERT_EQ(m->getNumGeometries(), 3);                        // the notch is a hole
     EXPECT_EQ(m->getGeometryRef(0)->getNumInteriorRings(), 1);  // of the concave ring
+  }
+
+  // A deleted record (kept, not repacked) is no feature: nothing is built for it.
+  {
+    const std::string copy = (dir() / "archipelagos_deleted.shp").string();
+    for (const char* ext : {".shp", ".shx", ".dbf"})
+      fs::copy_file(fs::path(path).replace_extension(ext), fs::path(copy).replace_extension(ext));
+    GIntBig victim = 0;  // a record built when not deleted
+    {
+      GDALDatasetUniquePtr ds(GDALDataset::Open(copy.c_str(), GDAL_OF_VECTOR));
+      loci::io::detail::ShapefilePolygons polygons(copy, *ds->GetLayer(0));
+      while (!polygons.read(victim))
+        ++victim;
+    }
+    const char* const options[] = {"AUTO_REPACK=NO", nullptr};
+    {
+      GDALDatasetUniquePtr ds(
+          GDALDataset::Open(copy.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, options));
+      ASSERT_EQ(ds->GetLayer(0)->DeleteFeature(victim), OGRERR_NONE);
+    }
+    GDALDatasetUniquePtr ds(GDALDataset::Open(copy.c_str(), GDAL_OF_VECTOR));
+    loci::io::detail::ShapefilePolygons polygons(copy, *ds->GetLayer(0));
+    EXPECT_FALSE(polygons.read(victim));
+    int built_here = 0;
+    CPLPushErrorHandler(CPLQuietErrorHandler);  // GDAL reports reading the deleted record
+    expect_polygons_like_gdal(copy, &built_here);
+    CPLPopErrorHandler();
+    EXPECT_GT(built_here, 20);
   }
 
   // A user's ring sorting method: GDAL builds everything.
