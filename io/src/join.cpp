@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include "gdal_layer.hpp"
@@ -13,6 +14,7 @@
 #include "loci/index/sweep_join.hpp"
 #include "loci/io/atomic_file.hpp"
 #include "loci/io/exact.hpp"
+#include "shapefile_polygons.hpp"
 
 namespace loci::io {
 
@@ -28,10 +30,27 @@ const PreparedGeometry& JoinLayer::prepared(std::size_t i) const {
 JoinLayer read_join_layer(const std::string& path, const std::string& name) {
   JoinLayer out;
   auto ol = detail::open_layer(path, name);
+  // A shapefile's polygons of many rings are built from its records (GDAL would sort their
+  // rings all against all): GDAL then reads the features in order without geometry, and the
+  // other geometries by FID through a second handle.
+  detail::ShapefilePolygons polygons(path, *ol.layer);
+  std::optional<detail::OpenLayer> by_fid;
+  if (polygons.active()) {
+    by_fid = detail::open_layer(path, name);
+    const char* no_geometry[] = {"OGR_GEOMETRY", nullptr};
+    if (ol.layer->SetIgnoredFields(no_geometry) != OGRERR_NONE) by_fid.reset();
+  }
   const detail::ReadCheck check(path);
   ol.layer->ResetReading();
   for (auto& f : *ol.layer) {
+    std::unique_ptr<OGRGeometry> built;
+    OGRFeatureUniquePtr whole;
     const OGRGeometry* g = f->GetGeometryRef();
+    if (by_fid) {
+      built = polygons.read(f->GetFID());
+      if (!built) whole.reset(by_fid->layer->GetFeature(f->GetFID()));
+      g = built ? built.get() : whole ? whole->GetGeometryRef() : nullptr;
+    }
     if (!g || g->IsEmpty()) continue;
     FlatGeometry flat = detail::flatten(g, detail::where(path, f->GetFID()));
     if (flat.empty()) continue;

@@ -29,6 +29,9 @@ class ShapefilePolygons {
   ShapefilePolygons(const ShapefilePolygons&) = delete;
   ShapefilePolygons& operator=(const ShapefilePolygons&) = delete;
 
+  // Whether the file was taken (else read() always answers nullptr).
+  bool active() const { return bool(files_); }
+
   // The geometry of feature `fid` as GDAL would give it, with the layer's spatial reference,
   // when it is a polygon record of several rings placed plainly; nullptr when GDAL must build
   // it (any other record, an unusual or unreadable one, a deleted one).

@@ -662,6 +662,24 @@ TEST_F(LayersCli, JoinMatchesGeosOnAllPairs) {
                                 " --predicate contains -f ids -q");
     ASSERT_EQ(run.status, 0) << run.err;
     EXPECT_EQ(run.out, "0 0\n");
+    // The same square with a hole and a far island, as a shapefile: its polygons are built
+    // from the records, not by GDAL, and the hole is kept.
+    const fs::path holed_shp = g_dir / "holed_multi.shp";
+    write_layer(
+        holed_shp, wkbMultiPolygon,
+        [](int) {
+          OGRGeometry* g = nullptr;
+          const char* wkt =
+              "MULTIPOLYGON(((0 0,10 0,10 10,0 10,0 0),(4 4,6 4,6 6,4 6,4 4)),"
+              "((20 20,21 20,21 21,20 21,20 20)))";
+          OGRGeometryFactory::createFromWkt(wkt, nullptr, &g);
+          return std::unique_ptr<OGRGeometry>(g);
+        },
+        1);
+    const CliRun shp = run_loci("join " + shell_quote(holed_shp.string()) + " " +
+                                shell_quote(squares) + " --predicate contains -f ids -q");
+    ASSERT_EQ(shp.status, 0) << shp.err;
+    EXPECT_EQ(shp.out, "0 0\n");
     const CliRun self = run_loci("join " + shell_quote(squares) + " " + shell_quote(squares) +
                                  " --predicate within -f ids -q");
     ASSERT_EQ(self.status, 0) << self.err;
