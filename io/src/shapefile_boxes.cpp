@@ -14,6 +14,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <vector>
@@ -420,7 +421,8 @@ struct PolygonRings {
   Point2 point(std::uint32_t i) const { return {x(i), y(i)}; }
 
   // Ring k's orientation as GDAL decides it: by the turn at its lowest rightmost vertex, or
-  // by its signed area when that vertex is there twice or has a neighbour within 1e-5.
+  // by the sign of GDAL's area sum when that vertex is there twice or has a neighbour within
+  // 1e-5.
   // 1 clockwise, 0 counter-clockwise, -1 for a ring GDAL places otherwise: fewer than 4
   // points, unclosed, or of zero area.
   int clockwise(std::uint32_t k) const {
@@ -445,19 +447,23 @@ struct PolygonRings {
       return std::abs(x(i) - x(v)) < 1e-5 && std::abs(y(i) - y(v)) < 1e-5;
     };
     const bool by_area = twice || near(prev) || near(next) || !(turn != 0);
-    return (by_area ? area < 0 : turn < 0) ? 1 : 0;
+    return (by_area ? green_sum(k) < 0 : turn < 0) ? 1 : 0;
   }
 
-  // Ring k's area as GDAL computes it (Green's theorem, the same sum in the same order), by
-  // which it ranks the rings that may hold a hole.
-  double gdal_area(std::uint32_t k) const {
+  // Twice ring k's signed area as GDAL sums it (Green's theorem, in GDAL's order): its area
+  // ranks rings, its sign decides the orientation when the turn cannot.
+  double green_sum(std::uint32_t k) const {
     const auto [begin, end] = range(k);
     double sum = x(begin) * (y(begin + 1) - y(end - 1));
     for (std::uint32_t i = begin + 1; i + 1 < end; ++i)
       sum += x(i) * (y(i + 1) - y(i - 1));
     sum += x(end - 1) * (y(begin) - y(end - 2));
-    return 0.5 * std::fabs(sum);
+    return sum;
   }
+
+  // Ring k's area as GDAL computes it (Green's theorem, the same sum in the same order), by
+  // which it ranks the rings that may hold a hole.
+  double gdal_area(std::uint32_t k) const { return 0.5 * std::fabs(green_sum(k)); }
 
   Box2 envelope(std::uint32_t k) const {
     const auto [begin, end] = range(k);
@@ -523,9 +529,9 @@ const char* polygon_type(const unsigned char* c) {
 // larger area whose envelope holds the hole's and which holds the hole's first point (when
 // that lies on the ring, the first of its points, then of its edges' midpoints, off it); the
 // polygons keep the order of their outer rings, the holes their order in the record. Here
-// the candidates come from a packed R-tree of the outer rings' envelopes and each test is an
-// exact point location, so a record of thousands of islands and lakes costs about linear
-// time instead of holes times rings. nullptr, for GDAL to build it, whenever the record is
+// the candidates come from a packed R-tree of the outer rings' envelopes and are tested as
+// GDAL tests them, so a record of thousands of islands and lakes no longer costs holes times
+// rings. nullptr, for GDAL to build it, whenever the record is
 // not plain: a ring orientation cannot place, no outer ring, a tie in area, a hole not
 // starting strictly inside the one outer ring (GDAL versions differ there; GDAL needs no
 // sorting then). As in GDAL, the largest ring of all, when clockwise, holds every hole inside
@@ -542,10 +548,27 @@ std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
     if (o) outers.push_back(k);
   }
   if (outers.empty() || r.parts < 2) return nullptr;
-  std::vector<std::unique_ptr<PreparedRing>> prepared(r.parts);
+  // The rings as OGR rings, made once: tested below, then handed to the polygons.
+  std::vector<std::unique_ptr<OGRLinearRing>> rings(r.parts);
+  const auto ring = [&](std::uint32_t k) -> OGRLinearRing& {
+    if (!rings[k]) {
+      const auto [begin, end] = r.range(k);
+      rings[k] = std::make_unique<OGRLinearRing>();
+      rings[k]->setNumPoints(int(end - begin), FALSE);
+      for (std::uint32_t i = begin; i < end; ++i)
+        rings[k]->setPoint(int(i - begin), r.x(i), r.y(i));
+    }
+    return *rings[k];
+  };
+  // Where p lies in an outer ring, decided by GDAL's own predicates on the ring (its boundary
+  // test, then its crossing test), so that a point on or within rounding of an edge goes where
+  // GDAL puts it; each costs a pass over the ring, as in GDAL, but only the candidates GDAL
+  // itself would test are tested.
   const auto at = [&](std::uint32_t outer, const Point2& p) {
-    if (!prepared[outer]) prepared[outer] = std::make_unique<PreparedRing>(r.ring(outer));
-    return prepared[outer]->prepared.locate(p);
+    OGRPoint point(p[0], p[1]);
+    const OGRLinearRing& o = ring(outer);
+    if (o.isPointOnRingBoundary(&point, FALSE)) return Location::boundary;
+    return o.isPointInRing(&point, FALSE) ? Location::inside : Location::outside;
   };
   // Where hole k lies for GDAL: where its first point lies in the outer ring; when that is
   // on the ring, where the first of its next points off the ring lies (repeats skipped), and
@@ -624,14 +647,6 @@ std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
       if (owner[k] == kNone) top.push_back(k);
     }
   }
-  const auto ring = [&](std::uint32_t k) {
-    const auto [begin, end] = r.range(k);
-    auto g = std::make_unique<OGRLinearRing>();
-    g->setNumPoints(int(end - begin), FALSE);
-    for (std::uint32_t i = begin; i < end; ++i)
-      g->setPoint(int(i - begin), r.x(i), r.y(i));
-    return g;
-  };
   // Each outer ring's holes, in the record's order: a list threaded through `next`.
   std::vector<std::uint32_t> head(r.parts, kNone), tail(r.parts, kNone), next(r.parts, kNone);
   for (std::uint32_t k = 0; k < r.parts; ++k) {
@@ -642,9 +657,12 @@ std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
   }
   const auto polygon = [&](std::uint32_t outer) {
     auto p = std::make_unique<OGRPolygon>();
-    p->addRingDirectly(ring(outer).release());
-    for (std::uint32_t k = head[outer]; k != kNone; k = next[k])
-      p->addRingDirectly(ring(k).release());
+    ring(outer);
+    p->addRingDirectly(rings[outer].release());
+    for (std::uint32_t k = head[outer]; k != kNone; k = next[k]) {
+      ring(k);
+      p->addRingDirectly(rings[k].release());
+    }
     return p;
   };
   if (top.size() == 1) return polygon(top[0]);
@@ -755,7 +773,12 @@ struct ShapefilePolygons::Files {
 
 ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) : layer_(&layer) {
   if constexpr (std::endian::native != std::endian::little) return;
-  if (CPLGetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr) || !is_shp_path(path)) return;
+  // The rules followed are those of GDAL 3.6 (Debian 12's), checked against it by the tests;
+  // other versions, and the options that change how GDAL sorts rings, leave it to GDAL.
+  if (std::atoi(GDALVersionInfo("VERSION_NUM")) / 10000 != 306) return;
+  if (CPLGetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr) ||
+      CPLTestBool(CPLGetConfigOption("OGR_DEBUG_ORGANIZE_POLYGONS", "NO")) || !is_shp_path(path))
+    return;
   const std::string shx_path = sibling(path, ".shx", ".SHX");
   const std::string dbf_path = sibling(path, ".dbf", ".DBF");
   if (shx_path.empty() || dbf_path.empty()) return;
