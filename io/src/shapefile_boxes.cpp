@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include <cpl_conv.h>
@@ -169,17 +170,48 @@ bool is_polygon_type(std::uint32_t type) {
   return type == 5 || type == 15 || type == 25;
 }
 
+// The .shp and .shx headers of one shapefile checked against each other (file codes, version,
+// the same shape type, an .shx of whole entries): its shape type and record count, or nullopt.
+struct ShapefileHeaders {
+  std::uint32_t file_type;
+  std::uint64_t count;
+};
+std::optional<ShapefileHeaders> shapefile_headers(ChunkReader& shp, ChunkReader& shx) {
+  const unsigned char* sh = shx.get(0, 100);
+  const unsigned char* ph = shp.get(0, 100);
+  if (!sh || !ph || be32(sh) != 9994 || be32(ph) != 9994 || le32(sh + 28) != 1000 ||
+      le32(ph + 28) != 1000 || le32(sh + 32) != le32(ph + 32))
+    return std::nullopt;
+  if (2 * std::uint64_t(be32(sh + 24)) != shx.size() || (shx.size() - 100) % 8 != 0)
+    return std::nullopt;
+  return ShapefileHeaders{le32(ph + 32), (shx.size() - 100) / 8};
+}
+
+// Where the records of a .dbf lie, from its header, when it holds exactly `count` of them.
+struct DbfLayout {
+  std::uint64_t header, record;  // header and record lengths
+  const unsigned char* deletion_flag(ChunkReader& dbf, std::uint64_t i) const {
+    return dbf.get(header + i * record, 1);
+  }
+};
+std::optional<DbfLayout> dbf_layout(ChunkReader& dbf, std::uint64_t count) {
+  const unsigned char* h = dbf.get(0, 32);
+  if (!h || le32(h + 4) != count) return std::nullopt;
+  const DbfLayout layout{le16(h + 8), le16(h + 10)};
+  if (layout.record == 0 || layout.header < 32 ||
+      dbf.size() < layout.header + count * layout.record)
+    return std::nullopt;
+  return layout;
+}
+
 // Whether the .dbf holds exactly `count` records, none deleted.
 bool plain_attributes(const std::string& dbf_path, std::uint64_t count) {
   ChunkReader dbf(dbf_path);
   if (!dbf.is_open()) return false;
-  const unsigned char* h = dbf.get(0, 32);
-  if (!h) return false;
-  const std::uint64_t records = le32(h + 4), header = le16(h + 8), length = le16(h + 10);
-  if (records != count || length == 0 || header < 32) return false;
-  if (dbf.size() < header + records * length) return false;
-  for (std::uint64_t i = 0; i < records; ++i) {
-    const unsigned char* flag = dbf.get(header + i * length, 1);
+  const auto layout = dbf_layout(dbf, count);
+  if (!layout) return false;
+  for (std::uint64_t i = 0; i < count; ++i) {
+    const unsigned char* flag = layout->deletion_flag(dbf, i);
     if (!flag || *flag == '*') return false;
   }
   return true;
@@ -251,6 +283,9 @@ struct RecordRead {
   std::uint64_t segments = 0;
 };
 
+// Shapelib, inside GDAL, takes a record of more points or parts than these for a corrupt one.
+constexpr std::uint64_t kMaxPoints = 50'000'000, kMaxParts = 10'000'000;
+
 RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32_t file_type,
                        const std::string& path, std::int64_t fid) {
   RecordRead r;
@@ -270,7 +305,7 @@ RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32
     case Kind::multipoint: {
       if (length < 40) return r;
       const std::uint64_t n = le32(c + 36);
-      if (n == 0 || n > (length - 40) / 16) return r;
+      if (n == 0 || n > kMaxPoints || n > (length - 40) / 16) return r;
       add_points(c + 40, n, r.box, path, fid);
       r.segments = n;
       break;
@@ -278,7 +313,9 @@ RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32
     case Kind::polyline_or_polygon: {
       if (length < 44) return r;
       const std::uint64_t parts = le32(c + 36), n = le32(c + 40);
-      if (parts == 0 || n == 0 || parts > n || 44 + 4 * parts + 16 * n > length) return r;
+      if (parts == 0 || n == 0 || parts > n || n > kMaxPoints || parts > kMaxParts ||
+          44 + 4 * parts + 16 * n > length)
+        return r;
       // Parts start at 0 and each holds at least one point.
       std::uint64_t previous = 0;
       for (std::uint64_t i = 0; i < parts; ++i) {
@@ -322,15 +359,9 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
   StreamHash shp_hash;
   ChunkReader shx(shx_path), shp(path, &shp_hash);
   if (!shx.is_open() || !shp.is_open()) return false;
-  const unsigned char* sh = shx.get(0, 100);
-  const unsigned char* ph = shp.get(0, 100);
-  if (!sh || !ph || be32(sh) != 9994 || be32(ph) != 9994 || le32(sh + 28) != 1000 ||
-      le32(ph + 28) != 1000)
-    return false;
-  const std::uint32_t file_type = le32(ph + 32);
-  if (le32(sh + 32) != file_type || kind_of(file_type) == Kind::other) return false;
-  if (2 * std::uint64_t(be32(sh + 24)) != shx.size() || (shx.size() - 100) % 8 != 0) return false;
-  const std::uint64_t count = (shx.size() - 100) / 8;
+  const auto headers = shapefile_headers(shp, shx);
+  if (!headers || kind_of(headers->file_type) == Kind::other) return false;
+  const auto [file_type, count] = *headers;
   if (ol.layer->GetFeatureCount(FALSE) != GIntBig(count)) return false;
   if (!plain_attributes(dbf_path, count)) return false;
   begin(file_type, count, shp.size());
@@ -768,7 +799,7 @@ struct ShapefilePolygons::Files {
   std::string path;
   ChunkReader shx, shp, dbf;
   std::uint64_t count = 0;
-  std::uint64_t dbf_header = 0, dbf_record = 0;  // .dbf header and record lengths
+  DbfLayout dbf_layout{};
 };
 
 ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) : layer_(&layer) {
@@ -784,23 +815,15 @@ ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) :
   if (shx_path.empty() || dbf_path.empty()) return;
   auto f = std::make_unique<Files>(path, shx_path, dbf_path);
   if (!f->shx.is_open() || !f->shp.is_open() || !f->dbf.is_open()) return;
-  const unsigned char* sh = f->shx.get(0, 100);
-  const unsigned char* ph = f->shp.get(0, 100);
-  if (!sh || !ph || be32(sh) != 9994 || be32(ph) != 9994 || le32(sh + 28) != 1000 ||
-      le32(ph + 28) != 1000 || le32(ph + 32) != 5 || le32(sh + 32) != 5)
-    return;
-  if (2 * std::uint64_t(be32(sh + 24)) != f->shx.size() || (f->shx.size() - 100) % 8 != 0) return;
-  f->count = (f->shx.size() - 100) / 8;
+  const auto headers = shapefile_headers(f->shp, f->shx);
+  if (!headers || headers->file_type != 5) return;
+  f->count = headers->count;
   if (layer.GetFeatureCount(FALSE) != GIntBig(f->count)) return;
   // The .dbf's header only: opening costs the same however big the files (each read checks
   // its record's deletion flag).
-  const unsigned char* dh = f->dbf.get(0, 32);
-  if (!dh || le32(dh + 4) != f->count) return;
-  f->dbf_header = le16(dh + 8);
-  f->dbf_record = le16(dh + 10);
-  if (f->dbf_record == 0 || f->dbf_header < 32 ||
-      f->dbf.size() < f->dbf_header + f->count * f->dbf_record)
-    return;
+  const auto layout = dbf_layout(f->dbf, f->count);
+  if (!layout) return;
+  f->dbf_layout = *layout;
   srs_ = layer.GetSpatialRef();
   files_ = std::move(f);
 }
@@ -809,8 +832,7 @@ ShapefilePolygons::~ShapefilePolygons() = default;
 
 std::unique_ptr<OGRGeometry> ShapefilePolygons::read(std::int64_t fid) {
   if (!files_ || fid < 0 || std::uint64_t(fid) >= files_->count) return nullptr;
-  const unsigned char* deleted =
-      files_->dbf.get(files_->dbf_header + std::uint64_t(fid) * files_->dbf_record, 1);
+  const unsigned char* deleted = files_->dbf_layout.deletion_flag(files_->dbf, std::uint64_t(fid));
   if (!deleted || *deleted == '*') return nullptr;  // GDAL has no such feature
   const unsigned char* e = files_->shx.get(100 + 8 * std::uint64_t(fid), 8);
   if (!e) return nullptr;
