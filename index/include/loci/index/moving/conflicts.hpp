@@ -169,7 +169,8 @@ class ConflictFinder {
       const double t0 = now + step * double(s);
       const double t1 = s + 1 == slices ? now + horizon : now + step * double(s + 1);
       for (std::uint32_t k = 0; k < n; ++k) {
-        const Box<D> b = detail::grown_sweep(objects[order_[k]], t0, t1, 0.5 * within);
+        // The reports in proxy order, read in sequence.
+        const Box<D> b = detail::grown_sweep(motion_[k], t0, t1, 0.5 * within);
         if (k < held_)
           broad_.move(k, b);
         else
