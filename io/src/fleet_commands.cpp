@@ -264,6 +264,7 @@ FleetRun fleet_query(const FleetQueryOptions& o, std::FILE* fallback) {
     throw InvalidArgument("--nearest answers at one time (--at), not --during");
   if (o.during && !(o.during->first <= o.during->second))
     throw InvalidArgument("--during T1,T2 needs T1 <= T2");
+  refuse_overwriting(o.out_path, o.path);
   const Loaded l = load(o.path, o.at);
   std::vector<Hit> hits;
   if (o.kind == FleetQueryOptions::Kind::nearest)
@@ -282,6 +283,7 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   check_conflict_query(o.within, o.at.value_or(0), o.horizon);
   if (o.format == Format::ids)
     throw InvalidArgument("conflicts are written as csv or geojson, not ids");
+  refuse_overwriting(o.out_path, o.path);
   const Loaded l = load(o.path, o.at);
   const auto now = in_force(l.data.reports, l.now);
   std::vector<Id> ids;
@@ -434,6 +436,7 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
     throw InvalidArgument("the interval between reports must be > 0");
   if (o.distribution == Dist::lanes && o.along.empty())
     throw InvalidArgument("--distribution lanes needs --along LAYER");
+  refuse_overwriting(o.out_path, o.along);
   Box2 bbox = o.bbox.value_or(ais ? Box2{{8, 54.5}, {13, 58}} : Box2{{0, 0}, {1e4, 1e4}});
   if (!ais && !o.bbox && o.distribution == Dist::lanes) {
     // Planar lanes along a layer: by default, the layer's extent and a margin for the offsets.
@@ -587,6 +590,7 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
   if (!(o.tick > 0) || !std::isfinite(o.tick)) throw InvalidArgument("--tick must be > 0");
   const double slack = o.slack.value_or(o.horizon / 4);
   if (!(slack >= 0) || !std::isfinite(slack)) throw InvalidArgument("--slack must be >= 0");
+  refuse_overwriting(o.out_path, o.path);
   const Loaded l = load(o.path, std::nullopt);
   const auto start = in_force(l.data.reports, l.now);
   std::vector<Id> ids;

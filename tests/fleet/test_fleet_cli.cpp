@@ -534,6 +534,27 @@ TEST_F(FleetCli, FailuresLeaveNothingWritten) {
   EXPECT_EQ(lines(read_text(kept)).size(), 2u);
 }
 
+TEST_F(FleetCli, TheInputIsNeverOverwritten) {
+  const std::string text = "id,t,x,y,vx,vy\n1,0,0,0,1,0\n2,0,5,0,-1,0\n";
+  const std::string in = write("in.csv", text);
+  fs::create_symlink(in, path("link.csv"));
+  fs::copy_file(kCoast, path("lanes.geojson"));
+  const std::string lanes = read_text(path("lanes.geojson"));
+  for (const std::string& out : {in, path("link.csv")}) {
+    const std::string o = " -o " + shell_quote(out);
+    expect_one_line_error(run_loci("fleet query " + shell_quote(in) + " --bbox 0,0,9,9" + o));
+    expect_one_line_error(
+        run_loci("fleet conflicts " + shell_quote(in) + " --within 1 --horizon 10" + o));
+    expect_one_line_error(
+        run_loci("fleet simulate " + shell_quote(in) + " --ticks 2 --within 1 --horizon 10" + o));
+    EXPECT_EQ(read_text(in), text) << out;
+  }
+  expect_one_line_error(run_loci("fleet generate --count 3 --distribution lanes --along " +
+                                 shell_quote(path("lanes.geojson")) + " -o " +
+                                 shell_quote(path("lanes.geojson"))));
+  EXPECT_EQ(read_text(path("lanes.geojson")), lanes);
+}
+
 }  // namespace
 
 namespace {
