@@ -60,7 +60,7 @@ void fleet_window(sqlite3* db, const Registry& registry, std::span<sqlite3_value
 void fleet_nearest(sqlite3* db, const Registry& registry, std::span<sqlite3_value* const> args,
                    FunctionRows& rows) {
   const char* f = "loci_fleet_nearest";
-  const Point2 q{{number_argument(args[1], f, "x"), number_argument(args[2], f, "y")}};
+  const Point2 q{{coordinate_argument(args[1], f, "x"), coordinate_argument(args[2], f, "y")}};
   const std::size_t k = count_argument(args[3], f);
   FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f);
   FleetState& state = fleet.current();
@@ -72,6 +72,7 @@ void fleet_nearest(sqlite3* db, const Registry& registry, std::span<sqlite3_valu
     for (Neighbor& n : found)
       n.id = Id(FleetState::id_of(n.id));
   } else {
+    loci::detail::check_nearest_time(t);
     for (const auto& [id, m] : fleet.in_force_at(t))
       found.push_back({Id(id), std::sqrt(squared_distance(position(m, t), q))});
     const auto by_distance = [](const Neighbor& a, const Neighbor& b) {
@@ -80,6 +81,8 @@ void fleet_nearest(sqlite3* db, const Registry& registry, std::span<sqlite3_valu
     const std::size_t n = std::min(k, found.size());
     std::partial_sort(found.begin(), found.begin() + std::ptrdiff_t(n), found.end(), by_distance);
     found.resize(n);
+    for (const Neighbor& near : found)
+      loci::detail::check_nearest_distance(near.distance);
   }
   for (const Neighbor& n : found) {
     rows.add(sqlite3_int64(n.id));

@@ -16,11 +16,14 @@ const char* const kShadowSuffixes[] = {"node", "delta", "dead", "meta", "aux"};
 
 // ---- Values -------------------------------------------------------------------------------
 
-// A coordinate from SQL: integers and real numbers, and text that reads as one; anything
-// else is an error naming the column.
+// A coordinate from SQL: integers and real numbers, and text that reads as one, within
+// +-1e150 (as in layers: squared distances of larger ones overflow a double); anything else
+// is an error naming the column.
 double coordinate(sqlite3_value* v, const char* column, const RTreeTable& t) {
   double x = 0;
-  if (const char* problem = read_number(v, x))
+  const char* problem = read_number(v, x);
+  if (!problem && !(std::abs(x) <= kMaxCoordinate)) problem = "beyond 1e150";
+  if (problem)
     throw SqlError{SQLITE_CONSTRAINT,
                    format_sql("loci_rtree %s: %s is %s", t.name.c_str(), column, problem)};
   return x;

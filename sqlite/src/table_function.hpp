@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "loci/geom/point.hpp"
 #include "shadow_table.hpp"
 
 namespace loci::sqlite {
@@ -59,6 +60,15 @@ inline double number_argument(sqlite3_value* v, const char* function, const char
   double x = 0;
   if (const char* problem = read_number(v, x))
     throw SqlError{SQLITE_MISMATCH, format_sql("%s: %s is %s", function, what, problem)};
+  return x;
+}
+
+// A coordinate argument: a number as number_argument gives, within +-1e150 (squared distances
+// of larger ones overflow a double).
+inline double coordinate_argument(sqlite3_value* v, const char* function, const char* what) {
+  const double x = number_argument(v, function, what);
+  if (!(std::abs(x) <= kMaxCoordinate))
+    throw SqlError{SQLITE_MISMATCH, format_sql("%s: %s is beyond 1e150", function, what)};
   return x;
 }
 

@@ -495,6 +495,19 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   expect_one_line_error(
       run_loci("fleet query " + shell_quote(good) + " --nearest 0,0 --during 0,1"), "--nearest");
   expect_one_line_error(run_loci("fleet teleport " + shell_quote(good)), "unknown command");
+  // Positions far beyond 1e150 at the time asked: refused, not answered with infinite
+  // distances or a misranked nearest.
+  const std::string far = write("far.csv", "id,t,x,y,vx,vy\n1,0,0,0,2,0\n2,0,0,0,1,0\n");
+  expect_one_line_error(
+      run_loci("fleet query " + shell_quote(far) + " --nearest 0,0 -k 1 --at 1e160 -f csv"),
+      "beyond 1e150");
+  const CliRun near =
+      run_loci("fleet query " + shell_quote(far) + " --nearest 0,0 -k 1 --at 1e149");
+  ASSERT_EQ(near.status, 0) << near.err;
+  EXPECT_EQ(ids_of(near.out), std::vector<Id>{2});
+  expect_one_line_error(
+      run_loci("fleet conflicts " + shell_quote(far) + " --within 1 --horizon 5 --at 1e160"),
+      "beyond 1e150");
   expect_one_line_error(run_loci("fleet generate --count 0 -o " + shell_quote(path("g.csv"))),
                         "--count");
   expect_one_line_error(

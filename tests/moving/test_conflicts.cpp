@@ -102,6 +102,29 @@ TEST(Conflicts, ByIdsSortedAndChecked) {
       find_conflicts<2>(std::span<const Id>(), std::span<const Motion2>(), 1, 0, 1).empty());
 }
 
+// Objects whose positions leave +-1e150 during the horizon would overflow the closest
+// approaches: refused, by find_conflicts and by a monitor, which keeps its last answer.
+TEST(Conflicts, PositionsBeyondTheRangeAreRefused) {
+  const std::vector<Motion2> fleet{{0, {0, 0}, {1e140, 0}}, {0, {1, 0}, {1e140, 0}}};
+  EXPECT_EQ(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 0, 1e9).size(), 1u);
+  EXPECT_THROW(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 0, 1e11), InvalidArgument);
+  EXPECT_THROW(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 1e11, 1), InvalidArgument);
+  ConflictMonitor<2> monitor(2, 1e9, 1e9);
+  monitor.report(1, fleet[0]);
+  monitor.report(2, fleet[1]);
+  monitor.refresh(0);
+  ASSERT_EQ(monitor.conflicts().size(), 1u);
+  // A new report that leaves the range within the span searched (incremental), then a time
+  // whose span leaves it (full): refused, the answer of time 0 kept.
+  monitor.report(3, Motion2{0, {5, 0}, {2e141, 0}});
+  EXPECT_THROW(monitor.refresh(1), InvalidArgument);
+  monitor.remove(3);
+  EXPECT_THROW(monitor.refresh(1e11), InvalidArgument);
+  EXPECT_EQ(monitor.conflicts().size(), 1u);
+  monitor.refresh(1);
+  EXPECT_EQ(monitor.conflicts().size(), 1u);
+}
+
 TEST(Conflicts, VisitorStops) {
   const auto fleet = test::make_fleet(test::Fleet::identical, 300, 2);
   int seen = 0;

@@ -170,6 +170,32 @@ TYPED_TEST(MovingIndexTest, RefusesBadInput) {
   index.validate();
 }
 
+// Positions at the time asked may lie beyond 1e150: the ranking stays exact while the
+// distances fit a double, and an answer whose distance overflows is refused, never reported
+// as infinite (nor two overflowed distances ranked as a tie), before and after the clock.
+TYPED_TEST(MovingIndexTest, NearestFarAwayIsExactOrRefused) {
+  TypeParam index;
+  for (Id i = 1; i <= 40; ++i)
+    index.insert(i, Motion2{0, {double(i), 0}, {1e148 * double(41 - i), 0}});
+  index.update(41, Motion2{10, {0, 0}, {0, 0}});  // the clock moves to 10
+  for (const double s : {5.0, 30.0}) {
+    // Object 40 is the nearest after the still one: 1e148 * s away, squares finite.
+    const auto got = index.nearest(Point2{0, 0}, s, 3);
+    ASSERT_EQ(got.size(), 3u);
+    EXPECT_EQ(got[0].id, 41u);
+    EXPECT_EQ(got[1].id, 40u);
+    EXPECT_EQ(got[2].id, 39u);
+    EXPECT_LT(got[2].distance, INFINITY);
+  }
+  // At 1e8 every moving object's squared distance overflows: the still one is found, the
+  // next refused.
+  EXPECT_EQ(index.nearest(Point2{0, 0}, 1e8, 1).at(0).id, 41u);
+  EXPECT_THROW(index.nearest(Point2{0, 0}, 1e8, 2), InvalidArgument);
+  EXPECT_THROW(index.nearest(Point2{0, 0}, 1e160, 1), InvalidArgument);
+  EXPECT_THROW(index.nearest(Point2{1e200, 0}, 20, 1), InvalidArgument);
+  index.validate();
+}
+
 TYPED_TEST(MovingIndexTest, VisitorStopsEarly) {
   const auto fleet = test::make_fleet(test::Fleet::clustered, 500, 1);
   TypeParam index;

@@ -426,6 +426,22 @@ TEST(SqliteFleetSql, BadInputIsAnSqlErrorWithAClearMessage) {
   EXPECT_TRUE(
       has(db.error_of("SELECT * FROM loci_fleet_window('f', 0, 0, 1, 1)"), "six arguments"));
   EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_fleet_nearest('f', 0, 0, 1.5)"), "k must be"));
+  EXPECT_TRUE(
+      has(db.error_of("SELECT * FROM loci_fleet_nearest('f', 2e150, 0, 1)"), "x is beyond 1e150"));
+  // Positions far beyond 1e150 at the time asked: refused, never an infinite distance or
+  // two of them ranked as a tie; after the latest report (the tree) and before it (history).
+  db.exec("INSERT INTO f VALUES (2, 10, 0, 0, 1e150, 0), (3, 10, 0, 0, 5e149, 0)");
+  EXPECT_EQ(db.value("SELECT id FROM loci_fleet_nearest('f', 0, 0, 2, 1e3) LIMIT 1 OFFSET 1"), "3");
+  EXPECT_TRUE(
+      has(db.error_of("SELECT * FROM loci_fleet_nearest('f', 0, 0, 2, 1e160)"), "beyond 1e150"));
+  EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_fleet_nearest('f', 0, 0, 2, 1e100)"),
+                  "too far for its distance"));
+  db.exec("INSERT INTO f VALUES (4, 1e12, 0, 0, 0, 0)");
+  EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_fleet_nearest('f', 0, 0, 3, 1e11)"),
+                  "too far for its distance"));
+  EXPECT_EQ(db.value("SELECT id FROM loci_fleet_nearest('f', 0, 0, 1, 1e11)"), "1");
+  EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_conflicts('f', 1, 1e160)"), "beyond 1e150"));
+  db.exec("DELETE FROM f WHERE id IN (2, 3, 4)");
   EXPECT_TRUE(has(db.error_of("SELECT loci_check('plain')"), "not a loci_rtree or loci_fleet"));
 }
 

@@ -440,6 +440,8 @@ TEST(SqliteRtreeSql, BadInputIsAnSqlErrorWithAClearMessage) {
             std::string::npos);
   EXPECT_NE(db.try_exec("INSERT INTO t VALUES (1, 0, 1e999, 0, 1)").find("not finite"),
             std::string::npos);
+  EXPECT_NE(db.try_exec("INSERT INTO t VALUES (1, 0, 1, 0, 2e150)").find("maxy is beyond 1e150"),
+            std::string::npos);
   EXPECT_NE(db.try_exec("INSERT INTO t VALUES (1, 2, 1, 0, 1)").find("minx > maxx"),
             std::string::npos);
   EXPECT_NE(db.try_exec("INSERT INTO t VALUES ('x', 0, 1, 0, 1)").find("id must be an integer"),
@@ -471,6 +473,10 @@ TEST(SqliteRtreeSql, BadInputIsAnSqlErrorWithAClearMessage) {
       std::string::npos);
   EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', NULL, 0, 1)").find("x is NULL"),
             std::string::npos);
+  EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', 0, -1e200, 1)").find("y is beyond 1e150"),
+            std::string::npos);
+  // Windows compare without squaring: any finite bound is fine.
+  EXPECT_EQ(db.value("SELECT count(*) FROM t WHERE minx <= 1e300 AND maxx >= -1e300"), "1");
   EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', 0, 0, -1)").find("k must be"),
             std::string::npos);
   EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', 0, 0)").find("four arguments"),

@@ -127,6 +127,17 @@ inline void check_conflict_query(double within, double now, double horizon) {
   if (!std::isfinite(now)) throw InvalidArgument("conflict time is NaN or infinite");
 }
 
+namespace detail {
+// Closest approaches square differences of positions and velocities: every object must stay
+// within +-kMaxCoordinate over [t0, t1] (it moves linearly: checked at both ends), or the
+// arithmetic could overflow and lose pairs. Throws InvalidArgument.
+template <int D>
+void check_conflict_span(const Motion<D>& m, double t0, double t1) {
+  if (!within_coordinate_range(position(m, t0)) || !within_coordinate_range(position(m, t1)))
+    throw InvalidArgument("conflicts: an object moves beyond 1e150 in the time searched");
+}
+}  // namespace detail
+
 // The broad phase and buffers of conflict searches, kept between calls so that a search
 // repeated every tick reuses its memory (and the broad phase its proxies).
 template <int D>
@@ -206,6 +217,8 @@ class ConflictFinder {
   // the broad phase reports (neighbours in space) read neighbouring memory.
   void prepare(std::span<const Motion<D>> objects, double now, double horizon) {
     const std::size_t n = objects.size();
+    for (const Motion<D>& m : objects)
+      detail::check_conflict_span(m, now, now + horizon);
     at_now_.resize(n);
     motion_.resize(n);
     Box<D> extent = Box<D>::empty();
@@ -343,11 +356,14 @@ class ConflictMonitor {
   // Brings the kept pairs up to time now.
   QueryStats refresh(double now) {
     if (!std::isfinite(now)) throw InvalidArgument("conflict time is NaN or infinite");
-    now_ = now;
     if (!computed_ || now < base_ || now > base_ + slack_) return recompute(now);
+    const double t1 = base_ + horizon_ + slack_;
+    // Every new report is checked before anything changes.
+    for (std::uint32_t s : dirty_list_)
+      if (alive_[s]) detail::check_conflict_span(motion_[s], base_, t1);
+    now_ = now;
     ++incremental_;
     QueryStats st;
-    const double t1 = base_ + horizon_ + slack_;
     dirty_seen_.resize(ids_.size(), 0);
     moved_.resize(ids_.size(), 0);
     for (std::uint32_t s : dirty_list_) {
@@ -487,10 +503,14 @@ class ConflictMonitor {
   }
 
   QueryStats recompute(double now) {
+    const double span = horizon_ + slack_;
+    // Every report is checked before anything changes.
+    for (std::uint32_t s = 0; s < ids_.size(); ++s)
+      if (alive_[s]) detail::check_conflict_span(motion_[s], now, now + span);
+    now_ = now;
     ++full_;
     computed_ = true;
     base_ = now;
-    const double span = horizon_ + slack_;
     for (std::uint32_t s : dirty_list_) {
       dirty_[s] = 0;
       if (!alive_[s]) free_.push_back(s);

@@ -98,6 +98,7 @@ class Fleet {
   QueryStats nearest(const Point<D>& q, double s, std::size_t k, F&& visit) const {
     if (s >= index_.clock()) return index_.nearest(q, s, k, visit);
     check_point(q, "nearest point");
+    detail::check_nearest_time(s);
     QueryStats st;
     st.nodes_visited = 1;
     std::vector<std::pair<Id, const Motion<D>*>> live;
@@ -109,6 +110,7 @@ class Fleet {
     });
     for (const auto& [d2, i] : out) {
       ++st.results;
+      detail::check_nearest_distance(d2);
       if (!visit(live[i].first, *live[i].second, std::sqrt(d2))) break;
     }
     return st;

@@ -30,8 +30,10 @@
 // one template parameter.
 #pragma once
 
+#include <cmath>
 #include <concepts>
 #include <cstddef>
+#include <limits>
 #include <queue>
 #include <utility>
 #include <vector>
@@ -63,6 +65,22 @@ struct MotionNearestProbe {
 }  // namespace detail
 
 namespace detail {
+// Nearest-n at time s: s must lie within +-kMaxCoordinate (so that s - t never overflows),
+// and a distance that overflows a double is refused rather than reported. Positions at s may
+// lie beyond kMaxCoordinate; while the distances ranked stay finite the order is exact (an
+// object whose squared distance overflows is farther than every one that does not), so only
+// an answer that would report an overflowed distance throws.
+inline void check_nearest_time(double s) {
+  check_coordinate(s, "nearest time");
+  if (!(std::abs(s) <= kMaxCoordinate)) throw InvalidArgument("nearest time is beyond 1e150");
+}
+inline void check_nearest_distance(double d) {
+  if (!(d < std::numeric_limits<double>::infinity()))
+    throw InvalidArgument(
+        "nearest: an answer lies too far for its distance to fit a double (positions beyond "
+        "1e150 at the time asked)");
+}
+
 // The k smallest of the squared distances d2(i), i < n, nearest first, as (d2, i): the
 // nearest-n of the scans.
 template <class D2>

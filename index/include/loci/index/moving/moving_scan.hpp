@@ -123,7 +123,7 @@ class MovingScan {
   template <MotionNearestVisitor<D> F>
   QueryStats nearest(const Point<D>& q, double s, std::size_t k, F&& visit) const {
     check_point(q, "nearest point");
-    check_coordinate(s, "nearest time");
+    detail::check_nearest_time(s);
     QueryStats st;
     st.nodes_visited = 1;
     st.entries_tested = ids_.size();
@@ -139,6 +139,7 @@ class MovingScan {
     });
     for (const auto& [dd, i] : out) {
       ++st.results;
+      detail::check_nearest_distance(dd);
       if (!visit(ids_[i], motion(std::uint32_t(i)), std::sqrt(dd))) break;
     }
     return st;

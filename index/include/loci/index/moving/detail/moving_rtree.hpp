@@ -286,7 +286,7 @@ class MovingRTree {
   template <MotionNearestVisitor<D> F>
   QueryStats nearest(const Point<D>& q, double s, std::size_t k, F&& visit) const {
     check_point(q, "nearest point");
-    check_coordinate(s, "nearest time");
+    detail::check_nearest_time(s);
     if (root_ == kNone || k == 0) return {};
     const double r = s - epoch_;
     const bool prune = s >= clock_;
@@ -307,6 +307,7 @@ class MovingRTree {
       return n.count;
     };
     return detail::best_first(root_, k, expand, [&](Id id, std::uint64_t ref, double d) {
+      detail::check_nearest_distance(d);
       return visit(id, obj_motion_[std::uint32_t(ref)], d);
     });
   }
