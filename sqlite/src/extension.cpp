@@ -5,7 +5,9 @@
 // entry point sqlite3_loci_init from the file name. Programs that link SQLite in call the same
 // function from the static library loci_sqlite_static (sqlite3_auto_extension, see
 // include/loci/sqlite/loci_sqlite.h).
+#include <map>
 #include <memory>
+#include <mutex>
 
 #include "shadow_table.hpp"
 
@@ -34,9 +36,26 @@ void check_function(sqlite3_context* ctx, int, sqlite3_value** argv) {
   }
 }
 
+// The registry of the connection db: the one its loci tables and functions already share
+// when the extension is loaded again on it (loading registers the modules and functions anew,
+// and tables connected earlier must stay visible to the new functions), else a new one. A
+// connection's registry lives while SQLite holds a module, function or table of it, so an
+// entry left by a closed connection has expired before its address can be reused.
+std::shared_ptr<Registry> registry_for(sqlite3* db) {
+  static std::mutex guard;
+  static std::map<sqlite3*, std::weak_ptr<Registry>> live;
+  const std::lock_guard<std::mutex> lock(guard);
+  std::erase_if(live, [](const auto& entry) { return entry.second.expired(); });
+  if (const auto it = live.find(db); it != live.end())
+    if (auto registry = it->second.lock()) return registry;
+  auto registry = std::make_shared<Registry>();
+  live[db] = registry;
+  return registry;
+}
+
 int register_all(sqlite3* db, char** err) {
   try {
-    auto registry = std::make_shared<Registry>();
+    const std::shared_ptr<Registry> registry = registry_for(db);
     int rc = register_rtree(db, registry);
     if (rc == SQLITE_OK) rc = register_nearest(db, registry);
     if (rc == SQLITE_OK) rc = register_fleet(db, registry);

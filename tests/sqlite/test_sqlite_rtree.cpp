@@ -363,6 +363,23 @@ TEST(SqliteRtreeSql, RandomWritesFollowRollbackAndSavepoints) {
   EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
 }
 
+// Loading the extension again on a connection (a script that loads it twice) keeps the
+// tables made before usable by the functions it registers anew.
+TEST(SqliteRtreeSql, LoadingTwiceKeepsEarlierTablesVisible) {
+  Db db;
+  db.exec("CREATE VIRTUAL TABLE s USING loci_rtree(id, minx, maxx, miny, maxy)");
+  db.exec("CREATE VIRTUAL TABLE f USING loci_fleet(id, t, x, y, vx, vy)");
+  db.exec("INSERT INTO s VALUES (1, 0, 1, 0, 1), (2, 5, 6, 5, 6)");
+  db.exec("INSERT INTO f VALUES (1, 0, 0, 0, 1, 0), (2, 0, 10, 0, -1, 0)");
+  db.load_extension();
+  EXPECT_EQ(db.value("SELECT id FROM loci_nearest('s', 5, 5, 1)"), "2");
+  EXPECT_EQ(db.value("SELECT loci_check('s')"), "ok");
+  EXPECT_EQ(db.value("SELECT count(*) FROM loci_conflicts('f', 1, 10)"), "1");
+  EXPECT_EQ(db.value("SELECT loci_check('f')"), "ok");
+  db.exec("INSERT INTO s VALUES (3, 9, 9, 9, 9)");
+  EXPECT_EQ(db.value("SELECT id FROM loci_nearest('s', 10, 10, 1)"), "3");
+}
+
 TEST(SqliteRtreeSql, SurvivesCloseAndReopen) {
   TempDir dir;
   const auto boxes = loci::test::make_boxes<2>(loci::test::Shape::clustered, 6000, 4);
