@@ -530,6 +530,21 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
     Point2 p, v;
   };
   std::vector<Out> rows;
+  // Every report must read back as written: distinct times for one object, times within
+  // +-1e150 (AIS: dates of four-digit years), positions and velocities within +-1e150.
+  constexpr double kYear0 = -62167219200, kYear10000 = 253402300800;  // 0000-01-01, 10000-01-01
+  auto check_generated = [&](double t, const Point2& p, const Point2& v) {
+    if (!(std::abs(t) <= kMaxCoordinate) || (ais && !(t >= kYear0 && t + 0.5 < kYear10000)))
+      throw InvalidArgument(ais ? "--time and --interval give report dates outside years 0 to 9999"
+                                : "--time and --interval give report times beyond 1e150");
+    if (!(t - o.interval < t))
+      throw InvalidArgument(
+          "--interval is too small for --time: reports of an object would "
+          "share a time");
+    if (!within_coordinate_range(p) || !within_coordinate_range(v))
+      throw InvalidArgument(
+          "reports would lie beyond 1e150: lower --speed, --interval or --reports");
+  };
   for (std::size_t n = 0; n < o.count; ++n) {
     const auto s = place();
     if (!s)
@@ -544,6 +559,7 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
     double t = t_last - std::floor(o.interval * unit(rng) * 0.5);
     for (std::size_t r = 0; r < o.reports; ++r) {
       const Point2 v{speed * std::cos(heading), speed * std::sin(heading)};
+      check_generated(t, p, v);
       rows.push_back({t, id, p, v});
       heading += 0.05 * (unit(rng) - 0.5);
       const Point2 back{speed * std::cos(heading), speed * std::sin(heading)};

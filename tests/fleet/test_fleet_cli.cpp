@@ -513,6 +513,14 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   expect_one_line_error(
       run_loci("fleet generate --count 5 --distribution lanes -o " + shell_quote(path("g.csv"))),
       "--along");
+  // Nothing is generated that would not read back as written.
+  const std::string gen = "fleet generate --count 3 -o " + shell_quote(path("g.csv")) + " ";
+  expect_one_line_error(run_loci(gen + "-f ais --time 1e13"), "years 0 to 9999");
+  expect_one_line_error(run_loci(gen + "-f ais --time -7e10"), "years 0 to 9999");
+  expect_one_line_error(run_loci(gen + "--time 1e300"), "beyond 1e150");
+  expect_one_line_error(run_loci(gen + "--time 1e9 --interval 1e-9"), "share a time");
+  expect_one_line_error(run_loci(gen + "--speed 1e300,1e300"), "beyond 1e150");
+  expect_one_line_error(run_loci(gen + "--speed 1e140,1e140 --interval 1e10"), "beyond 1e150");
   expect_one_line_error(
       run_loci("fleet query " + shell_quote(kData + "/ais-sentinels.csv") + " --bbox 0,0,200,1"),
       "lon/lat");
