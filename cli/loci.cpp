@@ -763,6 +763,8 @@ Args parse(const Command& c, int first, int argc, char** argv) {
       continue;
     }
     if (i + 1 >= argc) throw UsageError(arg + " needs a value: " + flag->value);
+    if (argv[i + 1][0] == '\0')  // `-o ""` would otherwise mean stdout or a default
+      throw UsageError(arg + " needs a value: " + flag->value + ", not an empty one");
     a.values[flag->name] = argv[++i];
   }
   return a;

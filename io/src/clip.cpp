@@ -11,6 +11,7 @@
 // windowing problem with a non-rectangular window: the index gives the features meeting the
 // window's envelope, the exact test of exact.hpp keeps those that meet the window itself, and
 // GEOS cuts them.
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -223,8 +224,11 @@ std::size_t clip_layer(const ClipOptions& options) {
           type = OGR_GT_GetCollection(type);
           break;
         }
-    OGRLayer* layer =
-        ds->CreateLayer(src.layer->GetName(), src.layer->GetSpatialRef(), type, nullptr);
+    // A CSV keeps the cut geometries as WKT (by default GDAL's CSV driver drops them).
+    const bool csv = std::strcmp(driver->GetDescription(), "CSV") == 0;
+    const char* as_wkt[] = {"GEOMETRY=AS_WKT", nullptr};
+    OGRLayer* layer = ds->CreateLayer(src.layer->GetName(), src.layer->GetSpatialRef(), type,
+                                      csv ? const_cast<char**>(as_wkt) : nullptr);
     if (!layer) throw Error("cannot write " + options.out_path + ": " + CPLGetLastErrorMsg());
     const OGRFeatureDefn* defn = src.layer->GetLayerDefn();
     for (int i = 0; i < defn->GetFieldCount(); ++i) {

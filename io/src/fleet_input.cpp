@@ -159,6 +159,9 @@ struct Header {
       if (names[i] == name) return int(i);
     return -1;
   }
+  bool twice(const char* name) const {
+    return std::count(names.begin(), names.end(), std::string_view(name)) > 1;
+  }
 };
 
 Header read_header(CsvRecords& csv, const std::string& source) {
@@ -170,8 +173,14 @@ Header read_header(CsvRecords& csv, const std::string& source) {
   return h;
 }
 
+// The column `name`, which the header must hold once (which of two would be meant?).
+int column(const Header& h, const CsvRecords& csv, const char* name) {
+  if (h.twice(name)) csv.fail(std::string("the header names column '") + name + "' twice");
+  return h.find(name);
+}
+
 int require(const Header& h, const CsvRecords& csv, const char* name, const char* header) {
-  const int i = h.find(name);
+  const int i = column(h, csv, name);
   if (i < 0)
     csv.fail(std::string("no column '") + name + "' in the header (expected " + header + ")");
   return i;
@@ -471,7 +480,7 @@ FleetData read_fleet_csv(std::string_view text, const std::string& source) {
   const Header h = read_header(csv, source);
   const int ci = require(h, csv, "id", kHeader), ct = require(h, csv, "t", kHeader),
             cx = require(h, csv, "x", kHeader), cy = require(h, csv, "y", kHeader);
-  const int cvx = h.find("vx"), cvy = h.find("vy");
+  const int cvx = column(h, csv, "vx"), cvy = column(h, csv, "vy");
   if ((cvx < 0) != (cvy < 0)) csv.fail("the header has one of vx, vy but not the other");
   FleetData out;
   out.format = FleetFormat::planar;

@@ -92,6 +92,8 @@ TEST(FleetCsv, MalformedInputIsOneLineErrorNamingFileAndLine) {
       {"", "f.csv: empty file"},
       {"id,t,x\n1,0,0\n", "f.csv: line 1: no column 'y'"},
       {"id,t,x,y,vx\n1,0,0,0,0\n", "line 1: the header has one of vx, vy"},
+      {"id,ID,t,x,y\n1,2,0,0,0\n", "line 1: the header names column 'id' twice"},
+      {"id,t,x,y,vx,vy,VY\n1,0,0,0,0,0,1\n", "line 1: the header names column 'vy' twice"},
       {"id,t,x,y\n1,0,0\n", "f.csv: line 2: 3 fields, the header has 4"},
       {"id,t,x,y\n1,0,0,0\n1,1,0,0,5\n", "line 3: 5 fields"},
       {"id,t,x,y\n1,0,abc,0\n", "line 2: x 'abc' is not a number"},
@@ -179,6 +181,8 @@ TEST(FleetAis, MalformedRowsAreErrorsNamingTheLine) {
   EXPECT_NE(error_of(h + "1,2023-01-01T00:00:00,55,10\n").find("line 2: 4 fields"),
             std::string::npos);
   EXPECT_NE(error_of("MMSI,BaseDateTime,LAT,LON,SOG\n").find("no column 'cog'"), std::string::npos);
+  EXPECT_NE(error_of("MMSI,BaseDateTime,LAT,LON,SOG,COG,Lat\n").find("column 'lat' twice"),
+            std::string::npos);
   // Header only: no vessels, no frame.
   const FleetData d = read_fleet(h, "h");
   EXPECT_EQ(d.format, FleetFormat::ais);

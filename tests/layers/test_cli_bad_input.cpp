@@ -136,6 +136,10 @@ TEST_F(BadInput, DevicesFifosAndLinksAreWrittenThroughNeverReplaced) {
   // a directory as output
   expect_one_line_error(
       run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o " + shell_quote(dir_.string())));
+  // an empty output name (not stdout, nor the default sidecar)
+  expect_one_line_error(run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o ''"));
+  expect_one_line_error(run_loci("index " + shell_quote(l) + " -o ''"));
+  expect_one_line_error(run_loci("fleet generate --count 3 -o ''"));
 }
 
 TEST_F(BadInput, TheInputLayerIsNeverOverwritten) {

@@ -466,6 +466,21 @@ TEST_F(LayersCli, ClipCutsToTheWindow) {
     EXPECT_GE(e.MinX, 20 - 1e-9);
     EXPECT_LE(e.MaxX, 60 + 1e-9);
   }
+  // A CSV output keeps the cut geometries (as WKT, which OGR reads back), the same ones to the
+  // 15 digits GDAL writes WKT with.
+  const std::string csv = path("clipped.csv");
+  const CliRun c = run_loci("clip " + path("polys.shp") + " --bbox 20,20,60,60 -q -o " + csv);
+  ASSERT_EQ(c.status, 0) << c.err;
+  const OgrFeatureSet t = read_with_ogr(csv);
+  ASSERT_EQ(t.geoms.size(), s.geoms.size());
+  for (std::size_t i = 0; i < t.geoms.size(); ++i) {
+    EXPECT_NEAR(t.envelopes[i].MinX, s.envelopes[i].MinX, 1e-9);
+    EXPECT_NEAR(t.envelopes[i].MaxY, s.envelopes[i].MaxY, 1e-9);
+    const double area = OGR_G_Area(OGRGeometry::ToHandle(s.geoms[i].get()));
+    EXPECT_GT(area, 0);
+    EXPECT_NEAR(OGR_G_Area(OGRGeometry::ToHandle(t.geoms[i].get())), area, 1e-9 * (1 + area));
+  }
+  fs::remove(csv);
   for (const char* ext : {".shp", ".shx", ".dbf"})
     fs::remove(path(std::string("clipped") + ext));
 }
