@@ -378,8 +378,12 @@ int run_fleet_conflicts(const Args& a) {
   o.within = parse_nonnegative("--within", a.get("--within"));
   o.horizon = parse_nonnegative("--horizon", a.get("--horizon"));
   o.at = at_flag(a);
-  o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
-  if (o.format == Format::ids) throw UsageError("--format: conflicts are csv or geojson");
+  const std::string format = a.get("--format", "csv");
+  if (format != "csv" && format != "geojson")
+    throw UsageError("--format: unknown format '" + format +
+                     "' for conflicts (choose csv or "
+                     "geojson)");
+  o.format = parse_format(format);
   o.out_path = a.get("--output");
   const FleetRun r = fleet_conflicts(o, stdout);
   print_fleet_run(a, r);
