@@ -617,6 +617,18 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
     motions.push_back(r.m);
     if (!o.from_scratch) monitor.report(r.id, r.m);
   }
+  // The simulated reports turn but keep their speed: every object stays within +-1e150 until
+  // the last tick's horizon when it would going straight in any direction.
+  const double span = o.tick * double(o.ticks) + o.horizon;
+  for (const Motion2& m : motions) {
+    const Point2 p = position(m, l.now);
+    const double reach = std::hypot(m.v[0], m.v[1]) * span;
+    if (!(std::abs(l.now + span) <= kMaxCoordinate) ||
+        !(std::max(std::abs(p[0]), std::abs(p[1])) + reach <= kMaxCoordinate))
+      throw InvalidArgument(
+          "--tick and --ticks carry the simulation beyond 1e150 (in time or "
+          "position)");
+  }
   FleetIndex ix = index_of(start);
   FleetSimulateReport rep;
   rep.run = run_of(l);

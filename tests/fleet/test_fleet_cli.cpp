@@ -487,6 +487,11 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   expect_one_line_error(run_loci(g + " --within 1 --horizon 5 --at soon"), "--at");
   expect_one_line_error(run_loci(g + " --within 1 --horizon 5 -f ids"), "--format");
   expect_one_line_error(run_loci(g + " --within 1 --horizon 5 -f xml"), "choose csv or geojson");
+  expect_one_line_error(
+      run_loci("fleet simulate " + shell_quote(good) +
+               " --ticks 3 --within 1 --horizon 1 --tick 1e300 -o " + shell_quote(path("sim.csv"))),
+      "--tick and --ticks");
+  EXPECT_FALSE(fs::exists(path("sim.csv")));
   expect_one_line_error(run_loci(g + " --within 1 --horizon 5 --bogus"), "unknown option");
   expect_one_line_error(run_loci("fleet query " + shell_quote(good) + " --bbox 1,2,3"), "--bbox");
   expect_one_line_error(run_loci("fleet query " + shell_quote(good)), "--bbox");
