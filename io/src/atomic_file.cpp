@@ -293,7 +293,7 @@ void AtomicDataset::commit() {
   }
 }
 
-void refuse_overwriting(const std::string& out, const std::string& input) {
+void refuse_overwriting(const std::string& out, const std::string& input, const char* what) {
   if (out.empty() || input.empty()) return;
   std::error_code ec;
   const fs::path o = fs::weakly_canonical(out, ec), i = fs::weakly_canonical(input, ec);
@@ -303,7 +303,7 @@ void refuse_overwriting(const std::string& out, const std::string& input) {
     const std::string x = extension_after(o.filename().string(), stem);
     same = shapefile_companion(i.extension().string()) && !x.empty() && shapefile_companion(x);
   }
-  if (same) throw Error("refusing to write " + out + ": it is the input layer " + input);
+  if (same) throw Error("refusing to write " + out + ": it is the " + what + " " + input);
 }
 
 }  // namespace loci::io

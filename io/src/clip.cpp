@@ -233,6 +233,8 @@ std::size_t clip_layer(const ClipOptions& options) {
     const OGRFeatureDefn* defn = src.layer->GetLayerDefn();
     for (int i = 0; i < defn->GetFieldCount(); ++i) {
       OGRFieldDefn fd(defn->GetFieldDefn(i));
+      // A CSV source shows its geometry column as a field too: the cut geometry replaces it.
+      if (csv && EQUAL(fd.GetNameRef(), "WKT")) continue;
       if (layer->CreateField(&fd) != OGRERR_NONE)
         throw Error("cannot write " + options.out_path + ": field " + fd.GetNameRef());
     }

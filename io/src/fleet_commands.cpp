@@ -264,7 +264,7 @@ FleetRun fleet_query(const FleetQueryOptions& o, std::FILE* fallback) {
     throw InvalidArgument("--nearest answers at one time (--at), not --during");
   if (o.during && !(o.during->first <= o.during->second))
     throw InvalidArgument("--during T1,T2 needs T1 <= T2");
-  refuse_overwriting(o.out_path, o.path);
+  refuse_overwriting(o.out_path, o.path, "input fleet");
   const Loaded l = load(o.path, o.at);
   std::vector<Hit> hits;
   if (o.kind == FleetQueryOptions::Kind::nearest)
@@ -283,7 +283,7 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   check_conflict_query(o.within, o.at.value_or(0), o.horizon);
   if (o.format == Format::ids)
     throw InvalidArgument("conflicts are written as csv or geojson, not ids");
-  refuse_overwriting(o.out_path, o.path);
+  refuse_overwriting(o.out_path, o.path, "input fleet");
   const Loaded l = load(o.path, o.at);
   const auto now = in_force(l.data.reports, l.now);
   std::vector<Id> ids;
@@ -434,6 +434,8 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
   if (o.reports == 0) throw InvalidArgument("reports per object must be >= 1");
   if (!(o.interval > 0) || !std::isfinite(o.interval))
     throw InvalidArgument("the interval between reports must be > 0");
+  if (ais && o.interval < 1)  // dates are written to the second
+    throw InvalidArgument("AIS dates are whole seconds: the interval between reports must be >= 1");
   if (o.distribution == Dist::lanes && o.along.empty())
     throw InvalidArgument("--distribution lanes needs --along LAYER");
   refuse_overwriting(o.out_path, o.along);
@@ -534,7 +536,7 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
   // +-1e150 (AIS: dates of four-digit years), positions and velocities within +-1e150.
   constexpr double kYear0 = -62167219200, kYear10000 = 253402300800;  // 0000-01-01, 10000-01-01
   auto check_generated = [&](double t, const Point2& p, const Point2& v) {
-    if (!(std::abs(t) <= kMaxCoordinate) || (ais && !(t >= kYear0 && t + 0.5 < kYear10000)))
+    if (!(std::abs(t) <= kMaxCoordinate) || (ais && !(t + 0.5 >= kYear0 && t + 0.5 < kYear10000)))
       throw InvalidArgument(ais ? "--time and --interval give report dates outside years 0 to 9999"
                                 : "--time and --interval give report times beyond 1e150");
     if (!(t - o.interval < t))
@@ -606,7 +608,7 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
   if (!(o.tick > 0) || !std::isfinite(o.tick)) throw InvalidArgument("--tick must be > 0");
   const double slack = o.slack.value_or(o.horizon / 4);
   if (!(slack >= 0) || !std::isfinite(slack)) throw InvalidArgument("--slack must be >= 0");
-  refuse_overwriting(o.out_path, o.path);
+  refuse_overwriting(o.out_path, o.path, "input fleet");
   const Loaded l = load(o.path, std::nullopt);
   const auto start = in_force(l.data.reports, l.now);
   std::vector<Id> ids;
@@ -695,7 +697,7 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
   if (o.arrows && !(std::isfinite(*o.arrows) && *o.arrows >= 0))
     throw InvalidArgument("the arrows' time must be a finite number >= 0");
   if (!o.over.empty()) refuse_overwriting(o.out_path, o.over);
-  refuse_overwriting(o.out_path, o.path);
+  refuse_overwriting(o.out_path, o.path, "input fleet");
   const Loaded l = load(o.path, o.at);
   const auto now = in_force(l.data.reports, l.now);
   if (now.empty()) throw Error(o.path + ": no object has reported by then; nothing to draw");

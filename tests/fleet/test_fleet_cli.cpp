@@ -522,6 +522,7 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   // Nothing is generated that would not read back as written.
   const std::string gen = "fleet generate --count 3 -o " + shell_quote(path("g.csv")) + " ";
   expect_one_line_error(run_loci(gen + "-f ais --time 1e13"), "years 0 to 9999");
+  expect_one_line_error(run_loci(gen + "-f ais --interval 0.3"), "whole seconds");
   expect_one_line_error(run_loci(gen + "-f ais --time -7e10"), "years 0 to 9999");
   expect_one_line_error(run_loci(gen + "--time 1e300"), "beyond 1e150");
   expect_one_line_error(run_loci(gen + "--time 1e9 --interval 1e-9"), "share a time");

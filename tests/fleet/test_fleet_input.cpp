@@ -102,6 +102,7 @@ TEST(FleetCsv, MalformedInputIsOneLineErrorNamingFileAndLine) {
       {"id,t,x,y\n1,0,inf,0\n", "line 2: x is NaN or infinite"},
       {"id,t,x,y,vx,vy\n1,0,0,0,1e400,0\n", "line 2: vx is NaN or infinite"},
       {"id,t,x,y\n1,0,2e150,0\n", "line 2: report has a position or velocity beyond 1e150"},
+      {"id,t,x,y\n1,1e200,0,0\n", "line 2: report has a time beyond 1e150"},
       {"id,t,x,y\n1,0,1e150,0\n1,1e-300,-1e150,0\n", "line 2: the velocity derived"},
       {"id,t,x,y\n1,0,\"0,0\n", "line 2: a quoted field is not closed"},
       {"id,t,x,y\n1,0,\"0\"x,0\n", "line 2: text after a quoted field"},

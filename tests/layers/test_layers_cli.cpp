@@ -480,6 +480,13 @@ TEST_F(LayersCli, ClipCutsToTheWindow) {
     EXPECT_GT(area, 0);
     EXPECT_NEAR(OGR_G_Area(OGRGeometry::ToHandle(t.geoms[i].get())), area, 1e-9 * (1 + area));
   }
+  // Clipping that CSV again: its WKT column is its geometry, not a field to copy beside it.
+  const std::string again = path("again.csv");
+  const CliRun c2 = run_loci("clip " + csv + " --bbox 30,30,50,50 -q -o " + again);
+  ASSERT_EQ(c2.status, 0) << c2.err;
+  const std::string header = read_text(again).substr(0, read_text(again).find('\n'));
+  EXPECT_EQ(header.find("WKT"), header.rfind("WKT")) << header;
+  fs::remove(again);
   fs::remove(csv);
   for (const char* ext : {".shp", ".shx", ".dbf"})
     fs::remove(path(std::string("clipped") + ext));

@@ -115,13 +115,26 @@ TEST(Conflicts, PositionsBeyondTheRangeAreRefused) {
   monitor.refresh(0);
   ASSERT_EQ(monitor.conflicts().size(), 1u);
   // A new report that leaves the range within the span searched (incremental), then a time
-  // whose span leaves it (full): refused, the answer of time 0 kept.
+  // whose span leaves it (full): refused, naming the object, the answer of time 0 kept.
   monitor.report(3, Motion2{0, {5, 0}, {2e141, 0}});
-  EXPECT_THROW(monitor.refresh(1), InvalidArgument);
+  try {
+    monitor.refresh(1);
+    ADD_FAILURE() << "refresh took a report beyond 1e150";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("id 3 "), std::string::npos) << e.what();
+  }
   monitor.remove(3);
   EXPECT_THROW(monitor.refresh(1e11), InvalidArgument);
   EXPECT_EQ(monitor.conflicts().size(), 1u);
   monitor.refresh(1);
+  EXPECT_EQ(monitor.conflicts().size(), 1u);
+  // A known object's bad report: its pairs wait with the report; a good report of it brings
+  // its pair back.
+  monitor.report(2, Motion2{1, {2, 0}, {2e141, 0}});
+  EXPECT_THROW(monitor.refresh(2), InvalidArgument);
+  EXPECT_TRUE(monitor.conflicts().empty());
+  monitor.report(2, fleet[1]);
+  monitor.refresh(2);
   EXPECT_EQ(monitor.conflicts().size(), 1u);
 }
 

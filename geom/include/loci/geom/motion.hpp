@@ -64,10 +64,12 @@ constexpr Point<D> position(const Motion<D>& m, double s) {
 }
 
 // Throws InvalidGeometry naming `what` for a NaN or infinite time, position or velocity, or
-// values beyond kMaxCoordinate.
+// values beyond kMaxCoordinate (times too: differences of times then never overflow).
 template <int D>
 void check_motion(const Motion<D>& m, const char* what = "report") {
   if (!std::isfinite(m.t)) throw InvalidGeometry(std::string(what) + " has a NaN or infinite time");
+  if (!(std::abs(m.t) <= kMaxCoordinate))
+    throw InvalidGeometry(std::string(what) + " has a time beyond 1e150");
   check_point(m.p, what);
   check_point(m.v, what);
   if (!within_coordinate_range(m.p) || !within_coordinate_range(m.v))

@@ -72,7 +72,8 @@ class AtomicDataset {
 
 // Throws loci::Error when writing `out` would overwrite the layer `input` or one of its
 // companion files (a shapefile's .shp, .shx, .dbf, ...): the same file, or the same stem in
-// the same directory for a shapefile.
-void refuse_overwriting(const std::string& out, const std::string& input);
+// the same directory for a shapefile. The message calls `input` `what`.
+void refuse_overwriting(const std::string& out, const std::string& input,
+                        const char* what = "input layer");
 
 }  // namespace loci::io

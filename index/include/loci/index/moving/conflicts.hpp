@@ -132,9 +132,11 @@ namespace detail {
 // within +-kMaxCoordinate over [t0, t1] (it moves linearly: checked at both ends), or the
 // arithmetic could overflow and lose pairs. Throws InvalidArgument.
 template <int D>
-void check_conflict_span(const Motion<D>& m, double t0, double t1) {
-  if (!within_coordinate_range(position(m, t0)) || !within_coordinate_range(position(m, t1)))
-    throw InvalidArgument("conflicts: an object moves beyond 1e150 in the time searched");
+bool stays_in_range(const Motion<D>& m, double t0, double t1) {
+  return within_coordinate_range(position(m, t0)) && within_coordinate_range(position(m, t1));
+}
+[[noreturn]] inline void out_of_range(const std::string& who) {
+  throw InvalidArgument("conflicts: " + who + " moves beyond 1e150 in the time searched");
 }
 }  // namespace detail
 
@@ -217,8 +219,9 @@ class ConflictFinder {
   // the broad phase reports (neighbours in space) read neighbouring memory.
   void prepare(std::span<const Motion<D>> objects, double now, double horizon) {
     const std::size_t n = objects.size();
-    for (const Motion<D>& m : objects)
-      detail::check_conflict_span(m, now, now + horizon);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!detail::stays_in_range(objects[i], now, now + horizon))
+        detail::out_of_range("object " + std::to_string(i) + " of the input");
     at_now_.resize(n);
     motion_.resize(n);
     Box<D> extent = Box<D>::empty();
@@ -297,6 +300,11 @@ std::vector<Conflict> find_conflicts(std::span<const Id> ids, std::span<const Mo
 // closest_approach at now, as find_conflicts decides it; so the pairs are exactly those of a
 // computation from scratch, and the times and distances agree with it to rounding.
 //
+// A report that would carry its object beyond +-1e150 during the span searched makes refresh
+// throw InvalidArgument naming the id, before anything changes: the reports stay pending (as
+// between any report and the next refresh, conflicts() leaves out the pairs of objects with a
+// pending report) until the object reports again or is removed.
+//
 // Cost: a full computation as find_conflicts over the longer span; an incremental refresh
 // O(reported x (log n + candidates)); conflicts() O(kept pairs), reading them in order. A
 // pair of an object that reported is forgotten by a version check, not found and erased;
@@ -360,7 +368,8 @@ class ConflictMonitor {
     const double t1 = base_ + horizon_ + slack_;
     // Every new report is checked before anything changes.
     for (std::uint32_t s : dirty_list_)
-      if (alive_[s]) detail::check_conflict_span(motion_[s], base_, t1);
+      if (alive_[s] && !detail::stays_in_range(motion_[s], base_, t1))
+        detail::out_of_range("id " + std::to_string(ids_[s]));
     now_ = now;
     ++incremental_;
     QueryStats st;
@@ -506,7 +515,8 @@ class ConflictMonitor {
     const double span = horizon_ + slack_;
     // Every report is checked before anything changes.
     for (std::uint32_t s = 0; s < ids_.size(); ++s)
-      if (alive_[s]) detail::check_conflict_span(motion_[s], now, now + span);
+      if (alive_[s] && !detail::stays_in_range(motion_[s], now, now + span))
+        detail::out_of_range("id " + std::to_string(ids_[s]));
     now_ = now;
     ++full_;
     computed_ = true;

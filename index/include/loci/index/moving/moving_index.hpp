@@ -65,7 +65,8 @@ struct MotionNearestProbe {
 }  // namespace detail
 
 namespace detail {
-// Nearest-n at time s: s must lie within +-kMaxCoordinate (so that s - t never overflows),
+// Nearest-n at time s: s must lie within +-kMaxCoordinate, as report times do (so that s - t
+// never overflows),
 // and a distance that overflows a double is refused rather than reported. Positions at s may
 // lie beyond kMaxCoordinate; while the distances ranked stay finite the order is exact (an
 // object whose squared distance overflows is farther than every one that does not), so only
