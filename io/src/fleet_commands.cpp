@@ -152,20 +152,48 @@ struct Hit {
 };
 
 std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
-  std::optional<FlatGeometry> poly;
+  // AIS windows are lon/lat boxes; objects move in the local frame. A position is in the
+  // window when its lon/lat is. Over an interval the window is the polygon of its edges in the
+  // frame; a window holding the antipode of the frame's centre holds the frame's edge, where
+  // the azimuthal projection is singular: there the polygon's edges bound what lies outside
+  // the window (`inverted`), and every object is a candidate.
+  std::optional<FlatGeometry> poly, ring;
+  bool inverted = false;
   Box2 box = o.box;
   if (l.ais()) {
     if (!l.data.frame) return {};
-    poly = lonlat_window(*l.data.frame, o.box);
+    const LocalFrame& frame = *l.data.frame;
+    poly = lonlat_window(frame, o.box);
+    const Point2 antipode{frame.lon0() > 0 ? frame.lon0() - 180 : frame.lon0() + 180,
+                          -frame.lat0()};
+    inverted = intersects(o.box, Box2::of_point(antipode));
     box = poly->envelope();
+    // The edges are chords of the window's curved edges, which bulge out of them by far less
+    // than this margin: the candidates hold every position the lon/lat test may take.
+    const double pad = 1000 + 1e-3 * std::max(box.extent(0), box.extent(1));
+    box = {{box.min[0] - pad, box.min[1] - pad}, {box.max[0] + pad, box.max[1] + pad}};
+    if (inverted) box = {{-kMaxCoordinate, -kMaxCoordinate}, {kMaxCoordinate, kMaxCoordinate}};
+    if (inverted) {
+      ring = poly;
+      ring->parts[0].kind = PartKind::line;
+      ring->polygons = 0;
+    }
   }
+  auto in_window = [&](const Point2& p) {
+    if (!poly) return true;  // planar: the index query was exact
+    try {
+      return intersects(o.box, Box2::of_point(l.data.frame->to_lonlat(p)));
+    } catch (const Error&) {
+      return false;  // beyond the frame's edge: no lon/lat
+    }
+  };
   std::vector<Hit> hits;
   if (!o.during) {
     const auto now = in_force(l.data.reports, l.now);
     const FleetIndex ix = index_of(now);
     ix.query(MovingWindow<2>::at(box, l.now), [&](Id id, const Motion2& m) {
       const Point2 p = position(m, l.now);
-      if (!poly || meets(*poly, Box2::of_point(p))) hits.push_back({id, l.now, p});
+      if (in_window(p)) hits.push_back({id, l.now, p});
       return true;
     });
   } else {
@@ -179,10 +207,20 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
       const LinearSpan s = meets(m, MovingWindow<2>::during(box, pc.lo, pc.hi));
       if (s.empty()) return true;
       double t = s.lo;
-      if (poly) {
+      if (poly && !inverted) {
         const Segment2 path{position(m, pc.lo), position(m, pc.hi)};
         if (!meets(*poly, path)) return true;
         t = first_time_in(*poly, m, pc.lo, pc.hi);
+      } else if (poly) {
+        // In the window unless strictly inside the polygon of what lies outside it.
+        const Segment2 path{position(m, pc.lo), position(m, pc.hi)};
+        if (in_window(path.a)) {
+          t = pc.lo;
+        } else if (const auto at = first_meet(*ring, path)) {
+          t = pc.lo + (pc.hi - pc.lo) * *at;
+        } else {
+          return true;
+        }
       }
       hits.push_back({pc.id, t, position(m, t)});
       return true;

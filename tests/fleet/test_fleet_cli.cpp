@@ -323,8 +323,11 @@ TEST_F(FleetCli, AisConflictsAndLonLatWindowsMatchBruteForce) {
   // Lon/lat windows at now and ten minutes before.
   for (const double t : {now, now - 600}) {
     const auto at_t = io::in_force(d.reports, t);
+    // The last three hold the antipode of the fleet's frame (the whole world and most of it),
+    // or miss the fleet while holding it.
     for (const Box2& box : {Box2{{10, 55}, {11.5, 56.5}}, Box2{{8, 54.5}, {13, 58}},
-                            Box2{{12, 55.5}, {12.8, 56.2}}}) {
+                            Box2{{12, 55.5}, {12.8, 56.2}}, Box2{{-180, -90}, {180, 90}},
+                            Box2{{-179, -89}, {179, 89}}, Box2{{-179, -89}, {179, 50}}}) {
       const CliRun q = run_loci("fleet query " + shell_quote(f) + " -q --at " + num(t) +
                                 " --bbox " + num(box.min[0]) + "," + num(box.min[1]) + "," +
                                 num(box.max[0]) + "," + num(box.max[1]));
@@ -377,6 +380,29 @@ TEST_F(FleetCli, AisWindowOverAnIntervalHoldsEveryTimeSampledAndNothingOutside) 
     for (const io::FleetReport& rep : io::in_force(d.reports, t))
       if (intersects(box, Box2::of_point(d.frame->to_lonlat(position(rep.m, t)))))
         EXPECT_TRUE(got.count(rep.id)) << rep.id << " at " << t;
+  // A window holding the antipode of the fleet's frame: the whole world holds every vessel
+  // in force during the interval, at its first time in it; one ending south of the fleet
+  // (its edge at 50N) none.
+  const std::string during = " --during 2022-12-31T23:50:00," + num(t2);
+  const CliRun world =
+      run_loci("fleet query " + shell_quote(f) + " -q -f csv --bbox -179,-89,179,89" + during);
+  ASSERT_EQ(world.status, 0) << world.err;
+  std::set<Id> all;
+  for (const io::FleetReport& rep : d.reports)
+    if (rep.m.t <= t2) all.insert(rep.id);
+  const auto world_rows = csv_rows(world.out);
+  ASSERT_EQ(world_rows.size(), all.size() + 1);
+  for (std::size_t i = 1; i < world_rows.size(); ++i)
+    EXPECT_EQ(std::stod(world_rows[i][1]), std::max(t1, [&] {
+                double first = t2;
+                for (const io::FleetReport& rep : d.reports)
+                  if (rep.id == std::stoull(world_rows[i][0])) first = std::min(first, rep.m.t);
+                return first;
+              }()));
+  const CliRun south =
+      run_loci("fleet query " + shell_quote(f) + " -q --bbox -179,-89,179,50" + during);
+  ASSERT_EQ(south.status, 0) << south.err;
+  EXPECT_EQ(south.out, "");
 }
 
 TEST_F(FleetCli, QueryAsGeoJsonAndAHeaderOnlyFleet) {
