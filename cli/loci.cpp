@@ -657,7 +657,7 @@ const std::vector<Command>& commands() {
         {"--speed", nullptr, "MIN,MAX", "speed range (default 1,10 per time unit; AIS 5,20 knots)"},
         {"--time", nullptr, "T0", "time of the last reports (default 0; AIS 2023-01-01T00:00:00)"},
         {"--reports", nullptr, "R", "reports per object (default 3)"},
-        {"--interval", nullptr, "S", "time between an object's reports (default 60)"},
+        {"--interval", nullptr, "S", "time between an object's reports (default 60; AIS: >= 1)"},
         {"--output", "-o", "OUT", "the fleet file"},
         kQuiet},
        "  loci fleet generate --count 1000 -o fleet.csv\n"

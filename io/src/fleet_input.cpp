@@ -558,8 +558,10 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
       if (!std::isfinite(*d) && !skip) skip = SkipReason::not_a_number;
       return *d;
     };
-    const double lat = num(clat, "LAT"), lon = num(clon, "LON"), sog = num(csog, "SOG"),
-                 cog = num(ccog, "COG");
+    const double lat = num(clat, "LAT"), lon = num(clon, "LON"), sog = num(csog, "SOG");
+    double cog = num(ccog, "COG");
+    // A vessel at rest (SOG 0, often moored) has no course to give: its velocity is known.
+    if (sog == 0 && cog == 360) cog = 0;
     const auto t = parse_utc(f[cd]);
     if (!skip) {
       if (lat == 91)

@@ -173,6 +173,20 @@ TEST(FleetAis, EverySentinelBadDateNanAndDuplicateIsSkippedAndCounted) {
   EXPECT_NEAR(south.m.v[1], -5 * 1852.0 / 3600, 1e-3);
 }
 
+// A vessel at rest reports SOG 0 and often COG 360 ("not available"): kept, standing still;
+// COG 360 with a speed is skipped.
+TEST(FleetAis, AVesselAtRestWithoutCourseStandsStill) {
+  const std::string h = "MMSI,BaseDateTime,LAT,LON,SOG,COG\n";
+  const FleetData d = read_fleet(
+      h + "1,2023-01-01T00:00:00,55,10,0,360\n" + "2,2023-01-01T00:00:00,55.01,10,3,360\n",
+      "moored");
+  ASSERT_EQ(d.reports.size(), 1u);
+  EXPECT_EQ(d.reports[0].id, 1u);
+  EXPECT_EQ(d.reports[0].m.v[0], 0.0);
+  EXPECT_EQ(d.reports[0].m.v[1], 0.0);
+  EXPECT_EQ(d.skipped.total(), 1u);
+}
+
 TEST(FleetAis, MalformedRowsAreErrorsNamingTheLine) {
   const std::string h = "MMSI,BaseDateTime,LAT,LON,SOG,COG\n";
   EXPECT_NE(error_of(h + "1,2023-01-01T00:00:00,55,10,x,1\n").find("line 2: SOG 'x' is not a"),

@@ -21,12 +21,12 @@
 // seconds. Real AIS feeds carry sentinels and junk; such a row is skipped and counted by
 // reason (SkipCounts), never used: LAT 91, LON 181, SOG 102.3 and COG 360 ("not available"),
 // latitudes, longitudes, speeds or courses out of range, an unreadable date, NaN, an empty
-// value. A field that is not a number at all, a missing required column or a wrong field count
-// are errors naming the line, as for the planar format. Positions are projected to a local
-// metric frame (LocalFrame: azimuthal equidistant on WGS 84 centred on the mean position of
-// the rows kept, in metres); SOG (knots) and COG (degrees from true north) become a velocity
-// in metres per second in that frame, turned by the frame's local direction of true north so
-// that the course stays true away from the centre.
+// value (a vessel at rest, SOG 0, needs no course: with COG 360 it is kept). A field that is not a
+// number at all, a missing required column or a wrong field count are errors naming the line, as
+// for the planar format. Positions are projected to a local metric frame (LocalFrame: azimuthal
+// equidistant on WGS 84 centred on the mean position of the rows kept, in metres); SOG (knots) and
+// COG (degrees from true north) become a velocity in metres per second in that frame, turned by the
+// frame's local direction of true north so that the course stays true away from the centre.
 //
 // Both formats: two reports of one id at the same time are one too many; the first in the
 // file is kept and the others are skipped and counted as duplicates. Reports may come in any
