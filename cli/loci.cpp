@@ -380,9 +380,7 @@ int run_fleet_conflicts(const Args& a) {
   o.at = at_flag(a);
   const std::string format = a.get("--format", "csv");
   if (format != "csv" && format != "geojson")
-    throw UsageError("--format: unknown format '" + format +
-                     "' for conflicts (choose csv or "
-                     "geojson)");
+    throw UsageError("--format: '" + format + "' for conflicts (choose csv or geojson)");
   o.format = parse_format(format);
   o.out_path = a.get("--output");
   const FleetRun r = fleet_conflicts(o, stdout);

@@ -167,16 +167,17 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
     const Point2 antipode{frame.lon0() > 0 ? frame.lon0() - 180 : frame.lon0() + 180,
                           -frame.lat0()};
     inverted = intersects(o.box, Box2::of_point(antipode));
-    box = poly->envelope();
-    // The edges are chords of the window's curved edges, which bulge out of them by far less
-    // than this margin: the candidates hold every position the lon/lat test may take.
-    const double pad = 1000 + 1e-3 * std::max(box.extent(0), box.extent(1));
-    box = {{box.min[0] - pad, box.min[1] - pad}, {box.max[0] + pad, box.max[1] + pad}};
-    if (inverted) box = {{-kMaxCoordinate, -kMaxCoordinate}, {kMaxCoordinate, kMaxCoordinate}};
     if (inverted) {
+      box = {{-kMaxCoordinate, -kMaxCoordinate}, {kMaxCoordinate, kMaxCoordinate}};
       ring = poly;
       ring->parts[0].kind = PartKind::line;
       ring->polygons = 0;
+    } else {
+      // The edges are chords of the window's curved edges, which bulge out of them by far less
+      // than this margin: the candidates hold every position the lon/lat test may take.
+      box = poly->envelope();
+      const double pad = 1000 + 1e-3 * std::max(box.extent(0), box.extent(1));
+      box = {{box.min[0] - pad, box.min[1] - pad}, {box.max[0] + pad, box.max[1] + pad}};
     }
   }
   auto in_window = [&](const Point2& p) {
@@ -579,8 +580,7 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
                                 : "--time and --interval give report times beyond 1e150");
     if (!(t - o.interval < t))
       throw InvalidArgument(
-          "--interval is too small for --time: reports of an object would "
-          "share a time");
+          "--interval is too small for --time: an object's reports would share a time");
     if (!within_coordinate_range(p) || !within_coordinate_range(v))
       throw InvalidArgument(
           "reports would lie beyond 1e150: lower --speed, --interval or --reports");
@@ -657,17 +657,15 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
     motions.push_back(r.m);
     if (!o.from_scratch) monitor.report(r.id, r.m);
   }
-  // The simulated reports turn but keep their speed: every object stays within +-1e150 until
-  // the last tick's horizon when it would going straight in any direction.
+  // The simulated reports turn but keep their speed: every object must stay within +-1e150
+  // until the last tick's horizon whichever way it turns.
   const double span = o.tick * double(o.ticks) + o.horizon;
   for (const Motion2& m : motions) {
     const Point2 p = position(m, l.now);
     const double reach = std::hypot(m.v[0], m.v[1]) * span;
     if (!(std::abs(l.now + span) <= kMaxCoordinate) ||
         !(std::max(std::abs(p[0]), std::abs(p[1])) + reach <= kMaxCoordinate))
-      throw InvalidArgument(
-          "--tick and --ticks carry the simulation beyond 1e150 (in time or "
-          "position)");
+      throw InvalidArgument("--tick and --ticks carry the simulation beyond 1e150");
   }
   FleetIndex ix = index_of(start);
   FleetSimulateReport rep;

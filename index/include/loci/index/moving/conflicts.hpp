@@ -130,7 +130,7 @@ inline void check_conflict_query(double within, double now, double horizon) {
 namespace detail {
 // Closest approaches square differences of positions and velocities: every object must stay
 // within +-kMaxCoordinate over [t0, t1] (it moves linearly: checked at both ends), or the
-// arithmetic could overflow and lose pairs. Throws InvalidArgument.
+// arithmetic could overflow and lose pairs; out_of_range throws the error naming `who`.
 template <int D>
 bool stays_in_range(const Motion<D>& m, double t0, double t1) {
   return within_coordinate_range(position(m, t0)) && within_coordinate_range(position(m, t1));

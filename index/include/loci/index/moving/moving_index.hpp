@@ -66,11 +66,10 @@ struct MotionNearestProbe {
 
 namespace detail {
 // Nearest-n at time s: s must lie within +-kMaxCoordinate, as report times do (so that s - t
-// never overflows),
-// and a distance that overflows a double is refused rather than reported. Positions at s may
-// lie beyond kMaxCoordinate; while the distances ranked stay finite the order is exact (an
-// object whose squared distance overflows is farther than every one that does not), so only
-// an answer that would report an overflowed distance throws.
+// never overflows), and a distance that overflows a double is refused rather than reported.
+// Positions at s may lie beyond kMaxCoordinate; while the distances ranked stay finite the order is
+// exact (an object whose squared distance overflows is farther than every one that does not), so
+// only an answer that would report an overflowed distance throws.
 inline void check_nearest_time(double s) {
   check_coordinate(s, "nearest time");
   if (!(std::abs(s) <= kMaxCoordinate)) throw InvalidArgument("nearest time is beyond 1e150");
