@@ -306,7 +306,11 @@ const LayerIndex::Features& LayerIndex::features() const {
   std::call_once(features_->once, [&] {
     Features& f = features_->value;
     const auto records = f.records = this->records();
-    f.of_item.resize(records.size());
+    const PackedRTree2* t = packed();
+    // Only a packed tree per segment is walked through hierarchies; the other walks look the
+    // feature of each item up in of_item.
+    const bool hierarchies = f.hierarchical = t && t->size() > 0 && per_ == Per::segment;
+    if (!hierarchies) f.of_item.resize(records.size());
     auto& number = f.number;
     std::int64_t last_fid = 0;
     std::uint32_t last = Features::none;
@@ -318,54 +322,61 @@ const LayerIndex::Features& LayerIndex::features() const {
         last = it->second;
         last_fid = fid;
       }
-      f.of_item[id] = last;
+      if (!hierarchies) f.of_item[id] = last;
     }
-    const PackedRTree2* t = packed();
-    if (!t || t->size() == 0 || per_ != Per::segment) return;  // only per segment walks them
+    if (!hierarchies) return;
+    const std::size_t n = t->size(), features = f.fid.size();
+    const std::span<const std::uint32_t> items = f.items = t->item_indices().first(n);
+    // The feature of the item at packed position pos (none for an item of no record, in a
+    // corrupt index), the map asked once per run of one FID.
+    last = Features::none;
+    auto feature_at = [&](std::size_t pos) {
+      const std::uint32_t id = items[pos];
+      if (id >= records.size()) return Features::none;
+      if (last == Features::none || records[id].fid != last_fid) {
+        last_fid = records[id].fid;
+        last = number.find(last_fid)->second;
+      }
+      return last;
+    };
     // Level 0: per leaf of the tree, one node per feature it holds, grouped by feature (a
     // counting sort that keeps packed order, so that a feature's neighbouring leaves stay
-    // together).
-    const std::size_t n = t->size(), features = f.fid.size();
-    f.at.resize(n);
-    const std::span<const std::uint32_t> items = t->item_indices().first(n);
-    for (std::size_t pos = 0; pos < n; ++pos)
-      f.at[pos] = items[pos] < f.of_item.size() ? f.of_item[items[pos]] : Features::none;
+    // together). The features of each leaf are listed first, compactly.
     constexpr std::uint32_t kFanout = 16;
     static_assert(kFanout == PackedRTree2::node_size);
-    loci::detail::LargeVector<Features::Node> leaves;
+    struct Part {
+      std::uint32_t feature, leaf;
+    };
+    loci::detail::LargeVector<Part> parts;
+    parts.reserve(n / kFanout + n / kFanout / 8 + 1);
+    std::vector<std::uint32_t> start(features + 1, 0);
     for (std::size_t b = 0, first = 0; first < n; ++b, first += kFanout) {
-      const std::size_t last = std::min<std::size_t>(first + kFanout, n);
+      const std::size_t last_pos = std::min<std::size_t>(first + kFanout, n);
       std::uint32_t seen[kFanout];
       int distinct = 0;
-      bool lost = false;  // an item of no feature (a corrupt record)
-      for (std::size_t pos = first; pos < last; ++pos) {
-        const std::uint32_t g = f.at[pos];
-        lost |= g == Features::none;
+      for (std::size_t pos = first; pos < last_pos; ++pos) {
+        const std::uint32_t g = feature_at(pos);
         if (g != Features::none && std::find(seen, seen + distinct, g) == seen + distinct)
           seen[distinct++] = g;
       }
-      // The box the tree stores for the leaf bounds each of its features' parts: looser for a
-      // leaf shared by several features, but no leaf is read until a query reaches it.
-      Box2 box = Box2::empty();
-      if (t->levels() > 1) {
-        box = t->entry_box(1, b);
-      } else {
-        for (std::size_t pos = first; pos < last; ++pos)
-          box.expand(t->box_at(pos));
+      for (int i = 0; i < distinct; ++i) {
+        parts.push_back({seen[i], std::uint32_t(b)});
+        ++start[seen[i] + 1];
       }
-      for (int i = 0; i < distinct; ++i)
-        leaves.push_back(
-            {box, seen[i], std::uint32_t(b), std::uint32_t(b), distinct == 1 && !lost});
     }
-    std::vector<std::uint32_t> start(features + 1, 0);
-    for (const Features::Node& node : leaves)
-      ++start[node.feature + 1];
     for (std::size_t i = 0; i < features; ++i)
       start[i + 1] += start[i];
-    loci::detail::LargeVector<Features::Node> level(leaves.size());
-    for (const Features::Node& node : leaves)
-      level[start[node.feature]++] = node;
-    leaves = {};
+    // The box the tree stores for the leaf bounds each of its features' parts: looser for a
+    // leaf shared by several features, but no leaf is read until a query reaches it.
+    Box2 only_leaf = Box2::empty();
+    if (t->levels() == 1)
+      for (std::size_t pos = 0; pos < n; ++pos)
+        only_leaf.expand(t->box_at(pos));
+    loci::detail::LargeVector<Features::Node> level(parts.size());
+    for (const Part& part : parts)
+      level[start[part.feature]++] = {t->levels() > 1 ? t->entry_box(1, part.leaf) : only_leaf,
+                                      part.feature, part.leaf, part.leaf};
+    parts = {};
     // Then up to 16 nodes of one feature per node, until each feature has one node, its root.
     while (!level.empty()) {
       loci::detail::LargeVector<Features::Node> up;
@@ -378,11 +389,9 @@ const LayerIndex::Features& LayerIndex::features() const {
           f.roots.emplace_back(l, i);
         } else {
           for (std::uint32_t c = i; c < j; c += kFanout) {
-            Features::Node node{Box2::empty(), level[i].feature, c, std::min(c + kFanout, j), true};
-            for (std::uint32_t k = node.first; k < node.last; ++k) {
+            Features::Node node{Box2::empty(), level[i].feature, c, std::min(c + kFanout, j)};
+            for (std::uint32_t k = node.first; k < node.last; ++k)
               node.box.expand(level[k].box);
-              node.tight = node.tight && level[k].tight;
-            }
             up.push_back(node);
           }
         }
@@ -391,6 +400,11 @@ const LayerIndex::Features& LayerIndex::features() const {
       f.levels.push_back(std::move(level));
       level = std::move(up);
     }
+    std::vector<Box2> boxes;
+    boxes.reserve(f.roots.size());
+    for (const auto& [l, i] : f.roots)
+      boxes.push_back(f.levels[l][i].box);
+    f.root_tree = PackedRTree2::build(boxes);
   });
   return features_->value;
 }
@@ -424,10 +438,10 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
   // direction that leaves its box soonest, through its own hierarchy: no other feature's
   // segments are read. Each direction is a map that turns it into +x (reflections and swaps of
   // coordinates are exact), and ray_crosses decides on the mapped points as it does for +x.
-  for (const auto& root : features.roots) {
+  features.root_tree.query(Box2::of_point(p), [&](Id r, const Box2&) {
+    const auto root = features.roots[r];
     const LayerIndex::Features::Node& top = features.levels[root.first][root.second];
     const Box2& reach = top.box;
-    if (!intersects(reach, p)) continue;
     const double length[4] = {reach.max[0] - p[0], p[0] - reach.min[0], reach.max[1] - p[1],
                               p[1] - reach.min[1]};
     const int dir = int(std::min_element(length, length + 4) - length);
@@ -448,6 +462,7 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
                      : dir == 2 ? Box2{p, {p[0], reach.max[1]}}
                                 : Box2{{p[0], reach.min[1]}, p};
     const Point2 mp = map(p);
+    const std::int64_t fid = features.fid[top.feature];
     bool odd = false;
     stack.assign(1, root);
     while (!stack.empty()) {
@@ -462,19 +477,80 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
       const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
       const std::size_t last = std::min(first + PackedRTree2::node_size, tree->size());
       for (std::size_t pos = first; pos < last; ++pos) {
-        if (features.at[pos] != top.feature) continue;
         const Box2 b = tree->box_at(pos);
         if (!intersects(b, ray)) continue;
-        const Id id = tree->item_at(pos);
-        if (id >= records.size() || !(records[id].flags & item_ring)) continue;
+        const Id id = features.items[pos];
+        if (id >= records.size() || records[id].fid != fid || !(records[id].flags & item_ring))
+          continue;
         const Segment2 s = segment_of(b, records[id].flags);
         odd ^= ray_crosses(map(s.a), map(s.b), mp);
       }
     }
-    if (odd) out.push_back(features.fid[top.feature]);
-  }
+    if (odd) out.push_back(fid);
+    return true;
+  });
   return out;
 }
+
+namespace {
+
+// The squared distance from p to the segments (or, for candidates, the boxes) of the feature
+// of node (level, i) below that node, taken into `best` when nearer: children nearest first,
+// each dropped unread once it is no nearer than best.
+struct FeatureDescent {
+  const LayerIndex::Features& features;
+  const PackedRTree2& tree;
+  Point2 p;
+  bool boxes_only;
+
+  void operator()(std::uint32_t level, std::uint32_t i, double& best) const {
+    const LayerIndex::Features::Node& node = features.levels[level][i];
+    if (level == 0) {
+      const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
+      const int used = int(std::min<std::size_t>(PackedRTree2::node_size, tree.size() - first));
+      const PackedRTree2::Block& leaf = tree.leaf(node.first);
+      double box2[PackedRTree2::node_size];
+      leaf.squared_distances(p, box2);
+      const std::int64_t fid = features.fid[node.feature];
+      for (int e = 0; e < used; ++e) {
+        if (!(box2[e] < best)) continue;
+        const std::uint32_t id = features.items[first + e];
+        if (id >= features.records.size() || features.records[id].fid != fid) continue;
+        if (boxes_only) {
+          best = box2[e];
+          continue;
+        }
+        // A segment is no nearer than its box, so only those whose box is nearer are measured.
+        const Segment2 s = segment_of(leaf.box(e), features.records[id].flags);
+        best = std::min(best, squared_distance(p, s));
+      }
+      return;
+    }
+    const auto& below = features.levels[level - 1];
+    struct Child {
+      double d2;
+      std::uint32_t node;
+    };
+    Child order[PackedRTree2::node_size];
+    int n = 0;
+    for (std::uint32_t c = node.first; c < node.last; ++c) {
+      const double c2 = squared_distance(p, below[c].box);
+      if (!(c2 < best)) continue;
+      if (level == 1) {  // the leaf will likely be read: its loads overlap the work before it
+        tree.leaf(below[c].first).prefetch();
+        __builtin_prefetch(&features.items[std::size_t(below[c].first) * PackedRTree2::node_size]);
+      }
+      int j = n++;
+      for (; j > 0 && order[j - 1].d2 > c2; --j)
+        order[j] = order[j - 1];
+      order[j] = {c2, c};
+    }
+    for (int j = 0; j < n && order[j].d2 < best; ++j)
+      (*this)(level - 1, order[j].node, best);
+  }
+};
+
+}  // namespace
 
 void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
                      std::vector<Answer>& out) {
@@ -484,6 +560,44 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
   if (q.kind == Query::Kind::nearest) {
     const Point2 p = q.point;
     const LayerIndex::Features& features = index_.features();
+    if (features.hierarchical) {
+      // The k best (squared distance, feature) as a max-heap: its top is the k-th distance.
+      auto& top = top_;
+      top.clear();
+      auto kth = [&] {
+        return top.size() < q.k ? std::numeric_limits<double>::infinity() : top.front().first;
+      };
+      auto keep = [&](double d2, std::uint32_t f) {
+        if (top.size() == q.k) {
+          std::pop_heap(top.begin(), top.end());
+          top.pop_back();
+        }
+        top.emplace_back(d2, f);
+        std::push_heap(top.begin(), top.end());
+      };
+      std::vector<std::uint32_t> inside;
+      if (!candidates_only)
+        for (const auto fid : containing_polygons(index_, p, features)) {
+          const std::uint32_t f = features.number.at(fid);
+          inside.push_back(f);
+          if (top.size() < q.k) keep(0.0, f);
+        }
+      const FeatureDescent descend{features, *index_.packed(), p, candidates_only};
+      features.root_tree.browse(p, [&](Id r, const Box2& b, double) {
+        double best = kth();
+        if (!(squared_distance(p, b) < best)) return false;  // no feature left can be nearer
+        const auto [level, i] = features.roots[r];
+        const std::uint32_t f = features.levels[level][i].feature;
+        if (std::find(inside.begin(), inside.end(), f) != inside.end()) return true;
+        descend(level, i, best);
+        if (best < kth()) keep(best, f);
+        return true;
+      });
+      std::sort_heap(top.begin(), top.end());
+      for (const auto& [d2, f] : top)
+        out.push_back({number, features.fid[f], std::sqrt(d2)});
+      return;
+    }
     if (state_.size() != features.fid.size()) {
       state_.assign(features.fid.size(), FeatureState{});
       generation_ = 0;
@@ -493,15 +607,12 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       generation_ = 1;
     }
     constexpr double kInf = std::numeric_limits<double>::infinity();
-    // The state of feature f in this query (fresh: not seen, best and bound infinite).
+    // The state of feature f in this query (fresh: not seen, best infinite).
     auto state = [&](std::uint32_t f) -> FeatureState& {
       FeatureState& s = state_[f];
-      if (s.stamp != generation_) s = {generation_, false, kInf, kInf};
+      if (s.stamp != generation_) s = {generation_, false, kInf};
       return s;
     };
-    // A squared upper bound on the distance to a tight node's segments, raised by far more
-    // than the rounding of it and of the lower bounds compared with it.
-    auto upper = [&](const Box2& b) { return squared_minmax_distance(p, b) * (1 + 1e-9); };
     using Pending = std::pair<double, std::uint32_t>;
     std::priority_queue<Pending, std::vector<Pending>, std::greater<>> pending;
     std::size_t found = 0;
@@ -526,8 +637,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     };
     const ItemRecord* records = features.records.data();
     if (per_segment && !candidates_only) {
-      for (const auto fid : features.roots.empty() ? containing_polygons(index_, p)
-                                                   : containing_polygons(index_, p, features))
+      for (const auto fid : containing_polygons(index_, p))
         offer(features.number.at(fid), 0.0);
     }
     auto visit = [&](const ItemRecord& r, const Box2& b, double box_distance) {
@@ -543,63 +653,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
         offer(f, distance(geometries_->get(r.fid), p));
       return true;
     };
-    if (per_segment && !features.roots.empty()) {
-      // Best first over the features' hierarchies (squared distances; level and node packed
-      // in one key), from every feature's root.
-      const PackedRTree2& tree = *index_.packed();
-      const auto all = features.records;
-      auto later = [](const auto& a, const auto& b) { return a.first > b.first; };
-      auto& heap = walk_;
-      heap.clear();
-      for (const auto& [l, i] : features.roots) {
-        const LayerIndex::Features::Node& root = features.levels[l][i];
-        if (root.tight) state(root.feature).bound = upper(root.box);
-        heap.emplace_back(squared_distance(p, root.box), (std::uint64_t(l) << 32) | i);
-      }
-      std::make_heap(heap.begin(), heap.end(), later);
-      while (!heap.empty()) {
-        std::pop_heap(heap.begin(), heap.end(), later);
-        const auto [d2, key] = heap.back();
-        heap.pop_back();
-        const double d = std::sqrt(d2);
-        settle(d);
-        if (found >= q.k) break;
-        const auto level = std::uint32_t(key >> 32);
-        const LayerIndex::Features::Node& node = features.levels[level][key & 0xffffffffu];
-        FeatureState& s = state(node.feature);
-        if (s.done || s.best <= d || d2 > s.bound) continue;  // nothing here can be nearer
-        if (level == 0) {
-          double best = std::numeric_limits<double>::infinity();
-          const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
-          const std::size_t last = std::min(first + PackedRTree2::node_size, tree.size());
-          for (std::size_t pos = first; pos < last; ++pos) {
-            if (features.at[pos] != node.feature) continue;
-            const Id id = tree.item_at(pos);
-            const Box2 b = tree.box_at(pos);
-            best =
-                std::min(best, candidates_only ? squared_distance(p, b)
-                                               : squared_distance(p, segment_of(b, all[id].flags)));
-          }
-          if (best < std::numeric_limits<double>::infinity()) offer(node.feature, std::sqrt(best));
-          continue;
-        }
-        // Children that cannot improve their feature stay out: those farther than the
-        // best distance found, or than a point of the feature the tight ones show.
-        const auto& below = features.levels[level - 1];
-        for (std::uint32_t c = node.first; c < node.last; ++c)
-          if (below[c].tight) s.bound = std::min(s.bound, upper(below[c].box));
-        const double limit = s.best * s.best;
-        for (std::uint32_t c = node.first; c < node.last; ++c) {
-          const double c2 = squared_distance(p, below[c].box);
-          if (c2 < limit && c2 <= s.bound) {
-            heap.emplace_back(c2, (std::uint64_t(level - 1) << 32) | c);
-            std::push_heap(heap.begin(), heap.end(), later);
-          }
-        }
-      }
-    } else {
-      index_.browse(p, visit);
-    }
+    index_.browse(p, visit);
     settle(std::numeric_limits<double>::infinity());
     return;
   }

@@ -266,5 +266,45 @@ TEST(LayerNearest, PolygonsHoldingThePointAreAtDistanceZero) {
   EXPECT_GT(compared, 10000u);
 }
 
+// --candidates: each feature at the distance of its nearest segment box (no exact test, no
+// polygon holding the point), against brute force over the boxes, for every structure.
+TEST(LayerNearest, CandidatesRankFeaturesByTheirBoxes) {
+  const Polygons l = star_polygons(150, 31);
+  for (const Structure s : {Structure::packed_hilbert, Structure::packed_str, Structure::rstar}) {
+    Polygons copy = l;
+    const LayerIndex index = LayerIndex::build(std::move(copy.items), s);
+    LayerQuery query(index, "", "");
+    std::mt19937_64 rng(32);
+    std::uniform_real_distribution<double> any(-20, 120);
+    std::size_t compared = 0;
+    for (int i = 0; i < 400; ++i) {
+      const Point2 p{any(rng), any(rng)};
+      std::map<std::int64_t, double> best;
+      for (const auto& [fid, seg] : l.rings) {
+        const double d = std::sqrt(squared_distance(p, seg.box()));
+        const auto [it, fresh] = best.try_emplace(fid, d);
+        if (!fresh) it->second = std::min(it->second, d);
+      }
+      std::vector<double> distances;
+      for (const auto& [fid, d] : best)
+        distances.push_back(d);
+      std::sort(distances.begin(), distances.end());
+      Query q;
+      q.kind = Query::Kind::nearest;
+      q.point = p;
+      q.k = 1 + i % 12;
+      std::vector<Answer> answers;
+      query.run(q, 1, true, answers);
+      ASSERT_EQ(answers.size(), q.k);
+      for (std::size_t r = 0; r < answers.size(); ++r) {
+        EXPECT_EQ(answers[r].distance, distances[r]) << "point " << p[0] << ',' << p[1];
+        EXPECT_EQ(answers[r].distance, best[answers[r].fid]);
+        ++compared;
+      }
+    }
+    EXPECT_GT(compared, 2000u);
+  }
+}
+
 }  // namespace
 }  // namespace loci::io

@@ -214,6 +214,9 @@ class PackedRTree {
   // The id and the box of the item at packed position pos < size().
   Id item_at(std::size_t pos) const { return Id(item_index(pos)); }
   Box<D> box_at(std::size_t pos) const { return leaf_box(pos); }
+  // The boxes of the items at packed positions [b * NodeSize, (b + 1) * NodeSize), leaf b
+  // (slots past size() hold the empty box), read at once.
+  const Block& leaf(std::size_t b) const { return block(0, b); }
   // The box of entry e < level(l).entries of level l (level 0: box_at(e)).
   Box<D> entry_box(int l, std::size_t e) const {
     return block(l, e / NodeSize).box(int(e % NodeSize));

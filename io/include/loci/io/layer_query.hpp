@@ -22,10 +22,12 @@
 // Nearest-n browses entry boxes by increasing distance (the trees' browse()) and refines with
 // exact distances: a feature is final once its exact distance is no larger than the box
 // distance of the next entry, since every entry not yet seen is at least that far, and the
-// walk stops there. Per segment on a packed tree, the walk goes over one hierarchy of boxes
-// per feature instead (Features): a feature's many segments never come out one by one, a
-// node is dropped unseen when its feature is final or already known at most as far, and the
-// segments of a level-0 node give the feature's exact distance there at once. --candidates
+// walk stops there. Per segment on a packed tree, it goes over one hierarchy of boxes per
+// feature instead (Features): the features come out of a tree of their hierarchies' roots
+// nearest box first, and each one's exact distance is found by a depth-first descent of its
+// own hierarchy, nearest child first, that drops every node no nearer than the k-th distance
+// found so far (or than the feature's own best). A feature's many segments never come out one
+// by one, and the walk stops at the first root no nearer than the k-th distance. --candidates
 // answers from boxes alone. Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry
 // and belongs to one thread.
 #pragma once
@@ -132,31 +134,33 @@ class LayerIndex {
       if (!visit(*h.record, h.box, h.key)) return;
   }
   // The features of the index numbered densely (0, 1, ... in order of first appearance), so
-  // that per-query state is a flat array: the feature of every item (`none` for a corrupt
-  // record) and the FID of every feature. For a packed tree per segment, also one hierarchy
-  // of boxes per feature over its entries: a level-0 node is the part of one leaf of the tree
-  // that belongs to one feature (bounded by the leaf's box), a level-l node groups up to 16
-  // level-(l - 1) nodes of one feature, and `roots` names each feature's top node. Nearest-n
-  // walks these: no node mixes features, so a node of a feature already answered is dropped
-  // in one test. Built on first use, once for all threads.
+  // that per-query state is a flat array: the FID of every feature and, except for a packed
+  // tree per segment, the feature of every item (of_item; `none` for a corrupt record). For a
+  // packed tree per segment, instead one hierarchy of boxes per feature over its entries: a
+  // level-0 node is the part of one leaf of the tree that belongs to one feature (bounded by
+  // the leaf's box; an entry of the leaf is the feature's when its record has the feature's
+  // FID), a level-l node groups up to 16 level-(l - 1) nodes of one feature, and `roots`
+  // names each feature's top node. Nearest-n walks these: no node mixes features, so a feature
+  // is measured without reading any other's segments. Built on first use, once for all
+  // threads.
   struct Features {
     static constexpr std::uint32_t none = 0xffffffffu;
+    bool hierarchical = false;  // a packed tree per segment: levels and roots, no of_item
     struct Node {
       Box2 box;
       std::uint32_t feature;
       std::uint32_t first, last;  // level 0: the leaf; above: its nodes one level down
-      // Every side of the box holds a point of the feature's segments below (the leaves
-      // below hold this feature only), so the farthest point of the nearest side bounds the
-      // feature's distance from above.
-      bool tight;
     };
-    std::span<const ItemRecord> records;  // every record, verified (records() once)
+    std::span<const ItemRecord> records;   // every record, verified (records() once)
+    std::span<const std::uint32_t> items;  // a packed tree's item_indices(), verified
     loci::detail::LargeVector<std::uint32_t> of_item;
     std::vector<std::int64_t> fid;
     std::unordered_map<std::int64_t, std::uint32_t> number;  // fid -> feature
-    loci::detail::LargeVector<std::uint32_t> at;             // per position, as levels
     std::vector<loci::detail::LargeVector<Node>> levels;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> roots;  // (level, node) per feature
+    // A packed tree over the roots' boxes (entry r: roots[r]), so that a query meets only
+    // the features near it, however many the layer has.
+    PackedRTree2 root_tree;
   };
   const Features& features() const;
 
@@ -253,11 +257,10 @@ class LayerQuery {
     std::uint32_t stamp = 0;
     bool done = false;
     double best = 0;
-    double bound = 0;  // squared upper bound on the distance, from tight nodes
   };
   std::vector<FeatureState> state_;
   std::uint32_t generation_ = 0;
-  std::vector<std::pair<double, std::uint64_t>> walk_;  // nearest-n's queue, kept between queries
+  std::vector<std::pair<double, std::uint32_t>> top_;  // nearest-n's k best, kept between queries
 };
 
 }  // namespace loci::io
