@@ -328,14 +328,27 @@ const LayerIndex::Features& LayerIndex::features() const {
     const std::size_t n = t->size(), features = f.fid.size();
     const std::span<const std::uint32_t> items = f.items = t->item_indices().first(n);
     // The feature of the item at packed position pos (none for an item of no record, in a
-    // corrupt index), the map asked once per run of one FID.
+    // corrupt index), asked once per run of one FID: of a table when the FIDs are dense (as
+    // GDAL numbers most formats' features), of the map otherwise.
+    std::int64_t low = 0;
+    std::vector<std::uint32_t> dense;
+    if (features > 0) {
+      const auto [min, max] = std::minmax_element(f.fid.begin(), f.fid.end());
+      low = *min;
+      if (std::uint64_t(*max) - std::uint64_t(low) < 4 * std::uint64_t(features) + 1024) {
+        dense.assign(std::size_t(std::uint64_t(*max) - std::uint64_t(low)) + 1, Features::none);
+        for (std::size_t g = 0; g < features; ++g)
+          dense[std::size_t(std::uint64_t(f.fid[g]) - std::uint64_t(low))] = std::uint32_t(g);
+      }
+    }
     last = Features::none;
     auto feature_at = [&](std::size_t pos) {
       const std::uint32_t id = items[pos];
       if (id >= records.size()) return Features::none;
       if (last == Features::none || records[id].fid != last_fid) {
         last_fid = records[id].fid;
-        last = number.find(last_fid)->second;
+        last = dense.empty() ? number.find(last_fid)->second
+                             : dense[std::size_t(std::uint64_t(last_fid) - std::uint64_t(low))];
       }
       return last;
     };
