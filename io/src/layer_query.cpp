@@ -561,6 +561,24 @@ struct FeatureDescent {
     for (int j = 0; j < n && order[j].d2 < best; ++j)
       (*this)(level - 1, order[j].node, best);
   }
+
+  // An upper bound on the squared distance of the feature of node (level, i): the nearest
+  // child at every level down to one leaf, measured there (infinity when that leaf holds none
+  // of its segments, in a corrupt index).
+  double dive(std::uint32_t level, std::uint32_t i) const {
+    for (; level > 0; --level) {
+      const LayerIndex::Features::Node& node = features.levels[level][i];
+      const auto& below = features.levels[level - 1];
+      double nearest = std::numeric_limits<double>::infinity();
+      for (std::uint32_t c = node.first; c < node.last; ++c) {
+        const double c2 = squared_distance(p, below[c].box);
+        if (c2 < nearest) nearest = c2, i = c;
+      }
+    }
+    double best = std::numeric_limits<double>::infinity();
+    (*this)(0, i, best);
+    return best;
+  }
 };
 
 }  // namespace
@@ -595,17 +613,49 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
           inside.push_back(f);
           if (top.size() < q.k) keep(0.0, f);
         }
+      // First the candidates: the features in increasing distance of their roots' boxes, each
+      // with an upper bound on its distance from one dive down its hierarchy, until a root is
+      // no nearer than the k-th smallest upper bound (no feature from there on can rank).
+      auto& bounds = bounds_;  // the k smallest upper bounds, as a max-heap
+      bounds.assign(top.size(), 0.0);
+      auto bound = [&] {
+        return bounds.size() < q.k ? std::numeric_limits<double>::infinity() : bounds.front();
+      };
       const FeatureDescent descend{features, *index_.packed(), p, candidates_only};
+      auto& candidates = candidates_;
+      candidates.clear();
       features.root_tree.browse(p, [&](Id r, const Box2& b, double) {
-        double best = kth();
-        if (!(squared_distance(p, b) < best)) return false;  // no feature left can be nearer
+        const double lower = squared_distance(p, b);
+        if (!(lower < bound())) return false;
         const auto [level, i] = features.roots[r];
         const std::uint32_t f = features.levels[level][i].feature;
         if (std::find(inside.begin(), inside.end(), f) != inside.end()) return true;
-        descend(level, i, best);
-        if (best < kth()) keep(best, f);
+        const double upper = descend.dive(level, i);
+        candidates.push_back({upper, lower, std::uint32_t(r)});
+        if (bounds.size() == q.k) {
+          if (!(upper < bounds.front())) return true;
+          std::pop_heap(bounds.begin(), bounds.end());
+          bounds.pop_back();
+        }
+        bounds.push_back(upper);
+        std::push_heap(bounds.begin(), bounds.end());
         return true;
       });
+      // Then each candidate measured exactly, nearest upper bound first (so that the k-th
+      // distance is soon the final one), its descent bounded by the nearer of its own upper
+      // bound (a distance it has) and the k-th distance so far; a candidate whose root is no
+      // nearer than the k-th distance is dropped unread.
+      std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+        return a.upper < b.upper || (a.upper == b.upper && a.lower < b.lower);
+      });
+      for (const Candidate& c : candidates) {
+        const double limit = kth();
+        if (!(c.lower < limit)) continue;
+        const auto [level, i] = features.roots[c.root];
+        double best = std::min(c.upper, limit);
+        descend(level, i, best);
+        if (best < limit) keep(best, features.levels[level][i].feature);
+      }
       std::sort_heap(top.begin(), top.end());
       for (const auto& [d2, f] : top)
         out.push_back({number, features.fid[f], std::sqrt(d2)});

@@ -260,7 +260,15 @@ class LayerQuery {
   };
   std::vector<FeatureState> state_;
   std::uint32_t generation_ = 0;
-  std::vector<std::pair<double, std::uint32_t>> top_;  // nearest-n's k best, kept between queries
+  // Nearest-n's arrays, kept between queries: the k best (squared distance, feature), the k
+  // smallest upper bounds, and the candidate features (squared bounds, root).
+  std::vector<std::pair<double, std::uint32_t>> top_;
+  std::vector<double> bounds_;
+  struct Candidate {
+    double upper, lower;
+    std::uint32_t root;
+  };
+  std::vector<Candidate> candidates_;
 };
 
 }  // namespace loci::io
