@@ -564,7 +564,7 @@ struct FeatureDescent {
 
   // An upper bound on the squared distance of the feature of node (level, i): the nearest
   // child at every level down to one leaf, measured there (infinity when that leaf holds none
-  // of its segments, in a corrupt index).
+  // of its segments, in a corrupt index, or when every child's squared distance overflows).
   double dive(std::uint32_t level, std::uint32_t i) const {
     for (; level > 0; --level) {
       const LayerIndex::Features::Node& node = features.levels[level][i];
@@ -574,6 +574,7 @@ struct FeatureDescent {
         const double c2 = squared_distance(p, below[c].box);
         if (c2 < nearest) nearest = c2, i = c;
       }
+      if (!(nearest < std::numeric_limits<double>::infinity())) return nearest;
     }
     double best = std::numeric_limits<double>::infinity();
     (*this)(0, i, best);

@@ -266,6 +266,40 @@ TEST(LayerNearest, PolygonsHoldingThePointAreAtDistanceZero) {
   EXPECT_GT(compared, 10000u);
 }
 
+// A feature whose root box is at a finite squared distance while every box below it
+// overflows (coordinates near 1e154, which the command line refuses but the library takes):
+// it is left out, as the walks over the shared tree leave it, and never given the distance of
+// another feature's leaf.
+TEST(LayerNearest, FeatureBeyondTheSquaredRangeIsLeftOut) {
+  for (const Structure s : {Structure::packed_hilbert, Structure::rstar}) {
+    LayerItems items;
+    items.per = Per::segment;
+    items.layer_name = "far";
+    auto add = [&](std::int64_t fid, const Point2& a, const Point2& b) {
+      items.boxes.push_back(Segment2{a, b}.box());
+      items.records.push_back({fid, 0, segment_flags(a, b, false)});
+    };
+    const double e = 1e154;
+    for (int i = 0; i < 32; ++i)
+      add(0, {double(i), 0}, {double(i + 1), 0});
+    for (int i = 0; i < 16; ++i)
+      add(1, {0.9 * e + i * 1e150, 1.3 * e}, {0.9 * e + (i + 1) * 1e150, 1.3 * e});
+    for (int i = 0; i < 16; ++i)
+      add(1, {1.3 * e, 0.9 * e + i * 1e150}, {1.3 * e, 0.9 * e + (i + 1) * 1e150});
+    const LayerIndex index = LayerIndex::build(std::move(items), s);
+    LayerQuery query(index, "", "");
+    Query q;
+    q.kind = Query::Kind::nearest;
+    q.point = {-5, 0};
+    q.k = 2;
+    std::vector<Answer> answers;
+    query.run(q, 1, false, answers);
+    ASSERT_EQ(answers.size(), 1u) << to_string(s);
+    EXPECT_EQ(answers[0].fid, 0);
+    EXPECT_EQ(answers[0].distance, 5.0);
+  }
+}
+
 // --candidates: each feature at the distance of its nearest segment box (no exact test, no
 // polygon holding the point), against brute force over the boxes, for every structure.
 TEST(LayerNearest, CandidatesRankFeaturesByTheirBoxes) {

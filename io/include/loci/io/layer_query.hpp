@@ -23,12 +23,14 @@
 // exact distances: a feature is final once its exact distance is no larger than the box
 // distance of the next entry, since every entry not yet seen is at least that far, and the
 // walk stops there. Per segment on a packed tree, it goes over one hierarchy of boxes per
-// feature instead (Features): the features come out of a tree of their hierarchies' roots
-// nearest box first, and each one's exact distance is found by a depth-first descent of its
-// own hierarchy, nearest child first, that drops every node no nearer than the k-th distance
-// found so far (or than the feature's own best). A feature's many segments never come out one
-// by one, and the walk stops at the first root no nearer than the k-th distance. --candidates
-// answers from boxes alone. Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry
+// feature instead (Features), in two passes. First the candidates: the features come out of a
+// tree of their hierarchies' roots nearest box first, each with an upper bound on its distance
+// from one dive down its hierarchy (nearest child at every level, one leaf measured), until a
+// root is no nearer than the k-th smallest upper bound. Then each candidate, nearest bound
+// first, is measured exactly by a depth-first descent of its own hierarchy, nearest child
+// first, that drops every node no nearer than the feature's bound or the k-th distance found
+// so far. A feature's many segments never come out one by one. --candidates answers from
+// boxes alone. Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry
 // and belongs to one thread.
 #pragma once
 
