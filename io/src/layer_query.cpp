@@ -369,8 +369,8 @@ const LayerIndex::Features& LayerIndex::features() const {
       int distinct = 0;
       for (std::size_t pos = first; pos < last_pos; ++pos) {
         const std::uint32_t g = feature_at(pos);
-        if (g != Features::none && std::find(seen, seen + distinct, g) == seen + distinct)
-          seen[distinct++] = g;
+        if (g == Features::none || (distinct > 0 && seen[distinct - 1] == g)) continue;
+        if (std::find(seen, seen + distinct, g) == seen + distinct) seen[distinct++] = g;
       }
       for (int i = 0; i < distinct; ++i) {
         parts.push_back({seen[i], std::uint32_t(b)});
