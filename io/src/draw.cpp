@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <sys/stat.h>
+
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
@@ -71,6 +73,11 @@ std::size_t draw_index(const DrawOptions& options) {
   if (detail::ends_with(options.path, ".loci")) {
     load.layer_path = options.path.substr(0, options.path.size() - 5);
     load.index_path = options.path;
+    struct stat st {};
+    if (::stat(options.path.c_str(), &st) == 0 && ::stat(load.layer_path.c_str(), &st) != 0 &&
+        load.layer_path.rfind("/vsi", 0) != 0)
+      throw Error(options.path + ": its layer " + load.layer_path +
+                  " is missing (an index is drawn over the layer it was built from)");
   } else {
     load.layer_path = options.path;
   }

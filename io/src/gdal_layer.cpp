@@ -14,6 +14,7 @@
 
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
+#include "loci/io/sidecar.hpp"
 
 namespace loci::io {
 
@@ -60,6 +61,8 @@ OpenLayer open_layer(const std::string& path, const std::string& name) {
   if (!ol.dataset) {
     VSIStatBufL st;
     if (VSIStatL(path.c_str(), &st) != 0) throw Error(path + ": no such file");
+    if (starts_as_sidecar(path))
+      throw Error(path + ": a loci index, not a layer (give the layer it indexes)");
     throw Error(path + ": cannot open as a vector layer" +
                 (gdal_message.empty() ? std::string() : " (" + gdal_message + ")"));
   }

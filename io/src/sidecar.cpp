@@ -286,6 +286,15 @@ std::string default_sidecar_path(const std::string& layer_path) {
   return p + ".loci";
 }
 
+bool starts_as_sidecar(const std::string& path) {
+  char magic[sizeof kMagic] = {};
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  const bool whole = std::fread(magic, 1, sizeof magic, f) == sizeof magic;
+  std::fclose(f);
+  return whole && std::memcmp(magic, kMagic, sizeof magic) == 0;
+}
+
 void write_sidecar(const std::string& path, const PackedRTree2& tree,
                    std::span<const ItemRecord> records, const SidecarInfo& info) {
   if (records.size() != tree.size()) throw InvalidArgument("sidecar: one record per item");

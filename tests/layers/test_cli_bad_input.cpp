@@ -271,6 +271,28 @@ TEST_F(BadInput, SignalsRemoveTheTemporaries) {
 
 namespace {
 
+// A sidecar given where a layer is expected is named as one, and a sidecar drawn after its layer
+// was renamed away names the missing layer.
+TEST_F(BadInput, ASidecarGivenAsALayerIsNamed) {
+  const std::string l = lines_layer();
+  ASSERT_EQ(run_loci("index -q " + shell_quote(l)).status, 0);
+  const std::string sidecar = l + ".loci";
+  for (const std::string& args :
+       {"info " + shell_quote(sidecar), "index -q " + shell_quote(sidecar),
+        "query " + shell_quote(sidecar) + " --bbox 0,0,9,9"}) {
+    const CliRun r = run_loci(args);
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("a loci index, not a layer"), std::string::npos) << args << r.err;
+  }
+  const std::string moved = path("moved.geojson.loci");
+  fs::rename(sidecar, moved);
+  const CliRun d = run_loci("draw " + shell_quote(moved) + " -o " + shell_quote(path("d.svg")));
+  expect_one_line_error(d);
+  EXPECT_NE(d.err.find("its layer " + path("moved.geojson") + " is missing"), std::string::npos)
+      << d.err;
+  EXPECT_FALSE(fs::exists(path("d.svg")));
+}
+
 // A GeoPackage with layers a and b: the sidecar says which layer it indexes, and a query of the
 // default (first) layer does not use a sidecar of b.
 TEST_F(BadInput, ASidecarAnswersOnlyForTheLayerItIndexes) {

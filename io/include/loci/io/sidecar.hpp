@@ -127,6 +127,9 @@ std::uint64_t hash_bytes(const void* data, std::size_t size, std::uint64_t seed 
 
 // Where `loci index` writes by default: the layer path with ".loci" appended.
 std::string default_sidecar_path(const std::string& layer_path);
+// Whether the file at path begins as a loci index file does (its magic), so that a command
+// given a sidecar where it takes a layer can say so.
+bool starts_as_sidecar(const std::string& path);
 
 struct SidecarInfo {
   Per per = Per::feature;
