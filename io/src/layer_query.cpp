@@ -584,6 +584,80 @@ struct FeatureDescent {
 
 }  // namespace
 
+void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
+                                             bool candidates_only,
+                                             const LayerIndex::Features& features,
+                                             std::vector<Answer>& out) {
+  const Point2 p = q.point;
+  // The k best (squared distance, feature) as a max-heap: its top is the k-th distance.
+  auto& top = top_;
+  top.clear();
+  auto kth = [&] {
+    return top.size() < q.k ? std::numeric_limits<double>::infinity() : top.front().first;
+  };
+  auto keep = [&](double d2, std::uint32_t f) {
+    if (top.size() == q.k) {
+      std::pop_heap(top.begin(), top.end());
+      top.pop_back();
+    }
+    top.emplace_back(d2, f);
+    std::push_heap(top.begin(), top.end());
+  };
+  std::vector<std::uint32_t> inside;
+  if (!candidates_only)
+    for (const auto fid : containing_polygons(index_, p, features)) {
+      const std::uint32_t f = features.number.at(fid);
+      inside.push_back(f);
+      if (top.size() < q.k) keep(0.0, f);
+    }
+  // First the candidates: the features in increasing distance of their roots' boxes, each
+  // with an upper bound on its distance from one dive down its hierarchy, until a root is
+  // no nearer than the k-th smallest upper bound (no feature from there on can rank).
+  auto& bounds = bounds_;  // the k smallest upper bounds, as a max-heap
+  bounds.assign(top.size(), 0.0);
+  auto bound = [&] {
+    return bounds.size() < q.k ? std::numeric_limits<double>::infinity() : bounds.front();
+  };
+  const FeatureDescent descend{features, *index_.packed(), p, candidates_only};
+  auto& candidates = candidates_;
+  candidates.clear();
+  features.root_tree.browse(p, [&](Id r, const Box2& b, double) {
+    const double lower = squared_distance(p, b);
+    if (!(lower < bound())) return false;
+    const auto [level, i] = features.roots[r];
+    const std::uint32_t f = features.levels[level][i].feature;
+    if (std::find(inside.begin(), inside.end(), f) != inside.end()) return true;
+    const double upper = descend.dive(level, i);
+    candidates.push_back({upper, lower, std::uint32_t(r)});
+    if (bounds.size() == q.k) {
+      if (!(upper < bounds.front())) return true;
+      std::pop_heap(bounds.begin(), bounds.end());
+      bounds.pop_back();
+    }
+    bounds.push_back(upper);
+    std::push_heap(bounds.begin(), bounds.end());
+    return true;
+  });
+  // Then each candidate measured exactly, nearest upper bound first (so that the k-th
+  // distance is soon the final one), its descent bounded by the nearer of its own upper
+  // bound (a distance it has) and the k-th distance so far; a candidate whose root is no
+  // nearer than the k-th distance is dropped unread.
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.upper < b.upper || (a.upper == b.upper && a.lower < b.lower);
+  });
+  for (const Candidate& c : candidates) {
+    const double limit = kth();
+    if (!(c.lower < limit)) continue;
+    const auto [level, i] = features.roots[c.root];
+    double best = std::min(c.upper, limit);
+    descend(level, i, best);
+    if (best < limit) keep(best, features.levels[level][i].feature);
+  }
+  std::sort_heap(top.begin(), top.end());
+  for (const auto& [d2, f] : top)
+    out.push_back({number, features.fid[f], std::sqrt(d2)});
+}
+
 void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
                      std::vector<Answer>& out) {
   check_query(q);
@@ -593,73 +667,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     const Point2 p = q.point;
     const LayerIndex::Features& features = index_.features();
     if (features.hierarchical) {
-      // The k best (squared distance, feature) as a max-heap: its top is the k-th distance.
-      auto& top = top_;
-      top.clear();
-      auto kth = [&] {
-        return top.size() < q.k ? std::numeric_limits<double>::infinity() : top.front().first;
-      };
-      auto keep = [&](double d2, std::uint32_t f) {
-        if (top.size() == q.k) {
-          std::pop_heap(top.begin(), top.end());
-          top.pop_back();
-        }
-        top.emplace_back(d2, f);
-        std::push_heap(top.begin(), top.end());
-      };
-      std::vector<std::uint32_t> inside;
-      if (!candidates_only)
-        for (const auto fid : containing_polygons(index_, p, features)) {
-          const std::uint32_t f = features.number.at(fid);
-          inside.push_back(f);
-          if (top.size() < q.k) keep(0.0, f);
-        }
-      // First the candidates: the features in increasing distance of their roots' boxes, each
-      // with an upper bound on its distance from one dive down its hierarchy, until a root is
-      // no nearer than the k-th smallest upper bound (no feature from there on can rank).
-      auto& bounds = bounds_;  // the k smallest upper bounds, as a max-heap
-      bounds.assign(top.size(), 0.0);
-      auto bound = [&] {
-        return bounds.size() < q.k ? std::numeric_limits<double>::infinity() : bounds.front();
-      };
-      const FeatureDescent descend{features, *index_.packed(), p, candidates_only};
-      auto& candidates = candidates_;
-      candidates.clear();
-      features.root_tree.browse(p, [&](Id r, const Box2& b, double) {
-        const double lower = squared_distance(p, b);
-        if (!(lower < bound())) return false;
-        const auto [level, i] = features.roots[r];
-        const std::uint32_t f = features.levels[level][i].feature;
-        if (std::find(inside.begin(), inside.end(), f) != inside.end()) return true;
-        const double upper = descend.dive(level, i);
-        candidates.push_back({upper, lower, std::uint32_t(r)});
-        if (bounds.size() == q.k) {
-          if (!(upper < bounds.front())) return true;
-          std::pop_heap(bounds.begin(), bounds.end());
-          bounds.pop_back();
-        }
-        bounds.push_back(upper);
-        std::push_heap(bounds.begin(), bounds.end());
-        return true;
-      });
-      // Then each candidate measured exactly, nearest upper bound first (so that the k-th
-      // distance is soon the final one), its descent bounded by the nearer of its own upper
-      // bound (a distance it has) and the k-th distance so far; a candidate whose root is no
-      // nearer than the k-th distance is dropped unread.
-      std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-        return a.upper < b.upper || (a.upper == b.upper && a.lower < b.lower);
-      });
-      for (const Candidate& c : candidates) {
-        const double limit = kth();
-        if (!(c.lower < limit)) continue;
-        const auto [level, i] = features.roots[c.root];
-        double best = std::min(c.upper, limit);
-        descend(level, i, best);
-        if (best < limit) keep(best, features.levels[level][i].feature);
-      }
-      std::sort_heap(top.begin(), top.end());
-      for (const auto& [d2, f] : top)
-        out.push_back({number, features.fid[f], std::sqrt(d2)});
+      nearest_through_hierarchies(q, number, candidates_only, features, out);
       return;
     }
     if (state_.size() != features.fid.size()) {

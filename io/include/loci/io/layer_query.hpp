@@ -137,7 +137,7 @@ class LayerIndex {
   }
   // The features of the index numbered densely (0, 1, ... in order of first appearance), so
   // that per-query state is a flat array: the FID of every feature and, except for a packed
-  // tree per segment, the feature of every item (of_item; `none` for a corrupt record). For a
+  // tree per segment, the feature of every item (of_item). For a
   // packed tree per segment, instead one hierarchy of boxes per feature over its entries: a
   // level-0 node is the part of one leaf of the tree that belongs to one feature (bounded by
   // the leaf's box; an entry of the leaf is the feature's when its record has the feature's
@@ -251,6 +251,10 @@ class LayerQuery {
   void run(const Query& q, std::size_t number, bool candidates_only, std::vector<Answer>& out);
 
  private:
+  // Nearest-n per segment on a packed tree, through the features' hierarchies (the two passes
+  // described at the top of this file).
+  void nearest_through_hierarchies(const Query& q, std::size_t number, bool candidates_only,
+                                   const LayerIndex::Features& features, std::vector<Answer>& out);
   struct Geometries;
   const LayerIndex& index_;
   std::unique_ptr<Geometries> geometries_;
