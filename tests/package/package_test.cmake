@@ -1,0 +1,24 @@
+# Installs the build into a fresh prefix, builds tests/package/consumer against it with
+# find_package(loci), and runs it on the bundled sample: the CMake package as users get it.
+# Run with cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DCXX=... -DLAYER=... -P.
+foreach(v BUILD_DIR SOURCE_DIR WORK_DIR CXX LAYER GENERATOR)
+  if(NOT DEFINED ${v})
+    message(FATAL_ERROR "package_test.cmake needs -D${v}=...")
+  endif()
+endforeach()
+file(REMOVE_RECURSE "${WORK_DIR}")
+function(run what)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${what} failed (${rc}):\n${out}")
+  endif()
+  message(STATUS "${what}: done")
+  set(last_output "${out}" PARENT_SCOPE)
+endfunction()
+run("install" "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix")
+run("configure the consumer" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}" -B "${WORK_DIR}/build"
+    -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_COMPILER=${CXX}"
+    "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix")
+run("build the consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
+run("run the consumer" "${WORK_DIR}/build/loci_consumer" "${LAYER}")
+message(STATUS "${last_output}")
