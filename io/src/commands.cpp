@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -238,7 +239,13 @@ IndexReport index_layer(const IndexOptions& options) {
   info.layer_name = items.layer_name;
   info.has_polygons = items.has_polygons;
   info.source = source;
-  write_sidecar(r.path, tree, items.records, info);
+  // Per segment, the features' hierarchies that nearest-n walks are stored too, so that a
+  // query reads them in place instead of building them from every record.
+  LayerIndex::Features features;
+  if (items.per == Per::segment)
+    features = LayerIndex::build_features(&tree, items.per, items.records);
+  const Hierarchies stored = features.stored();
+  write_sidecar(r.path, tree, items.records, info, features.hierarchical ? &stored : nullptr);
   if (options.progress) options.progress(1.0);
   r.layer_name = items.layer_name;
   r.per = items.per;
@@ -248,19 +255,49 @@ IndexReport index_layer(const IndexOptions& options) {
   return r;
 }
 
+namespace {
+
+// Whether the stored hierarchies are those the tree and records give (the sidecar verified).
+bool same_hierarchies(const LayerIndex::Features& stored, const LayerIndex::Features& built) {
+  auto same = [](auto a, auto b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
+  };
+  if (!built.hierarchical || !same(stored.fid, built.fid) || !same(stored.roots, built.roots) ||
+      stored.levels.size() != built.levels.size() ||
+      !same(stored.root_tree.blocks(), built.root_tree.blocks()) ||
+      !same(stored.root_tree.item_indices(), built.root_tree.item_indices()))
+    return false;
+  for (std::size_t l = 0; l < built.levels.size(); ++l)
+    if (!same(stored.levels[l], built.levels[l])) return false;
+  return true;
+}
+
+}  // namespace
+
 std::string check_sidecar(const std::string& path) {
-  const Sidecar sc = Sidecar::open(path);
+  Sidecar sc = Sidecar::open(path);
+  const SidecarInfo info = sc.info();
+  const std::size_t chunks = sc.check().chunks();
   try {
     sc.verify();
+    if (sc.hierarchies()) {
+      const LayerIndex index = LayerIndex::adopt(std::move(sc));
+      const LayerIndex::Features built =
+          LayerIndex::build_features(index.packed(), index.per(), index.records());
+      if (!same_hierarchies(index.features(), built))
+        throw Error(path +
+                    ": corrupt index file (the feature hierarchies do not match the segments); "
+                    "run 'loci index' to rebuild it");
+    }
   } catch (const Error& e) {
     const std::string what = e.what();
     if (what.rfind(path, 0) == 0) throw;
     throw Error(path + ": corrupt index file (" + what + "); run 'loci index' to rebuild it");
   }
-  const auto& i = sc.info();
+  const auto& i = info;
   return path + ": ok, " + (i.packing == Packing::str ? "packed-str" : "packed-hilbert") + " per " +
          to_string(i.per) + ", layer " + i.layer_name + ", " + std::to_string(i.items) +
-         " entries, " + std::to_string(sc.check().chunks()) + " chunks verified, " +
+         " entries, " + std::to_string(chunks) + " chunks verified, " +
          std::to_string(i.file_size) + " bytes";
 }
 

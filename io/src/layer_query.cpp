@@ -95,6 +95,8 @@ LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
   x.records_ = sidecar.mapped_records();
   x.keep_alive_ = sidecar.keep_alive();
   x.check_ = &sidecar.check();
+  x.stored_ = sidecar.hierarchies();
+  x.mapped_items_ = sidecar.mapped_items();
   x.tree_ = std::move(sidecar).take_tree();
   x.features_ = std::make_shared<LazyFeatures>();
   return x;
@@ -302,124 +304,170 @@ struct LayerIndex::LazyFeatures {
   Features value;
 };
 
+void LayerIndex::Features::corrupt() const {
+  throw Error((path.empty() ? std::string("index") : path) +
+              ": corrupt index file (feature hierarchies); run 'loci index' to rebuild it");
+}
+
 const LayerIndex::Features& LayerIndex::features() const {
   std::call_once(features_->once, [&] {
     Features& f = features_->value;
-    const auto records = f.records = this->records();
     const PackedRTree2* t = packed();
-    // Only a packed tree per segment is walked through hierarchies; the other walks look the
-    // feature of each item up in of_item.
-    const bool hierarchies = f.hierarchical = t && t->size() > 0 && per_ == Per::segment;
-    if (!hierarchies) f.of_item.resize(records.size());
-    auto& number = f.number;
-    std::int64_t last_fid = 0;
-    std::uint32_t last = Features::none;
-    for (std::size_t id = 0; id < records.size(); ++id) {
-      const std::int64_t fid = records[id].fid;
-      if (last == Features::none || fid != last_fid) {
-        const auto [it, fresh] = number.try_emplace(fid, std::uint32_t(f.fid.size()));
-        if (fresh) f.fid.push_back(fid);
-        last = it->second;
-        last_fid = fid;
-      }
-      if (!hierarchies) f.of_item[id] = last;
+    if (!stored_) {
+      f = build_features(t, per_, records());
+      return;
     }
-    if (!hierarchies) return;
-    const std::size_t n = t->size(), features = f.fid.size();
-    const std::span<const std::uint32_t> items = f.items = t->item_indices().first(n);
-    // The feature of the item at packed position pos (none for an item of no record, in a
-    // corrupt index), asked once per run of one FID: of a table when the FIDs are dense (as
-    // GDAL numbers most formats' features), of the map otherwise.
-    std::int64_t low = 0;
-    std::vector<std::uint32_t> dense;
-    if (features > 0) {
-      const auto [min, max] = std::minmax_element(f.fid.begin(), f.fid.end());
-      low = *min;
-      if (std::uint64_t(*max) - std::uint64_t(low) < 4 * std::uint64_t(features) + 1024) {
-        dense.assign(std::size_t(std::uint64_t(*max) - std::uint64_t(low)) + 1, Features::none);
-        for (std::size_t g = 0; g < features; ++g)
-          dense[std::size_t(std::uint64_t(f.fid[g]) - std::uint64_t(low))] = std::uint32_t(g);
-      }
+    // Stored: the arrays are viewed in place; the level sizes are read (and checked) now,
+    // everything else as a walk reads it.
+    const MappedHierarchies& m = *stored_;
+    f.hierarchical = true;
+    f.records = records_;
+    f.tree = t;
+    f.items = mapped_items_;
+    f.check = check_;
+    f.path = m.path;
+    f.leaves = (t->size() + PackedRTree2::node_size - 1) / PackedRTree2::node_size;
+    f.fid = {m.fids, m.features};
+    f.roots = {m.roots, m.features};
+    check_->touch(m.level_sizes, 8 * m.levels);
+    std::size_t at = 0;
+    for (std::size_t l = 0; l < m.levels; ++l) {
+      const std::uint64_t size = m.level_sizes[l];
+      if (size == 0 || size > m.nodes - at) f.corrupt();
+      f.levels.push_back({m.nodes_at + at, std::size_t(size)});
+      at += std::size_t(size);
     }
-    last = Features::none;
-    auto feature_at = [&](std::size_t pos) {
-      const std::uint32_t id = items[pos];
-      if (id >= records.size()) return Features::none;
-      if (last == Features::none || records[id].fid != last_fid) {
-        last_fid = records[id].fid;
-        last = dense.empty() ? number.find(last_fid)->second
-                             : dense[std::size_t(std::uint64_t(last_fid) - std::uint64_t(low))];
-      }
-      return last;
-    };
-    // Level 0: per leaf of the tree, one node per feature it holds, grouped by feature (a
-    // counting sort that keeps packed order, so that a feature's neighbouring leaves stay
-    // together). The features of each leaf are listed first, compactly.
-    constexpr std::uint32_t kFanout = 16;
-    static_assert(kFanout == PackedRTree2::node_size);
-    struct Part {
-      std::uint32_t feature, leaf;
-    };
-    loci::detail::LargeVector<Part> parts;
-    parts.reserve(n / kFanout + n / kFanout / 8 + 1);
-    std::vector<std::uint32_t> start(features + 1, 0);
-    for (std::size_t b = 0, first = 0; first < n; ++b, first += kFanout) {
-      const std::size_t last_pos = std::min<std::size_t>(first + kFanout, n);
-      std::uint32_t seen[kFanout];
-      int distinct = 0;
-      for (std::size_t pos = first; pos < last_pos; ++pos) {
-        const std::uint32_t g = feature_at(pos);
-        if (g == Features::none || (distinct > 0 && seen[distinct - 1] == g)) continue;
-        if (std::find(seen, seen + distinct, g) == seen + distinct) seen[distinct++] = g;
-      }
-      for (int i = 0; i < distinct; ++i) {
-        parts.push_back({seen[i], std::uint32_t(b)});
-        ++start[seen[i] + 1];
-      }
-    }
-    for (std::size_t i = 0; i < features; ++i)
-      start[i + 1] += start[i];
-    // The box the tree stores for the leaf bounds each of its features' parts: looser for a
-    // leaf shared by several features, but no leaf is read until a query reaches it.
-    Box2 only_leaf = Box2::empty();
-    if (t->levels() == 1)
-      for (std::size_t pos = 0; pos < n; ++pos)
-        only_leaf.expand(t->box_at(pos));
-    loci::detail::LargeVector<Features::Node> level(parts.size());
-    for (const Part& part : parts)
-      level[start[part.feature]++] = {t->levels() > 1 ? t->entry_box(1, part.leaf) : only_leaf,
-                                      part.feature, part.leaf, part.leaf};
-    parts = {};
-    // Then up to 16 nodes of one feature per node, until each feature has one node, its root.
-    while (!level.empty()) {
-      loci::detail::LargeVector<Features::Node> up;
-      const auto l = std::uint32_t(f.levels.size());
-      for (std::uint32_t i = 0; i < level.size();) {
-        std::uint32_t j = i + 1;
-        while (j < level.size() && level[j].feature == level[i].feature)
-          ++j;
-        if (j - i == 1) {
-          f.roots.emplace_back(l, i);
-        } else {
-          for (std::uint32_t c = i; c < j; c += kFanout) {
-            Features::Node node{Box2::empty(), level[i].feature, c, std::min(c + kFanout, j)};
-            for (std::uint32_t k = node.first; k < node.last; ++k)
-              node.box.expand(level[k].box);
-            up.push_back(node);
-          }
-        }
-        i = j;
-      }
-      f.levels.push_back(std::move(level));
-      level = std::move(up);
-    }
-    std::vector<Box2> boxes;
-    boxes.reserve(f.roots.size());
-    for (const auto& [l, i] : f.roots)
-      boxes.push_back(f.levels[l][i].box);
-    f.root_tree = PackedRTree2::build(boxes);
+    if (at != m.nodes) f.corrupt();
+    f.root_tree = PackedRTree2::adopt(m.features, Packing::hilbert, m.root_blocks, m.root_items,
+                                      keep_alive_, check_);
   });
   return features_->value;
+}
+
+LayerIndex::Features LayerIndex::build_features(const PackedRTree2* t, Per per,
+                                                std::span<const ItemRecord> records) {
+  Features f;
+  f.records = records;
+  // Only a packed tree per segment is walked through hierarchies; the other walks look the
+  // feature of each item up in of_item.
+  const bool hierarchies = f.hierarchical = t && t->size() > 0 && per == Per::segment;
+  if (!hierarchies) f.of_item.resize(records.size());
+  auto& number = f.number;
+  auto& fids = f.own_fid;
+  std::int64_t last_fid = 0;
+  std::uint32_t last = Features::none;
+  for (std::size_t id = 0; id < records.size(); ++id) {
+    const std::int64_t fid = records[id].fid;
+    if (last == Features::none || fid != last_fid) {
+      const auto [it, fresh] = number.try_emplace(fid, std::uint32_t(fids.size()));
+      if (fresh) fids.push_back(fid);
+      last = it->second;
+      last_fid = fid;
+    }
+    if (!hierarchies) f.of_item[id] = last;
+  }
+  f.fid = fids;
+  if (!hierarchies) return f;
+  f.tree = t;
+  const std::size_t n = t->size(), features = fids.size();
+  f.leaves = (n + PackedRTree2::node_size - 1) / PackedRTree2::node_size;
+  f.items = t->item_indices();
+  const std::span<const std::uint32_t> items = f.items.first(n);
+  // The feature of the item at packed position pos (none for an item of no record, in a
+  // corrupt index), asked once per run of one FID: of a table when the FIDs are dense (as
+  // GDAL numbers most formats' features), of the map otherwise.
+  std::int64_t low = 0;
+  std::vector<std::uint32_t> dense;
+  if (features > 0) {
+    const auto [min, max] = std::minmax_element(fids.begin(), fids.end());
+    low = *min;
+    if (std::uint64_t(*max) - std::uint64_t(low) < 4 * std::uint64_t(features) + 1024) {
+      dense.assign(std::size_t(std::uint64_t(*max) - std::uint64_t(low)) + 1, Features::none);
+      for (std::size_t g = 0; g < features; ++g)
+        dense[std::size_t(std::uint64_t(fids[g]) - std::uint64_t(low))] = std::uint32_t(g);
+    }
+  }
+  last = Features::none;
+  auto feature_at = [&](std::size_t pos) {
+    const std::uint32_t id = items[pos];
+    if (id >= records.size()) return Features::none;
+    if (last == Features::none || records[id].fid != last_fid) {
+      last_fid = records[id].fid;
+      last = dense.empty() ? number.find(last_fid)->second
+                           : dense[std::size_t(std::uint64_t(last_fid) - std::uint64_t(low))];
+    }
+    return last;
+  };
+  // Level 0: per leaf of the tree, one node per feature it holds, grouped by feature (a
+  // counting sort that keeps packed order, so that a feature's neighbouring leaves stay
+  // together). The features of each leaf are listed first, compactly.
+  constexpr std::uint32_t kFanout = 16;
+  static_assert(kFanout == PackedRTree2::node_size);
+  struct Part {
+    std::uint32_t feature, leaf;
+  };
+  loci::detail::LargeVector<Part> parts;
+  parts.reserve(n / kFanout + n / kFanout / 8 + 1);
+  std::vector<std::uint32_t> start(features + 1, 0);
+  for (std::size_t b = 0, first = 0; first < n; ++b, first += kFanout) {
+    const std::size_t last_pos = std::min<std::size_t>(first + kFanout, n);
+    std::uint32_t seen[kFanout];
+    int distinct = 0;
+    for (std::size_t pos = first; pos < last_pos; ++pos) {
+      const std::uint32_t g = feature_at(pos);
+      if (g == Features::none || (distinct > 0 && seen[distinct - 1] == g)) continue;
+      if (std::find(seen, seen + distinct, g) == seen + distinct) seen[distinct++] = g;
+    }
+    for (int i = 0; i < distinct; ++i) {
+      parts.push_back({seen[i], std::uint32_t(b)});
+      ++start[seen[i] + 1];
+    }
+  }
+  for (std::size_t i = 0; i < features; ++i)
+    start[i + 1] += start[i];
+  // The box the tree stores for the leaf bounds each of its features' parts: looser for a
+  // leaf shared by several features, but no leaf is read until a query reaches it.
+  Box2 only_leaf = Box2::empty();
+  if (t->levels() == 1)
+    for (std::size_t pos = 0; pos < n; ++pos)
+      only_leaf.expand(t->box_at(pos));
+  loci::detail::LargeVector<Features::Node> level(parts.size());
+  for (const Part& part : parts)
+    level[start[part.feature]++] = {t->levels() > 1 ? t->entry_box(1, part.leaf) : only_leaf,
+                                    part.feature, part.leaf, part.leaf, 0};
+  parts = {};
+  // Then up to 16 nodes of one feature per node, until each feature has one node, its root.
+  while (!level.empty()) {
+    loci::detail::LargeVector<Features::Node> up;
+    const auto l = std::uint32_t(f.own_levels.size());
+    for (std::uint32_t i = 0; i < level.size();) {
+      std::uint32_t j = i + 1;
+      while (j < level.size() && level[j].feature == level[i].feature)
+        ++j;
+      if (j - i == 1) {
+        f.own_roots.push_back({l, i});
+      } else {
+        for (std::uint32_t c = i; c < j; c += kFanout) {
+          Features::Node node{Box2::empty(), level[i].feature, c, std::min(c + kFanout, j), 0};
+          for (std::uint32_t k = node.first; k < node.last; ++k)
+            node.box.expand(level[k].box);
+          up.push_back(node);
+        }
+      }
+      i = j;
+    }
+    f.own_levels.push_back(std::move(level));
+    level = std::move(up);
+  }
+  for (const auto& l : f.own_levels)
+    f.levels.emplace_back(l.data(), l.size());
+  f.roots = f.own_roots;
+  std::vector<Box2> boxes;
+  boxes.reserve(f.roots.size());
+  for (const HierarchyRoot& r : f.roots)
+    boxes.push_back(f.levels[r.level][r.node].box);
+  f.root_tree = PackedRTree2::build(boxes);
+  return f;
 }
 
 // The ring segments crossing the ray from p towards +x, counted per feature.
@@ -440,20 +488,22 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
   return out;
 }
 
-std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p,
-                                              const LayerIndex::Features& features) {
-  std::vector<std::int64_t> out;
+namespace {
+
+// The features (by number) whose polygons contain p, through their hierarchies: only a
+// feature whose box holds p can contain it. Its rings are counted along the axis direction
+// that leaves its box soonest, through its own hierarchy: no other feature's segments are
+// read. Each direction is a map that turns it into +x (reflections and swaps of coordinates
+// are exact), and ray_crosses decides on the mapped points as it does for +x.
+std::vector<std::uint32_t> containing_features(const LayerIndex& index, const Point2& p,
+                                               const LayerIndex::Features& features) {
+  std::vector<std::uint32_t> out;
   const PackedRTree2* tree = index.packed();
   if (!index.has_polygons() || !tree || tree->size() == 0) return out;
-  const auto records = features.records;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack;
-  // Only a feature whose box holds p can contain it. Its rings are counted along the axis
-  // direction that leaves its box soonest, through its own hierarchy: no other feature's
-  // segments are read. Each direction is a map that turns it into +x (reflections and swaps of
-  // coordinates are exact), and ray_crosses decides on the mapped points as it does for +x.
+  std::vector<HierarchyRoot> stack;
   features.root_tree.query(Box2::of_point(p), [&](Id r, const Box2&) {
-    const auto root = features.roots[r];
-    const LayerIndex::Features::Node& top = features.levels[root.first][root.second];
+    const HierarchyRoot root = features.root(r);
+    const LayerIndex::Features::Node& top = features.node(root.level, root.node);
     const Box2& reach = top.box;
     const double length[4] = {reach.max[0] - p[0], p[0] - reach.min[0], reach.max[1] - p[1],
                               p[1] - reach.min[1]};
@@ -475,16 +525,17 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
                      : dir == 2 ? Box2{p, {p[0], reach.max[1]}}
                                 : Box2{{p[0], reach.min[1]}, p};
     const Point2 mp = map(p);
-    const std::int64_t fid = features.fid[top.feature];
+    const std::int64_t fid = features.fid_of(top.feature);
     bool odd = false;
     stack.assign(1, root);
     while (!stack.empty()) {
       const auto [level, i] = stack.back();
       stack.pop_back();
-      const LayerIndex::Features::Node& node = features.levels[level][i];
+      const LayerIndex::Features::Node& node = features.node(level, i);
       if (level > 0) {
-        for (std::uint32_t c = node.first; c < node.last; ++c)
-          if (intersects(features.levels[level - 1][c].box, ray)) stack.emplace_back(level - 1, c);
+        const auto below = features.children(node, level);
+        for (std::uint32_t c = 0; c < below.size(); ++c)
+          if (intersects(below[c].box, ray)) stack.push_back({level - 1, node.first + c});
         continue;
       }
       const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
@@ -492,16 +543,25 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
       for (std::size_t pos = first; pos < last; ++pos) {
         const Box2 b = tree->box_at(pos);
         if (!intersects(b, ray)) continue;
-        const Id id = features.items[pos];
-        if (id >= records.size() || records[id].fid != fid || !(records[id].flags & item_ring))
-          continue;
-        const Segment2 s = segment_of(b, records[id].flags);
+        const ItemRecord* r = features.record(features.leaf_items(node.first)[pos - first]);
+        if (!r || r->fid != fid || !(r->flags & item_ring)) continue;
+        const Segment2 s = segment_of(b, r->flags);
         odd ^= ray_crosses(map(s.a), map(s.b), mp);
       }
     }
-    if (odd) out.push_back(fid);
+    if (odd) out.push_back(top.feature);
     return true;
   });
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p,
+                                              const LayerIndex::Features& features) {
+  std::vector<std::int64_t> out;
+  for (const std::uint32_t f : containing_features(index, p, features))
+    out.push_back(features.fid_of(f));
   return out;
 }
 
@@ -516,68 +576,70 @@ struct FeatureDescent {
   Point2 p;
   bool boxes_only;
 
-  void operator()(std::uint32_t level, std::uint32_t i, double& best) const {
-    const LayerIndex::Features::Node& node = features.levels[level][i];
+  void operator()(std::uint32_t level, std::uint32_t i, double& best, bool touched) const {
+    const LayerIndex::Features::Node& node = features.node(level, i, touched);
     if (level == 0) {
       const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
       const int used = int(std::min<std::size_t>(PackedRTree2::node_size, tree.size() - first));
       const PackedRTree2::Block& leaf = tree.leaf(node.first);
       double box2[PackedRTree2::node_size];
       leaf.squared_distances(p, box2);
-      const std::int64_t fid = features.fid[node.feature];
+      const std::int64_t fid = features.fid_of(node.feature);
+      const std::uint32_t* ids = features.leaf_items(node.first);
       for (int e = 0; e < used; ++e) {
         if (!(box2[e] < best)) continue;
-        const std::uint32_t id = features.items[first + e];
-        if (id >= features.records.size() || features.records[id].fid != fid) continue;
+        const ItemRecord* r = features.record(ids[e]);
+        if (!r || r->fid != fid) continue;
         if (boxes_only) {
           best = box2[e];
           continue;
         }
         // A segment is no nearer than its box, so only those whose box is nearer are measured.
-        const Segment2 s = segment_of(leaf.box(e), features.records[id].flags);
+        const Segment2 s = segment_of(leaf.box(e), r->flags);
         best = std::min(best, squared_distance(p, s));
       }
       return;
     }
-    const auto& below = features.levels[level - 1];
+    const auto below = features.children(node, level);
     struct Child {
       double d2;
       std::uint32_t node;
     };
     Child order[PackedRTree2::node_size];
     int n = 0;
-    for (std::uint32_t c = node.first; c < node.last; ++c) {
+    for (std::uint32_t c = 0; c < below.size(); ++c) {
       const double c2 = squared_distance(p, below[c].box);
       if (!(c2 < best)) continue;
-      if (level == 1) {  // the leaf will likely be read: its loads overlap the work before it
-        tree.leaf(below[c].first).prefetch();
-        __builtin_prefetch(&features.items[std::size_t(below[c].first) * PackedRTree2::node_size]);
+      if (level == 1 && below[c].first < features.leaves) {
+        // The leaf will likely be read: its loads overlap the work before it.
+        tree.prefetch_leaf(below[c].first);
       }
       int j = n++;
       for (; j > 0 && order[j - 1].d2 > c2; --j)
         order[j] = order[j - 1];
-      order[j] = {c2, c};
+      order[j] = {c2, node.first + c};
     }
     for (int j = 0; j < n && order[j].d2 < best; ++j)
-      (*this)(level - 1, order[j].node, best);
+      (*this)(level - 1, order[j].node, best, true);
   }
 
   // An upper bound on the squared distance of the feature of node (level, i): the nearest
   // child at every level down to one leaf, measured there (infinity when that leaf holds none
   // of its segments, in a corrupt index, or when every child's squared distance overflows).
   double dive(std::uint32_t level, std::uint32_t i) const {
-    for (; level > 0; --level) {
-      const LayerIndex::Features::Node& node = features.levels[level][i];
-      const auto& below = features.levels[level - 1];
+    bool touched = false;  // node (level, i) was read as a child
+    for (; level > 0; --level, touched = true) {
+      const LayerIndex::Features::Node& node = features.node(level, i, touched);
+      const auto below = features.children(node, level);
       double nearest = std::numeric_limits<double>::infinity();
-      for (std::uint32_t c = node.first; c < node.last; ++c) {
+      for (std::uint32_t c = 0; c < below.size(); ++c) {
         const double c2 = squared_distance(p, below[c].box);
-        if (c2 < nearest) nearest = c2, i = c;
+        if (c2 < nearest) nearest = c2, i = node.first + c;
       }
       if (!(nearest < std::numeric_limits<double>::infinity())) return nearest;
     }
     double best = std::numeric_limits<double>::infinity();
-    (*this)(0, i, best);
+    (*this)(0, i, best, touched);
     return best;
   }
 };
@@ -605,8 +667,7 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
   };
   std::vector<std::uint32_t> inside;
   if (!candidates_only)
-    for (const auto fid : containing_polygons(index_, p, features)) {
-      const std::uint32_t f = features.number.at(fid);
+    for (const std::uint32_t f : containing_features(index_, p, features)) {
       inside.push_back(f);
       if (top.size() < q.k) keep(0.0, f);
     }
@@ -624,8 +685,8 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
   features.root_tree.browse(p, [&](Id r, const Box2& b, double) {
     const double lower = squared_distance(p, b);
     if (!(lower < bound())) return false;
-    const auto [level, i] = features.roots[r];
-    const std::uint32_t f = features.levels[level][i].feature;
+    const auto [level, i] = features.root(r);
+    const std::uint32_t f = features.node(level, i).feature;
     if (std::find(inside.begin(), inside.end(), f) != inside.end()) return true;
     const double upper = descend.dive(level, i);
     candidates.push_back({upper, lower, std::uint32_t(r)});
@@ -648,14 +709,14 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
   for (const Candidate& c : candidates) {
     const double limit = kth();
     if (!(c.lower < limit)) continue;
-    const auto [level, i] = features.roots[c.root];
+    const auto [level, i] = features.root(c.root);
     double best = std::min(c.upper, limit);
-    descend(level, i, best);
-    if (best < limit) keep(best, features.levels[level][i].feature);
+    descend(level, i, best, false);
+    if (best < limit) keep(best, features.node(level, i).feature);
   }
   std::sort_heap(top.begin(), top.end());
   for (const auto& [d2, f] : top)
-    out.push_back({number, features.fid[f], std::sqrt(d2)});
+    out.push_back({number, features.fid_of(f), std::sqrt(d2)});
 }
 
 void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,

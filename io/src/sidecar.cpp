@@ -24,7 +24,7 @@ namespace loci::io {
 namespace {
 
 constexpr char kMagic[8] = {'\x89', 'L', 'O', 'C', 'I', '\r', '\n', '\x1a'};
-constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kVersion = 3;
 constexpr std::uint32_t kByteOrder = 0x01020304;
 constexpr std::uint8_t kStructurePackedRTree = 1;
 constexpr std::uint8_t kCoordFloat64 = 1;
@@ -64,9 +64,13 @@ struct SidecarHeader {
   std::uint64_t data_offset;  // = blocks_offset; chunks cover [data_offset, file_size)
   std::uint32_t chunk_shift;  // a chunk is 2^chunk_shift bytes (the last may be shorter)
   std::uint32_t reserved1;
-  std::uint64_t front_checksum;  // XXH3-64 of bytes [sizeof(SidecarHeader), data_offset)
-  std::uint64_t feature_count;   // features with a geometry (0: not recorded)
-  std::uint8_t reserved[32];
+  std::uint64_t front_checksum;      // XXH3-64 of bytes [sizeof(SidecarHeader), data_offset)
+  std::uint64_t feature_count;       // features with a geometry (0: not recorded)
+  std::uint64_t hierarchy_offset;    // the feature hierarchies (0: none), after the records
+  std::uint64_t hierarchy_features;  // their FIDs and roots
+  std::uint64_t hierarchy_nodes;     // their nodes, all levels
+  std::uint32_t hierarchy_levels;
+  std::uint32_t reserved2;
   std::uint64_t header_checksum;  // XXH3-64 of the bytes before this field
 };
 static_assert(sizeof(SidecarHeader) == 256);
@@ -74,6 +78,31 @@ static_assert(std::endian::native == std::endian::little, "sidecars are little-e
 
 std::size_t align_up(std::size_t n) {
   return (n + kAlign - 1) / kAlign * kAlign;
+}
+
+// Where the arrays of the hierarchies section lie, from its offset and counts (each array
+// from a 64-byte boundary): FIDs, level sizes, roots, nodes, the roots' tree's blocks and item
+// indices. Counts too large for the file give an end beyond it (no overflow: each count is
+// checked against the file size first).
+struct HierarchyLayout {
+  std::uint64_t fids, sizes, roots, nodes, root_blocks, root_items, end;
+  std::uint64_t root_block_count, root_slots;
+};
+
+HierarchyLayout hierarchy_layout(std::uint64_t offset, std::uint64_t features, std::uint64_t levels,
+                                 std::uint64_t nodes) {
+  HierarchyLayout l{};
+  l.root_block_count = PackedRTree2::block_count(std::size_t(features));
+  l.root_slots =
+      (features + PackedRTree2::node_size - 1) / PackedRTree2::node_size * PackedRTree2::node_size;
+  l.fids = offset;
+  l.sizes = align_up(l.fids + 8 * features);
+  l.roots = align_up(l.sizes + 8 * levels);
+  l.nodes = align_up(l.roots + sizeof(HierarchyRoot) * features);
+  l.root_blocks = align_up(l.nodes + sizeof(HierarchyNode) * nodes);
+  l.root_items = align_up(l.root_blocks + sizeof(PackedRTree2::Block) * l.root_block_count);
+  l.end = l.root_items + 4 * l.root_slots;
+  return l;
 }
 
 struct Mapping {
@@ -296,10 +325,15 @@ bool starts_as_sidecar(const std::string& path) {
 }
 
 void write_sidecar(const std::string& path, const PackedRTree2& tree,
-                   std::span<const ItemRecord> records, const SidecarInfo& info) {
+                   std::span<const ItemRecord> records, const SidecarInfo& info,
+                   const Hierarchies* hierarchies) {
   if (records.size() != tree.size()) throw InvalidArgument("sidecar: one record per item");
   const auto blocks = tree.blocks();
   const auto items = tree.item_indices();
+  if (hierarchies && (!hierarchies->root_tree || info.per != Per::segment ||
+                      hierarchies->roots.size() != hierarchies->fids.size() ||
+                      hierarchies->root_tree->size() != hierarchies->roots.size()))
+    throw InvalidArgument("sidecar: hierarchies of a per-segment index, one root per feature");
 
   SidecarHeader h{};
   std::memcpy(h.magic, kMagic, 8);
@@ -322,13 +356,36 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   // The checksum table's length depends on the data's, which starts after the table.
   const std::size_t data_bytes =
       align_up(blocks.size_bytes()) + align_up(items.size_bytes()) + records.size_bytes();
+  std::vector<std::uint64_t> level_sizes;
+  std::size_t node_count = 0;
+  HierarchyLayout hl{};
+  if (hierarchies) {
+    for (const auto& level : hierarchies->levels) {
+      level_sizes.push_back(level.size());
+      node_count += level.size();
+    }
+    h.hierarchy_features = hierarchies->fids.size();
+    h.hierarchy_levels = std::uint32_t(level_sizes.size());
+    h.hierarchy_nodes = node_count;
+    // Laid out from 0 first, for its length.
+    hl = hierarchy_layout(0, h.hierarchy_features, h.hierarchy_levels, h.hierarchy_nodes);
+  }
+  const std::size_t hierarchy_bytes =
+      hierarchies ? align_up(records.size_bytes()) - records.size_bytes() + hl.end : 0;
   h.chunk_shift = kChunkShift;
-  h.chunk_count = data_bytes == 0 ? 0 : ((data_bytes - 1) >> kChunkShift) + 1;
+  const std::size_t all_data = data_bytes + hierarchy_bytes;
+  h.chunk_count = all_data == 0 ? 0 : ((all_data - 1) >> kChunkShift) + 1;
   h.data_offset = align_up(h.checks_offset + 8 * h.chunk_count);
   h.blocks_offset = h.data_offset;
   h.items_offset = align_up(h.blocks_offset + blocks.size_bytes());
   h.records_offset = align_up(h.items_offset + items.size_bytes());
   h.file_size = h.records_offset + records.size_bytes();
+  if (hierarchies) {
+    h.hierarchy_offset = align_up(h.file_size);
+    hl = hierarchy_layout(h.hierarchy_offset, h.hierarchy_features, h.hierarchy_levels,
+                          h.hierarchy_nodes);
+    h.file_size = hl.end;
+  }
   const Box2 b = tree.bounds();
   h.bounds[0] = b.min[0];
   h.bounds[1] = b.min[1];
@@ -347,9 +404,25 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
     const void* data;
     std::size_t size;
   };
-  const std::array<Piece, 3> pieces{{{h.blocks_offset, blocks.data(), blocks.size_bytes()},
-                                     {h.items_offset, items.data(), items.size_bytes()},
-                                     {h.records_offset, records.data(), records.size_bytes()}}};
+  std::vector<Piece> pieces{{h.blocks_offset, blocks.data(), blocks.size_bytes()},
+                            {h.items_offset, items.data(), items.size_bytes()},
+                            {h.records_offset, records.data(), records.size_bytes()}};
+  if (hierarchies) {
+    pieces.push_back({hl.fids, hierarchies->fids.data(), hierarchies->fids.size_bytes()});
+    pieces.push_back({hl.sizes, level_sizes.data(), 8 * level_sizes.size()});
+    pieces.push_back({hl.roots, hierarchies->roots.data(), hierarchies->roots.size_bytes()});
+    std::uint64_t at = hl.nodes;
+    for (const auto& level : hierarchies->levels) {
+      pieces.push_back({at, level.data(), level.size_bytes()});
+      at += level.size_bytes();
+    }
+    const auto root_blocks = hierarchies->root_tree->blocks();
+    const auto root_items = hierarchies->root_tree->item_indices();
+    if (root_blocks.size() != hl.root_block_count || root_items.size() != hl.root_slots)
+      throw InvalidArgument("sidecar: the roots' tree does not match the roots");
+    pieces.push_back({hl.root_blocks, root_blocks.data(), root_blocks.size_bytes()});
+    pieces.push_back({hl.root_items, root_items.data(), root_items.size_bytes()});
+  }
   // The bytes [first, first + size) of the file's data: in place when one piece holds them,
   // else gathered into `buffer`.
   std::vector<std::byte> buffer;
@@ -393,6 +466,7 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
     write_all(out.fd(), p.data, p.size, path);
     at = p.offset + p.size;
   }
+  write_all(out.fd(), zeros.data(), h.file_size - at, path);
   out.commit();
 }
 
@@ -439,12 +513,29 @@ Sidecar Sidecar::open(const std::string& path) {
       h.checks_offset + 8 * h.chunk_count <= h.data_offset &&
       h.chunk_count ==
           (m->size == h.data_offset ? 0 : ((m->size - h.data_offset - 1) >> kChunkShift) + 1);
+  // The hierarchies: only in a per-segment index of at least one item, one root per feature
+  // and at most one feature per item, after the records and ending the file.
+  const bool hierarchical = h.hierarchy_offset != 0;
+  const std::uint64_t records_end =
+      h.records_offset + 16 * std::min<std::uint64_t>(h.item_count, m->size / 16);
+  const bool hierarchies_fit =
+      !hierarchical ? h.hierarchy_features == 0 && h.hierarchy_nodes == 0 &&
+                          h.hierarchy_levels == 0 && h.file_size == records_end
+                    : h.per == std::uint8_t(Per::segment) && h.item_count > 0 &&
+                          h.hierarchy_offset == align_up(records_end) && h.hierarchy_features > 0 &&
+                          h.hierarchy_features <= h.item_count &&
+                          h.hierarchy_features <= m->size / 16 && h.hierarchy_levels > 0 &&
+                          h.hierarchy_levels <= 64 && h.hierarchy_nodes >= h.hierarchy_features &&
+                          h.hierarchy_nodes <= m->size / sizeof(HierarchyNode) &&
+                          hierarchy_layout(h.hierarchy_offset, h.hierarchy_features,
+                                           h.hierarchy_levels, h.hierarchy_nodes)
+                                  .end == h.file_size;
   if (h.item_count >= (1ull << 32) || h.block_count != expect_blocks ||
       h.slot_count != expect_slots || h.blocks_offset % kAlign != 0 ||
       !fits(h.name_offset, h.name_size, 1) ||
       !fits(h.blocks_offset, h.block_count, sizeof(Block)) ||
       !fits(h.items_offset, h.slot_count, 4) || !fits(h.records_offset, h.item_count, 16) ||
-      !chunks_fit)
+      !chunks_fit || !hierarchies_fit)
     throw refuse("corrupt index file (inconsistent sizes)");
   // The name and the checksum table are read now; the data only where a query reads it.
   if (h.front_checksum !=
@@ -467,9 +558,27 @@ Sidecar Sidecar::open(const std::string& path) {
   const auto* items = reinterpret_cast<const std::uint32_t*>(m->data + h.items_offset);
   s.records_ = {reinterpret_cast<const ItemRecord*>(m->data + h.records_offset),
                 std::size_t(h.item_count)};
+  s.items_ = {items, std::size_t(h.slot_count)};
   s.tree_ = PackedRTree2::adopt(std::size_t(h.item_count), Packing(h.packing),
-                                {blocks, std::size_t(h.block_count)},
-                                {items, std::size_t(h.slot_count)}, check, check.get());
+                                {blocks, std::size_t(h.block_count)}, s.items_, check, check.get());
+  if (hierarchical) {
+    const HierarchyLayout l = hierarchy_layout(h.hierarchy_offset, h.hierarchy_features,
+                                               h.hierarchy_levels, h.hierarchy_nodes);
+    auto x = std::make_shared<MappedHierarchies>();
+    x->features = std::size_t(h.hierarchy_features);
+    x->levels = h.hierarchy_levels;
+    x->nodes = std::size_t(h.hierarchy_nodes);
+    x->fids = reinterpret_cast<const std::int64_t*>(m->data + l.fids);
+    x->level_sizes = reinterpret_cast<const std::uint64_t*>(m->data + l.sizes);
+    x->roots = reinterpret_cast<const HierarchyRoot*>(m->data + l.roots);
+    x->nodes_at = reinterpret_cast<const HierarchyNode*>(m->data + l.nodes);
+    x->path = path;
+    x->root_blocks = {reinterpret_cast<const Block*>(m->data + l.root_blocks),
+                      std::size_t(l.root_block_count)};
+    x->root_items = {reinterpret_cast<const std::uint32_t*>(m->data + l.root_items),
+                     std::size_t(l.root_slots)};
+    s.hierarchies_ = std::move(x);
+  }
   s.check_ = check;
   return s;
 }

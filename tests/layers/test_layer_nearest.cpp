@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <numbers>
 #include <random>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "loci/geom/predicates.hpp"
+#include "loci/io/commands.hpp"
 #include "loci/io/exact.hpp"
 #include "loci/io/layer_query.hpp"
 #include "loci/io/sidecar.hpp"
@@ -161,6 +163,179 @@ TEST(LayerNearest, InterleavedFeaturesFromASidecar) {
   check(index, l, 13);
 }
 
+using Levels = std::vector<std::vector<HierarchyNode>>;
+using Tamper = std::function<void(Levels&, std::vector<HierarchyRoot>&)>;
+
+// Writes a per-segment sidecar of `items` at `path` with the features' hierarchies stored, as
+// loci index writes it; `tamper` may change a copy of their nodes and roots first (the file's
+// checksums then hold for what it wrote: a forged file).
+void write_with_hierarchies(const LayerItems& items, const std::string& path,
+                            const Tamper& tamper = {}) {
+  const PackedRTree2 tree = PackedRTree2::build(items.boxes);
+  const LayerIndex::Features f = LayerIndex::build_features(&tree, Per::segment, items.records);
+  ASSERT_TRUE(f.hierarchical);
+  Levels levels;
+  for (const auto& l : f.levels)
+    levels.emplace_back(l.begin(), l.end());
+  std::vector<HierarchyRoot> roots(f.roots.begin(), f.roots.end());
+  if (tamper) tamper(levels, roots);
+  Hierarchies h{f.fid, {}, roots, &f.root_tree};
+  for (const auto& l : levels)
+    h.levels.emplace_back(l);
+  SidecarInfo info;
+  info.per = Per::segment;
+  info.layer_name = items.layer_name;
+  info.has_polygons = items.has_polygons;
+  info.items = items.boxes.size();
+  info.bounds = tree.bounds();
+  write_sidecar(path, tree, items.records, info, &h);
+}
+
+std::string scratch(const char* name) {
+  return "/tmp/loci-" + std::string(name) + "-" + std::to_string(::getpid()) + ".loci";
+}
+
+// The hierarchies stored by loci index are read in place (nothing is built) and answer as
+// those built in memory do.
+TEST(LayerNearest, StoredHierarchiesAnswerAsBuiltOnes) {
+  for (const auto& [features, steps] : {std::pair{40, 200}, std::pair{2000, 3}}) {
+    const Layer l = interleaved(features, steps, 6);
+    const std::string path = scratch("stored");
+    write_with_hierarchies(l.items, path);
+    const LayerIndex index = LayerIndex::adopt(Sidecar::open(path));
+    ::unlink(path.c_str());
+    const LayerIndex::Features& f = index.features();
+    ASSERT_TRUE(f.hierarchical);
+    EXPECT_NE(f.check, nullptr) << "built instead of read from the file";
+    EXPECT_TRUE(f.own_levels.empty());
+    check(index, l, 13);
+  }
+}
+
+// A file whose hierarchies are forged with valid checksums (indices out of range, a node of
+// more than 16 children, a feature beyond the FIDs) is refused when a query reads the bad
+// node, with a message naming the file, and never followed outside the arrays.
+TEST(LayerNearest, ForgedHierarchiesAreRefusedWhenRead) {
+  const Layer l = interleaved(40, 200, 16);
+  const std::vector<std::pair<const char*, Tamper>> forgeries = {
+      {"leaf out of range",
+       [](Levels& levels, std::vector<HierarchyRoot>&) {
+         for (auto& n : levels[0])
+           n.first = n.last = 1u << 30;
+       }},
+      {"feature out of range",
+       [](Levels& levels, std::vector<HierarchyRoot>&) {
+         for (auto& n : levels[0])
+           n.feature = 1u << 20;
+       }},
+      {"children beyond the level below",
+       [](Levels& levels, std::vector<HierarchyRoot>&) {
+         for (auto& n : levels[1])
+           n.last = std::uint32_t(levels[0].size()) + 1;
+       }},
+      {"seventeen children",
+       [](Levels& levels, std::vector<HierarchyRoot>&) {
+         for (auto& n : levels[1])
+           n.last = std::min(n.first + 17, std::uint32_t(levels[0].size()));
+       }},
+      {"root out of range",
+       [](Levels&, std::vector<HierarchyRoot>& roots) {
+         for (auto& r : roots)
+           r.node = 1u << 30;
+       }},
+      {"root of no level",
+       [](Levels&, std::vector<HierarchyRoot>& roots) {
+         for (auto& r : roots)
+           r.level = 70;
+       }},
+  };
+  for (const auto& [what, tamper] : forgeries) {
+    const std::string path = scratch("forged");
+    write_with_hierarchies(l.items, path, tamper);
+    const LayerIndex index = LayerIndex::adopt(Sidecar::open(path));
+    LayerQuery query(index, "", "");
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> near(-5, 105);
+    std::size_t refused = 0;
+    for (int i = 0; i < 40; ++i) {
+      Query q;
+      q.kind = Query::Kind::nearest;
+      q.point = {near(rng), near(rng)};
+      q.k = 1 + i % 5;
+      std::vector<Answer> answers;
+      try {
+        query.run(q, 1, false, answers);
+      } catch (const Error& e) {
+        ++refused;
+        EXPECT_NE(std::string(e.what()).find(path + ": corrupt index file (feature hierarchies)"),
+                  std::string::npos)
+            << what << ": " << e.what();
+      }
+    }
+    EXPECT_EQ(refused, 40u) << what;
+    // loci check finds it too.
+    EXPECT_THROW(check_sidecar(path), Error) << what;
+    ::unlink(path.c_str());
+  }
+}
+
+// Hierarchies that stay within their arrays but are not those of the segments (two nodes'
+// boxes swapped) may answer wrongly; loci check compares them with the segments' and says so.
+TEST(LayerNearest, CheckComparesTheStoredHierarchiesWithTheSegments) {
+  const Layer l = interleaved(40, 200, 18);
+  const std::string path = scratch("check");
+  write_with_hierarchies(l.items, path);
+  EXPECT_NE(check_sidecar(path).find(": ok,"), std::string::npos);
+  write_with_hierarchies(l.items, path, [](Levels& levels, std::vector<HierarchyRoot>&) {
+    std::swap(levels[0][3].box, levels[0][levels[0].size() - 4].box);
+  });
+  try {
+    check_sidecar(path);
+    ADD_FAILURE() << "a hierarchy unlike the segments' passed loci check";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("feature hierarchies do not match"), std::string::npos)
+        << e.what();
+  }
+  ::unlink(path.c_str());
+}
+
+// Opening costs the same whatever the file's size for nearest-n too: one query verifies the
+// few chunks it reads (the hierarchies of the features near it, their leaves and records).
+TEST(LayerNearest, OneQueryReadsAFewChunksOfTheStoredHierarchies) {
+  // 400 features, each a walk of 300 segments within its own cell of a 20 x 20 grid.
+  Layer l;
+  l.items.per = Per::segment;
+  l.items.layer_name = "cells";
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> step(-1, 1);
+  for (int f = 0; f < 400; ++f) {
+    const double x0 = 10.0 * (f % 20), y0 = 10.0 * (f / 20);
+    Point2 p{x0 + 5, y0 + 5};
+    for (int i = 0; i < 300; ++i) {
+      const Point2 q{std::clamp(p[0] + step(rng), x0, x0 + 9),
+                     std::clamp(p[1] + step(rng), y0, y0 + 9)};
+      add_segment(l, f, p, q);
+      p = q;
+    }
+  }
+  const std::string path = scratch("chunks");
+  write_with_hierarchies(l.items, path);
+  const LayerIndex index = LayerIndex::adopt(Sidecar::open(path));
+  ::unlink(path.c_str());
+  LayerQuery query(index, "", "");
+  Query q;
+  q.kind = Query::Kind::nearest;
+  q.point = {50, 50};
+  q.k = 3;
+  std::vector<Answer> answers;
+  query.run(q, 1, false, answers);
+  ASSERT_EQ(answers.size(), 3u);
+  const loci::detail::LazyCheck* chunks = index.features().check;
+  ASSERT_NE(chunks, nullptr);
+  EXPECT_GT(chunks->chunks(), 100u);
+  EXPECT_LE(chunks->verified(), chunks->chunks() / 5) << "of " << chunks->chunks();
+}
+
 // Polygons per segment: features of one to three rings (star-shaped, vertices on an integer
 // grid so that rays from grid points run through vertices and along edges; a ring inside
 // another of the same feature is a hole by the even-odd rule), overlapping each other.
@@ -204,10 +379,23 @@ Polygons star_polygons(int features, std::uint64_t seed) {
   return l;
 }
 
+void check_polygons(const LayerIndex& index, const Polygons& l);
+
 TEST(LayerNearest, PolygonsHoldingThePointAreAtDistanceZero) {
   const Polygons l = star_polygons(120, 21);
   Polygons copy = l;
-  const LayerIndex index = LayerIndex::build(std::move(copy.items), Structure::packed_hilbert);
+  const LayerIndex memory = LayerIndex::build(std::move(copy.items), Structure::packed_hilbert);
+  // And the same through hierarchies stored in a sidecar.
+  const std::string path = scratch("stars");
+  write_with_hierarchies(l.items, path);
+  const LayerIndex stored = LayerIndex::adopt(Sidecar::open(path));
+  ::unlink(path.c_str());
+  ASSERT_NE(stored.features().check, nullptr);
+  for (const LayerIndex* from : {&memory, &stored})
+    check_polygons(*from, l);
+}
+
+void check_polygons(const LayerIndex& index, const Polygons& l) {
   const LayerIndex::Features& features = index.features();
   LayerQuery query(index, "", "");
   std::mt19937_64 rng(22);

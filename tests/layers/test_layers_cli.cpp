@@ -847,7 +847,15 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
     EXPECT_EQ(r.status, 1) << "cut at " << cut << ": " << r.err;
     EXPECT_EQ(r.err.rfind("loci: error: ", 0), 0u) << r.err;
   }
-  const std::string answer = run_loci(query).out;
+  put(good);
+  const CliRun intact = run_loci(query);
+  ASSERT_EQ(intact.status, 0) << intact.err;
+  const std::string answer = intact.out;
+  ASSERT_FALSE(answer.empty());
+  // Nearest-n reads the features' hierarchies the sidecar stores too.
+  const std::string nearest = "query " + layer + " --nearest 30,30 -k 3";
+  const std::string nearest_answer = run_loci(nearest).out;
+  ASSERT_FALSE(nearest_answer.empty());
   // One flipped byte anywhere: header, name, checksum table or data. The query reads the
   // chunks it needs and is refused when one of them is corrupt, or else answers exactly as
   // before; loci check reads everything and refuses every one.
@@ -865,6 +873,13 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
       EXPECT_EQ(r.status, 1) << "byte " << at;
       EXPECT_NE(r.err.find(sidecar), std::string::npos) << r.err;
     }
+    const CliRun n = run_loci(nearest);
+    if (n.status == 0) {
+      EXPECT_EQ(n.out, nearest_answer) << "byte " << at;
+    } else {
+      EXPECT_EQ(n.status, 1) << "byte " << at;
+      EXPECT_NE(n.err.find(sidecar), std::string::npos) << n.err;
+    }
     const CliRun c = run_loci("check " + sidecar);
     EXPECT_EQ(c.status, 1) << "byte " << at << ": " << c.out;
     EXPECT_NE(c.err.find(sidecar), std::string::npos) << c.err;
@@ -872,6 +887,11 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
   EXPECT_GT(refused, 4u);
   put(good + "extra");
   expect_error(query, "damaged index");
+  // A sidecar of the previous format (whose nearest-n built the hierarchies at every run).
+  std::string older = good;
+  older[8] = 2;
+  put(older);
+  expect_error(query, "index format version 2, this loci reads 3; run 'loci index' to rebuild it");
   put(good);
   EXPECT_EQ(run_loci(query).status, 0);
   const CliRun ok = run_loci("check " + sidecar);

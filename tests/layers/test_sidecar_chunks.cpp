@@ -1,4 +1,4 @@
-// The sidecar's data is verified chunk by chunk as queries read it (format 2): opening reads
+// The sidecar's data is verified chunk by chunk as queries read it (format 3): opening reads
 // nothing of the data, a small query verifies a few chunks of many, a flipped byte anywhere in
 // the data is refused exactly when its chunk is read and never answers, verify() (loci check)
 // finds every one, and answers from an intact file equal the in-memory tree's.

@@ -217,6 +217,12 @@ class PackedRTree {
   // The boxes of the items at packed positions [b * NodeSize, (b + 1) * NodeSize), leaf b
   // (slots past size() hold the empty box), read at once.
   const Block& leaf(std::size_t b) const { return block(0, b); }
+  // Announces that leaf b < level(0).blocks and its item indices will be read soon (nothing
+  // is read or verified now).
+  void prefetch_leaf(std::size_t b) const {
+    blocks_[level(0).first_block + b].prefetch();
+    __builtin_prefetch(items_ + b * NodeSize);
+  }
   // The box of entry e < level(l).entries of level l (level 0: box_at(e)).
   Box<D> entry_box(int l, std::size_t e) const {
     return block(l, e / NodeSize).box(int(e % NodeSize));

@@ -137,33 +137,97 @@ class LayerIndex {
   }
   // The features of the index numbered densely (0, 1, ... in order of first appearance), so
   // that per-query state is a flat array: the FID of every feature and, except for a packed
-  // tree per segment, the feature of every item (of_item). For a
-  // packed tree per segment, instead one hierarchy of boxes per feature over its entries: a
-  // level-0 node is the part of one leaf of the tree that belongs to one feature (bounded by
-  // the leaf's box; an entry of the leaf is the feature's when its record has the feature's
-  // FID), a level-l node groups up to 16 level-(l - 1) nodes of one feature, and `roots`
-  // names each feature's top node. Nearest-n walks these: no node mixes features, so a feature
-  // is measured without reading any other's segments. Built on first use, once for all
-  // threads.
+  // tree per segment, the feature of every item (of_item). For a packed tree per segment,
+  // instead one hierarchy of boxes per feature over its entries: a level-0 node is the part of
+  // one leaf of the tree that belongs to one feature (bounded by the leaf's box; an entry of
+  // the leaf is the feature's when its record has the feature's FID), a level-l node groups up
+  // to 16 level-(l - 1) nodes of one feature, and `roots` names each feature's top node.
+  // Nearest-n walks these: no node mixes features, so a feature is measured without reading
+  // any other's segments. A sidecar stores them (sidecar.hpp), and they are read in place as
+  // the tree is, each node checked as it is read (so that a forged file cannot lead a walk
+  // outside the mapping); otherwise they are built on first use, once for all threads.
   struct Features {
     static constexpr std::uint32_t none = 0xffffffffu;
+    using Node = HierarchyNode;
     bool hierarchical = false;  // a packed tree per segment: levels and roots, no of_item
-    struct Node {
-      Box2 box;
-      std::uint32_t feature;
-      std::uint32_t first, last;  // level 0: the leaf; above: its nodes one level down
-    };
-    std::span<const ItemRecord> records;   // every record, verified (records() once)
-    std::span<const std::uint32_t> items;  // a packed tree's item_indices(), verified
+    // Every record: verified whole, or with stored hierarchies as mapped (read through
+    // record()).
+    std::span<const ItemRecord> records;
+    const PackedRTree2* tree = nullptr;  // hierarchical: the index's tree
+    // Hierarchical: the tree's item indices (PackedRTree2::item_indices()), read through
+    // leaf_items().
+    std::span<const std::uint32_t> items;
     loci::detail::LargeVector<std::uint32_t> of_item;
-    std::vector<std::int64_t> fid;
-    std::unordered_map<std::int64_t, std::uint32_t> number;  // fid -> feature
-    std::vector<loci::detail::LargeVector<Node>> levels;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> roots;  // (level, node) per feature
+    std::span<const std::int64_t> fid;                       // read through fid_of()
+    std::unordered_map<std::int64_t, std::uint32_t> number;  // fid -> feature; not hierarchical
+    std::vector<std::span<const Node>> levels;               // read through node()
+    std::span<const HierarchyRoot> roots;                    // read through root()
     // A packed tree over the roots' boxes (entry r: roots[r]), so that a query meets only
     // the features near it, however many the layer has.
     PackedRTree2 root_tree;
+
+    // Node i of `level`, checked: its feature, and its leaf or the range of its children
+    // (at most 16), lie within the arrays. Throws loci::Error for a corrupt file.
+    // `touched`: the node was read already (as one of children()).
+    [[gnu::always_inline]] const Node& node(std::uint32_t level, std::uint32_t i,
+                                            bool touched = false) const {
+      if (level >= levels.size() || i >= levels[level].size()) corrupt();
+      const Node& n = levels[level][i];
+      if (check && !touched) check->touch(&n, sizeof n);
+      const bool fits = n.feature < fid.size() &&
+                        (level == 0 ? n.first == n.last && n.first < leaves
+                                    : n.first < n.last && n.last <= levels[level - 1].size() &&
+                                          n.last - n.first <= PackedRTree2::node_size);
+      if (!fits) corrupt();
+      return n;
+    }
+    // The children of n, a node of level > 0 given by node() (their boxes may be read; the
+    // nodes themselves are checked when node() gives them).
+    [[gnu::always_inline]] std::span<const Node> children(const Node& n,
+                                                          std::uint32_t level) const {
+      const std::span<const Node> c = levels[level - 1].subspan(n.first, n.last - n.first);
+      if (check) check->touch(c.data(), c.size_bytes());
+      return c;
+    }
+    HierarchyRoot root(Id r) const {
+      if (r >= roots.size()) corrupt();
+      if (check) check->touch(&roots[r], sizeof(HierarchyRoot));
+      return roots[r];
+    }
+    std::int64_t fid_of(std::uint32_t f) const {
+      if (check) check->touch(&fid[f], sizeof(std::int64_t));
+      return fid[f];
+    }
+    // The item indices of leaf b < leaves, the 16 slots of its packed positions.
+    [[gnu::always_inline]] const std::uint32_t* leaf_items(std::size_t b) const {
+      const std::uint32_t* at = items.data() + b * PackedRTree2::node_size;
+      if (check) check->touch(at, PackedRTree2::node_size * sizeof(std::uint32_t));
+      return at;
+    }
+    // The record of item `id`, or null for an id out of range (a corrupt index).
+    [[gnu::always_inline]] const ItemRecord* record(Id id) const {
+      if (id >= records.size()) return nullptr;
+      if (check) check->touch(&records[id], sizeof(ItemRecord));
+      return &records[id];
+    }
+    // The arrays as write_sidecar stores them.
+    Hierarchies stored() const { return {fid, levels, roots, &root_tree}; }
+
+    const loci::detail::LazyCheck* check = nullptr;  // stored: what is read is touched first
+    std::size_t leaves = 0;                          // hierarchical: the tree's leaves
+    std::string path;                                // stored: the sidecar, for messages
+    // What fid, levels and roots view when they are built here.
+    std::vector<std::int64_t> own_fid;
+    std::vector<loci::detail::LargeVector<Node>> own_levels;
+    std::vector<HierarchyRoot> own_roots;
+
+    // Throws loci::Error: the stored hierarchies are inconsistent.
+    [[noreturn]] void corrupt() const;
   };
+  // The hierarchies of a packed tree per segment over `records` (hierarchical is false
+  // otherwise), built; `tree` must outlive them.
+  static Features build_features(const PackedRTree2* tree, Per per,
+                                 std::span<const ItemRecord> records);
   const Features& features() const;
 
  private:
@@ -183,6 +247,8 @@ class LayerIndex {
   }
   struct LazyFeatures;
   std::shared_ptr<LazyFeatures> features_;
+  std::shared_ptr<const MappedHierarchies> stored_;  // a sidecar's hierarchies
+  std::span<const std::uint32_t> mapped_items_;      // and its tree's item indices
 };
 
 // Features of a per-segment index whose polygons contain p by the even-odd rule over all rings

@@ -1,20 +1,34 @@
 // The sidecar index file (`LAYER.loci`, DESIGN.md section 7): a packed R-tree over a layer's
 // features or segments, saved so that later queries map it into memory and search it in place.
 //
-// Layout (little-endian, every offset a multiple of 64 from the start of the file), format 2:
+// Layout (little-endian, every offset a multiple of 64 from the start of the file), format 3:
 //
 //   0    header, 256 bytes (SidecarHeader in sidecar.cpp): magic "\x89LOCI\r\n\x1a", format
 //        version, byte-order mark, structure kind, packing, coordinate type, granularity (per
 //        feature or per segment), dimension, node size, item and block counts, the offsets and
 //        sizes of the sections, the layer's bounds, the source fingerprint, the chunk size and
-//        count, a checksum of the name and checksum table, and last a checksum of the header
-//        bytes before it
+//        count, a checksum of the name and checksum table, the offset and counts (features,
+//        levels, nodes) of the hierarchies, and last a checksum of the header bytes before it
 //   256  the layer name (UTF-8, not terminated)
 //   ...  the checksum table: XXH3-64 (seed 0) of each 64 KiB chunk of the data below, the last
 //        chunk shorter; chunk c is [data + c * 65536, min(data + (c + 1) * 65536, file end))
 //   data blocks: the tree's nodes exactly as PackedRTree::blocks() holds them (SoA doubles)
 //   ...  item indices: PackedRTree::item_indices(), 32-bit, one per slot of level 0
 //   ...  records: one 16-byte ItemRecord per item (fid, part, flags), indexed by item id
+//   ...  per segment only, the features' hierarchies that nearest-n walks (layer_query.hpp,
+//        LayerIndex::Features), each array from a 64-byte boundary: the FID of every feature
+//        (int64), the node count of every level (uint64), the roots (HierarchyRoot: level and
+//        node, one per feature), the nodes of every level, level 0 first (HierarchyNode, 48
+//        bytes: box, feature, first, last, zero), and a packed tree over the roots' boxes
+//        (blocks, then item indices, as above; its entry r is root r)
+//
+// The hierarchies are what `loci index` builds from the tree and the records; storing them
+// lets nearest-n start at once instead of reading every record to build them, for about a
+// tenth more file on a coastline layer (the README has figures). Like the rest of the data they are
+// read in place and verified chunk by chunk; every node is checked as it is read (its feature, and
+// its leaf or its children, at most 16, within the arrays), so a file forged with valid checksums
+// is refused rather than followed outside the mapping, and `loci check` compares them with the ones
+// the tree and records give.
 //
 // Every checksum is XXH3-64 with seed 0 (libxxhash), so that others can check a file. The
 // magic's first byte has the high bit set and it holds CR LF and ^Z, so that text-mode
@@ -27,7 +41,8 @@
 // chunk is read and never answers; `loci check` verifies every chunk and the tree's invariants.
 // Item ids read from the file are bounds-checked where they index the records, so even a file
 // forged with valid checksums cannot make a query read outside the mapping. Format 1 (one
-// checksum over the whole payload, hashed on every open) is refused with the usual message.
+// checksum over the whole payload, hashed on every open) and format 2 (no hierarchies: every
+// nearest-n run read all the records to build them) are refused with the usual message.
 //
 // Fingerprint. The index is valid for the exact bytes it was built from: at index time the
 // source's size, modification time (nanoseconds), inode and a 64-bit XXH3 hash of its contents
@@ -47,6 +62,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "loci/geom/segment.hpp"
 #include "loci/index/detail/lazy_check.hpp"
@@ -82,6 +98,32 @@ inline std::uint32_t segment_flags(const Point2& a, const Point2& b, bool ring) 
 
 // Granularity of an index: one entry per feature, or one per segment of the linework.
 enum class Per : std::uint8_t { feature = 0, segment = 1 };
+
+// The hierarchies of boxes of a per-segment index, one per feature, that nearest-n walks
+// (layer_query.hpp, LayerIndex::Features, says what they are). Nodes and roots are stored as is.
+struct HierarchyNode {
+  Box2 box;
+  std::uint32_t feature;      // the feature's number, an index into the FIDs
+  std::uint32_t first, last;  // level 0: the leaf of the tree (first == last); above: the
+                              // nodes [first, last) of the level below
+  std::uint32_t zero = 0;     // padding, written as 0
+};
+static_assert(sizeof(HierarchyNode) == 48);
+
+struct HierarchyRoot {
+  std::uint32_t level, node;
+};
+static_assert(sizeof(HierarchyRoot) == 8);
+
+// The hierarchies as arrays (what write_sidecar stores and Sidecar::hierarchies maps): the FID
+// of every feature, the nodes level by level, and the roots, one per feature, with a packed
+// tree over the roots' boxes whose entry r is roots[r].
+struct Hierarchies {
+  std::span<const std::int64_t> fids;
+  std::vector<std::span<const HierarchyNode>> levels;
+  std::span<const HierarchyRoot> roots;
+  const PackedRTree2* root_tree = nullptr;
+};
 
 struct Fingerprint {
   std::uint64_t size = 0;     // bytes
@@ -145,8 +187,25 @@ struct SidecarInfo {
 };
 
 // Throws loci::Error when the file cannot be written (the target is left untouched).
+// `hierarchies` (a per-segment index's, or null) are stored with the tree.
 void write_sidecar(const std::string& path, const PackedRTree2& tree,
-                   std::span<const ItemRecord> records, const SidecarInfo& info);
+                   std::span<const ItemRecord> records, const SidecarInfo& info,
+                   const Hierarchies* hierarchies = nullptr);
+
+// The stored hierarchies of a sidecar, as mapped: nothing is read until it is used. The
+// arrays' sizes are checked against the file; their contents are not (the level sizes, the
+// nodes' indices): a reader checks what it reads, after check().touch() of it.
+struct MappedHierarchies {
+  std::size_t features = 0, levels = 0, nodes = 0;
+  const std::int64_t* fids = nullptr;
+  const std::uint64_t* level_sizes = nullptr;
+  const HierarchyRoot* roots = nullptr;
+  const HierarchyNode* nodes_at = nullptr;  // every level's nodes, level 0 first
+  // A packed tree over the roots (PackedRTree2::adopt() them).
+  std::span<const PackedRTree2::Block> root_blocks;
+  std::span<const std::uint32_t> root_items;
+  std::string path;  // the sidecar's, for messages
+};
 
 // A sidecar mapped into memory. Move-only; the tree and records stay valid while any copy of
 // keep_alive() does.
@@ -162,6 +221,10 @@ class Sidecar {
   std::span<const ItemRecord> records() const;
   // The records as mapped, unverified: read record i only after check().touch() of it.
   std::span<const ItemRecord> mapped_records() const { return records_; }
+  // The item indices as mapped, unverified, likewise.
+  std::span<const std::uint32_t> mapped_items() const { return items_; }
+  // The stored hierarchies (a per-segment index of at least one item), else null.
+  std::shared_ptr<const MappedHierarchies> hierarchies() const { return hierarchies_; }
   const loci::detail::LazyCheck& check() const { return *check_; }
   // Verifies every chunk and the tree's invariants; throws loci::Error naming the problem.
   void verify() const;
@@ -173,6 +236,8 @@ class Sidecar {
   SidecarInfo info_;
   PackedRTree2 tree_;
   std::span<const ItemRecord> records_;
+  std::span<const std::uint32_t> items_;
+  std::shared_ptr<const MappedHierarchies> hierarchies_;
   std::shared_ptr<const loci::detail::LazyCheck> check_;
 };
 

@@ -33,7 +33,7 @@ class LazyCheck {
   // Verifies the chunks holding [p, p + n) that were not verified yet. Bytes outside the
   // checked range are not this object's concern.
   // The common case, bytes within one chunk verified already, costs a few instructions.
-  void touch(const void* p, std::size_t n) const {
+  [[gnu::always_inline]] void touch(const void* p, std::size_t n) const {
     const auto* b = static_cast<const std::byte*>(p);
     if (b < base_ || n == 0) return;
     const std::size_t off = std::size_t(b - base_);
