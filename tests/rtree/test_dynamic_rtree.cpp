@@ -232,3 +232,24 @@ TYPED_TEST(DynamicRTreeTest, VisitorStopsEarly) {
   tree.nearest(Point<D>{}, 100, [&](Id, const Box<D>&, double) { return ++seen < 6; });
   EXPECT_EQ(seen, 6);
 }
+
+// Boxes 2e110 wide have a volume of inf in 3D, so every waste and enlargement the quadratic
+// split compares is inf or NaN; the split must still partition the node.
+TEST(DynamicRTree, QuadraticSplitWithInfiniteVolumes) {
+  RTree<3, QuadraticSplit> tree;
+  std::vector<Box<3>> boxes;
+  std::vector<Id> ids;
+  for (int i = 0; i < 200; ++i) {
+    const double c = (i % 7) * 1e109 - (i % 5) * 3e109;
+    const Box<3> b{{c - 1e110, c - 1e110, c - (i % 3) * 1e110}, {c + 1e110, c + 1e110, c + 1e110}};
+    tree.insert(b, Id(i));
+    boxes.push_back(b);
+    ids.push_back(Id(i));
+  }
+  ASSERT_NO_THROW(tree.validate());
+  ASSERT_EQ(tree.size(), boxes.size());
+  for (double x : {-2e110, 0.0, 1.5e110, 4e110}) {
+    const Box<3> w{{x, x, x}, {x, x, x}};
+    EXPECT_EQ(sorted(tree.query(w)), brute_window(boxes, ids, w, Relation::intersects));
+  }
+}

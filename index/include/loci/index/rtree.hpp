@@ -75,6 +75,9 @@ int distribute(Entry<D>* e, int n, int min_fill, int seed_a, int seed_b, PickNex
 struct QuadraticSplit {
   template <int D>
   static int split(Entry<D>* e, int n, int min_fill) {
+    // Contents of large boxes overflow to inf, and inf - inf is NaN, which compares greater
+    // than nothing: the seeds then stay the first pair and pick_next falls back to the first
+    // unassigned entry, so the split is still a partition, just not Guttman's choice.
     int sa = 0, sb = 1;
     double worst = -std::numeric_limits<double>::infinity();
     for (int i = 0; i < n; ++i)
@@ -88,6 +91,7 @@ struct QuadraticSplit {
       double pref = -1;
       for (int i = 0; i < n; ++i) {
         if (assigned[i]) continue;
+        if (best < 0) best = i;
         const double d =
             std::fabs(detail::enlargement(a, e[i].box) - detail::enlargement(b, e[i].box));
         if (d > pref) pref = d, best = i;
