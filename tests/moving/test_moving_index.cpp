@@ -376,5 +376,66 @@ TEST(StarTree, RegroupsAsNodesDeteriorate) {
   EXPECT_THROW(StarTree<2>(StarParams<2>{1.0, 30, true}), InvalidArgument);
 }
 
+// Reports within the accepted range, spread so widely that the costs of 3D boxes overflow to
+// inf (and to NaN where an infinite area meets a zero speed): choosing paths, reinserting and
+// splitting still make a valid tree whose answers are those of a scan.
+template <class Tree>
+void check_overflowing_costs() {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-1, 1);
+  double now = 100;
+  const auto report = [&](double p, double v) {
+    return Motion<3>{
+        now, {u(rng) * p, u(rng) * p, u(rng) * p}, {u(rng) * v, u(rng) * v, u(rng) * v}};
+  };
+  Tree tree;
+  std::unordered_map<Id, Motion<3>> objs;
+  for (Id id = 0; id < 200; ++id) {
+    objs[id] = report(1e110, 0);
+    ASSERT_NO_THROW(tree.insert(id, objs[id]));
+  }
+  for (int i = 0; i < 1500; ++i) {
+    const Id id = rng() % 300;
+    if (rng() % 3 == 0) {
+      EXPECT_EQ(tree.erase(id), objs.erase(id) == 1);
+    } else {
+      objs[id] = report(1e140, 1e138);
+      ASSERT_NO_THROW(tree.update(id, objs[id]));
+    }
+    if (i % 50 == 0) now += 1;
+  }
+  ASSERT_NO_THROW(tree.validate());
+  ASSERT_EQ(tree.size(), objs.size());
+  for (int q = 0; q < 20; ++q) {
+    const double s = now + q % 4;
+    const Point<3> c{u(rng) * 1e140, u(rng) * 1e140, u(rng) * 1e140};
+    const Box<3> b{{c[0] - 6e139, c[1] - 6e139, c[2] - 6e139},
+                   {c[0] + 6e139, c[1] + 6e139, c[2] + 6e139}};
+    const MovingWindow<3> w =
+        q % 2 ? MovingWindow<3>::during(b, s, s + 3) : MovingWindow<3>::at(b, s);
+    std::vector<Id> got = tree.query(w), want;
+    for (const auto& [id, m] : objs)
+      if (inside(m, w)) want.push_back(id);
+    std::sort(got.begin(), got.end());
+    std::sort(want.begin(), want.end());
+    ASSERT_EQ(got, want) << "query " << q;
+    std::vector<double> d;
+    for (const auto& [id, m] : objs)
+      d.push_back(std::sqrt(squared_distance(position(m, s), c)));
+    std::sort(d.begin(), d.end());
+    const auto near = tree.nearest(c, s, 10);
+    ASSERT_EQ(near.size(), 10u);
+    for (std::size_t i = 0; i < near.size(); ++i)
+      EXPECT_DOUBLE_EQ(near[i].distance, d[i]) << "nearest " << q << " rank " << i;
+  }
+}
+
+TEST(TprTree, CostsOverflowingInThreeDimensions) {
+  check_overflowing_costs<TprTree<3>>();
+}
+TEST(StarTree, CostsOverflowingInThreeDimensions) {
+  check_overflowing_costs<StarTree<3>>();
+}
+
 }  // namespace
 }  // namespace loci

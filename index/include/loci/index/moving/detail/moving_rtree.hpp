@@ -562,6 +562,11 @@ class MovingRTree {
   // it least. Partial paths wait in a heap by their cost so far; the children of a node just
   // above the target level are candidates, compared with the best found (minpen), and the
   // search ends when no waiting path is cheaper than it.
+  //
+  // Costs of boxes spread over more than about 1e102 in 3D overflow to inf (the rises are
+  // never NaN: enlargements() clamps them with std::max), and inf is not less than the initial
+  // minpen. Until a candidate is found, paths are therefore followed and candidates taken
+  // whatever their cost, so that there is always an answer: the first cheapest one met.
   std::uint32_t choose_path(const Box_& b, int level) {
     if (nodes_[root_].level == level) return root_;
     struct Waiting {
@@ -579,7 +584,7 @@ class MovingRTree {
       std::pop_heap(heap.begin(), heap.end());
       const Waiting top = heap.back();
       heap.pop_back();
-      if (!(top.key < minpen)) break;
+      if (best != kNone && !(top.key < minpen)) break;
       const Node& n = nodes_[top.node];
       ++explored;
       const bool last = n.level == level + 1;
@@ -587,7 +592,7 @@ class MovingRTree {
       enlargements(n, b, rise);
       for (int e = 0; e < n.count; ++e) {
         const double pen = top.key + rise[e];
-        if (!(pen < minpen)) continue;
+        if (best != kNone && !(pen < minpen)) continue;
         if (last) {
           minpen = pen;
           best = n.child[e];
@@ -663,19 +668,22 @@ class MovingRTree {
   }
 
   // Pick_Worst: removes the entries whose absence shrinks the node's cost most and reinserts
-  // them.
+  // them. Costs that overflow to inf (or NaN, from inf * 0) gain nothing: when no order does
+  // better, the first is taken.
   void pick_worst(std::uint32_t n, std::uint32_t& reinserted) {
     Node& node = nodes_[n];
     const int total = node.count;
     const int taken = std::max(1, int(0.3 * total));
     std::uint8_t order[M + 1], best_order[M + 1];
     double best_gain = -std::numeric_limits<double>::infinity();
+    bool chosen = false;
     for (int k = 0; k < 4 * D; ++k)
       for (bool descending : {true, false}) {
         order_by(node, k, descending, order);
         const double rest = cost(union_of(node, order, taken, total));
-        const double gain = -rest;
-        if (gain > best_gain) {
+        const double gain = std::isnan(rest) ? -std::numeric_limits<double>::infinity() : -rest;
+        if (!chosen || gain > best_gain) {
+          chosen = true;
           best_gain = gain;
           std::copy(order, order + total, best_order);
         }
@@ -703,6 +711,8 @@ class MovingRTree {
       nodes_[nodes_[x].parent].box[slot_in_parent(x)] = bound(nodes_[x]);
   }
 
+  // Splits n along the sort order and cut of least summed cost. Costs that overflow to inf (or
+  // NaN, from inf * 0) are the worst: when no distribution does better, the first is taken.
   void split(std::uint32_t n, std::uint32_t& reinserted) {
     Node& node = nodes_[n];
     const int total = node.count;
@@ -719,8 +729,9 @@ class MovingRTree {
       for (int e = total - 2; e >= 0; --e)
         (suffix[e] = suffix[e + 1]).enclose(node.box[order[e]], rel_clock());
       for (int cut = kMinFill; cut <= total - kMinFill; ++cut) {
-        const double c = cost(prefix[cut - 1]) + cost(suffix[cut]);
-        if (c < best) {
+        double c = cost(prefix[cut - 1]) + cost(suffix[cut]);
+        if (std::isnan(c)) c = std::numeric_limits<double>::infinity();
+        if (best_cut == 0 || c < best) {
           best = c;
           best_cut = cut;
           std::copy(order, order + total, best_order);
