@@ -131,6 +131,24 @@ TEST(GridJoinEdges, FlatExtentsAndBoxesSpanningEverything) {
   EXPECT_EQ(self_pairs(wide), brute_self_pairs(wide));
 }
 
+// Finite boxes further apart than a double reaches: max - min of the extent overflows on
+// both axes, yet the grid must still be a grid.
+TEST(GridJoinEdges, ExtentBeyondTheRangeOfDoubles) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Box<2>> boxes;
+  for (int i = 0; i < 3000; ++i) {
+    const double cx = (int(rng() % 3) - 1) * 1e308 * u(rng), cy = (int(rng() % 3) - 1) * 1e308;
+    const double wx = i % 50 == 0 ? 5e307 : 1e306 * u(rng), wy = 1e306 * u(rng);
+    boxes.push_back({{cx - wx, cy - wy}, {cx + wx, cy + wy}});
+  }
+  boxes.push_back({{-1.7e308, -1.7e308}, {-1.7e308, -1.7e308}});
+  boxes.push_back({{1.7e308, 1.7e308}, {1.7e308, 1.7e308}});
+  const std::vector<Box<2>> some(boxes.begin(), boxes.begin() + 500);
+  EXPECT_EQ(self_pairs(boxes), brute_self_pairs(boxes));
+  EXPECT_EQ(join_pairs(some, boxes), brute_join_pairs(some, boxes));
+}
+
 TEST(GridJoinEdges, StopsEarlyAndRefusesBadBoxes) {
   const auto boxes = make_boxes<2>(Shape::clustered, 3000, 9);
   std::size_t calls = 0;

@@ -115,6 +115,28 @@ TEST(SegmentIntersections, SpikeAlongItselfIsReportedAndNaNRefused) {
                InvalidGeometry);
 }
 
+// Segments whose boxes span more than a double reaches (the extent overflows on both axes).
+TEST(SegmentIntersections, ExtentBeyondTheRangeOfDoubles) {
+  Linework w = polylines(30, 8, 30, 9);
+  for (Segment2& s : w.segs)
+    for (Point2* p : {&s.a, &s.b})
+      for (int a = 0; a < 2; ++a)
+        (*p)[a] = ((*p)[a] - 15) * 1e307;
+  w.segs.push_back({{-1.7e308, -1.7e308}, {-1.7e308, -1.7e308}});
+  w.segs.push_back({{1.7e308, 1.7e308}, {1.7e308, 1.7e308}});
+  w.chain.push_back(30);
+  w.chain.push_back(31);
+  std::vector<Found> got;
+  segment_intersections(
+      std::span<const Segment2>(w.segs),
+      [&](Id i, Id j) { return j == i + 1 && w.chain[i] == w.chain[j]; },
+      [&](Id i, Id j, const SegmentIntersection& x) {
+        return got.push_back({i, j, x}), true;
+      });
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, brute_one_set(w));
+}
+
 TEST(SegmentIntersections, ThreadsGiveTheSameAnswersOnManyTiles) {
   // Enough segments for many tiles, with long ones crossing several, searched on 1 to 3
   // threads: the same pairs as brute force each time; a stop from one thread stops all.

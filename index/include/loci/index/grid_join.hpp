@@ -53,7 +53,12 @@ class TileLists {
 
   TileLists(std::span<const Box<2>> boxes, const Box<2>& extent, std::size_t total) {
     const std::size_t tiles = std::max<std::size_t>(1, total / kBoxesPerTile);
-    const double w = extent.max[0] - extent.min[0], h = extent.max[1] - extent.min[1];
+    // Half extents: finite boxes can lie further apart than a double reaches, and an extent of
+    // inf would make the grid NaN tiles wide. Halves never overflow and, above the denormals,
+    // give the same ratios and scales as whole extents. A position whose distance from the
+    // extent's minimum overflows saturates in the last tile, as col() and row() clamp.
+    const double w = extent.max[0] / 2 - extent.min[0] / 2;
+    const double h = extent.max[1] / 2 - extent.min[1] / 2;
     if (w > 0 && h > 0) {
       const double nx = std::sqrt(double(tiles) * w / h);
       nx_ = std::uint32_t(std::clamp(std::round(nx), 1.0, 4096.0));
@@ -64,7 +69,7 @@ class TileLists {
       ny_ = std::uint32_t(std::clamp<std::size_t>(tiles, 1, 1 << 16));
     }
     x0_ = extent.min[0], y0_ = extent.min[1];
-    sx_ = w > 0 ? nx_ / w : 0, sy_ = h > 0 ? ny_ / h : 0;
+    sx_ = w > 0 ? nx_ / 2.0 / w : 0, sy_ = h > 0 ? ny_ / 2.0 / h : 0;
     // Count the listings; give up on tiling when boxes span too many tiles.
     start_.assign(std::size_t(nx_) * ny_ + 1, 0);
     std::size_t listed = 0;
