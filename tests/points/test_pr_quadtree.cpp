@@ -144,6 +144,23 @@ TEST(QuadDynamic, ChurnIdenticalOctree) {
   churn<3>(PointShape::identical, 1, 6);
 }
 
+// Points on the axis y = 0, or all at the origin: build() widens the region by one ulp of
+// zero (4.9e-324), an extent whose Hilbert scale would overflow.
+TEST(PrQuadtree, BuildOnAnAxisOrAtTheOrigin) {
+  std::mt19937_64 rng(15);
+  std::uniform_real_distribution<double> u(0, 1000);
+  std::vector<Point2> axis, origin(50, Point2{0, 0});
+  for (int i = 0; i < 500; ++i)
+    axis.push_back({u(rng), 0});
+  for (const auto& pts : {axis, origin})
+    for (std::uint32_t bucket : {1u, 8u}) {
+      const auto tree = PrQuadtree2::build(pts, bucket);
+      tree.validate();
+      ASSERT_EQ(tree.size(), pts.size());
+      check_queries(tree, pts, 16);
+    }
+}
+
 TEST(PrQuadtree, CoincidentPointsShareOneLeaf) {
   PrQuadtree2 tree(Box2{{0, 0}, {1, 1}});
   for (int i = 0; i < 1000; ++i)

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "loci/index/detail/hilbert.hpp"
@@ -75,6 +76,30 @@ TEST(Hilbert, FullRangeKeysAreDistinctAndBounded) {
   }
   EXPECT_EQ(hilbert_key_2d(0, 0), 0u);
   EXPECT_EQ(hilbert_key_2d(0xffff, 0), (std::uint64_t(1) << 32) - 1);  // ends at the far x corner
+}
+
+// The grid's cells whatever its extent: wider than a double reaches (max - min overflows),
+// narrower than 65535 / DBL_MAX (65535 / extent overflows), flat; points outside it or NaN go to
+// its border cells. Extents are powers of two, so that the cells are exact.
+TEST(Hilbert, GridOverExtremeExtents) {
+  const auto cells = [](std::uint32_t x, std::uint32_t y) { return hilbert_key_2d(x, y); };
+  const double big = 0x1p1023, tiny = 0x1p-1010;
+  const HilbertGrid<2> wide(Box2{{-big, -big}, {big, big}});
+  EXPECT_EQ(wide.key({-big, -big}), cells(0, 0));
+  EXPECT_EQ(wide.key({big, big}), cells(0xffff, 0xffff));
+  EXPECT_EQ(wide.key({0, -big / 2}), cells(0x7fff, 0x3fff));
+  const HilbertGrid<2> narrow(Box2{{0, 0}, {tiny, 1}});
+  EXPECT_EQ(narrow.key({0, 0}), cells(0, 0));
+  EXPECT_EQ(narrow.key({tiny, 1}), cells(0xffff, 0xffff));
+  EXPECT_EQ(narrow.key({tiny / 2, 0.25}), cells(0x7fff, 0x3fff));
+  EXPECT_EQ(narrow.key({-1, 2}), cells(0, 0xffff));
+  EXPECT_EQ(narrow.key({std::nan(""), 0}), cells(0, 0));
+  // A line of points whose region is widened by one ulp (PrQuadtree::build): the flat axis.
+  const HilbertGrid<2> line(Box2{{0, 0}, {8, 0x1p-1074}});
+  EXPECT_EQ(line.key({8, 0x1p-1074}), cells(0xffff, 0));
+  const HilbertGrid<3> wide3(Box3{{-big, -big, -big}, {big, big, big}});
+  std::uint32_t corner[3] = {(1u << 21) - 1, (1u << 21) - 1, (1u << 21) - 1};
+  EXPECT_EQ(wide3.key({big, big, big}), hilbert_key<3>(corner));
 }
 
 TEST(RadixSort, MatchesStableSort) {

@@ -2,6 +2,7 @@
 // clustered and degenerate data, every window relation and nearest-n.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <random>
 #include <thread>
@@ -113,6 +114,32 @@ TEST(PackedRTree, ContainedNodesAreReportedWithoutTests) {
   EXPECT_EQ(n, boxes.size());
   EXPECT_EQ(all.results, boxes.size());
   EXPECT_EQ(all.nodes_visited, 1u);  // the root: every child lies inside the window
+}
+
+// Hilbert packing of a shuffled row of points whose centres overflow (min + max beyond
+// DBL_MAX) or spread over less than 65535 / DBL_MAX: the packing still follows the row, so a
+// window around one point reads one path, and answers are exact.
+TEST(PackedRTree, HilbertPackingOfExtremeCentres) {
+  for (const auto [x0, step] : {std::pair{1e308, 1.6e304}, std::pair{1e-300, 5e-308}}) {
+    std::vector<Box2> boxes;
+    for (int i = 0; i < 4096; ++i)
+      boxes.push_back(Box2::of_point({x0 + i * step, 1}));
+    std::shuffle(boxes.begin(), boxes.end(), std::mt19937_64(12));
+    std::vector<Id> ids(boxes.size());
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      ids[i] = i;
+    const auto tree = PackedRTree<2>::build(boxes);
+    tree.validate();
+    for (int i : {0, 1000, 4095}) {
+      const double x = x0 + i * step;
+      const Box2 w{{x - step / 4, 0}, {x + step / 4, 2}};
+      std::size_t n = 0;
+      const auto st = tree.query(w, [&](Id, const Box2&) { return ++n, true; });
+      EXPECT_EQ(n, 1u);
+      EXPECT_LE(st.nodes_visited, 6u) << x0;
+      EXPECT_EQ(sorted(tree.query(w)), brute_window(boxes, ids, w, Relation::intersects));
+    }
+  }
 }
 
 TEST(PackedRTree, VisitorStopsEarly) {

@@ -345,22 +345,30 @@ PackedRTree<D, NodeSize>::PackedRTree(std::span<const Box<D>> boxes, Packing pac
 template <int D, int NodeSize>
 void PackedRTree<D, NodeSize>::order_hilbert(std::span<const Box<D>> boxes,
                                              std::uint32_t* order) const {
+  // Centres as the sum of halves: min + max of boxes beyond 9e307 overflows, and the same
+  // centre otherwise.
+  const auto centre = [](const Box<D>& b) {
+    Point<D> c;
+    for (int a = 0; a < D; ++a)
+      c[a] = b.min[a] / 2 + b.max[a] / 2;
+    return c;
+  };
   Box<D> extent = Box<D>::empty();
   for (const auto& b : boxes)
-    extent.expand(b.center());
+    extent.expand(centre(b));
   const detail::HilbertGrid<D> grid(extent);
   if constexpr (D == 2) {
     // 32-bit keys: key and index share one 64-bit word, halving the sort's memory traffic.
     std::vector<std::uint64_t> keyed(boxes.size());
     for (std::size_t i = 0; i < boxes.size(); ++i)
-      keyed[i] = (grid.key(boxes[i].center()) << 32) | i;
+      keyed[i] = (grid.key(centre(boxes[i])) << 32) | i;
     detail::radix_sort(keyed, 32, 32, [](std::uint64_t v) { return v; });
     for (std::size_t i = 0; i < boxes.size(); ++i)
       order[i] = std::uint32_t(keyed[i]);
   } else {
     std::vector<detail::KeyedIndex> keyed(boxes.size());
     for (std::size_t i = 0; i < boxes.size(); ++i)
-      keyed[i] = {grid.key(boxes[i].center()), std::uint32_t(i)};
+      keyed[i] = {grid.key(centre(boxes[i])), std::uint32_t(i)};
     detail::radix_sort(keyed, 0, D * detail::hilbert_bits<D>(),
                        [](const detail::KeyedIndex& k) { return k.key; });
     for (std::size_t i = 0; i < boxes.size(); ++i)

@@ -14,7 +14,9 @@
 // (a nibble of x and y) at once, so a 16-bit key costs four look-ups.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "loci/geom/box.hpp"
@@ -140,25 +142,38 @@ std::uint64_t hilbert_key(std::uint32_t (&x)[D]) {
 namespace loci::detail {
 
 // Keys of points on the 2^hilbert_bits<D>() grid laid over `extent` (what packing and
-// quadtree building sort by). A flat axis maps to cell 0.
+// quadtree building sort by). A flat axis maps to cell 0; points outside the extent, and NaN
+// ones, map to its border cells.
+//
+// Coordinates are halved before they are measured: the extent of finite coordinates can
+// overflow (-1e308 to 1e308) where that of their halves cannot, and above the denormals halves
+// give exactly the keys whole coordinates give. An extent so narrow that kMax / extent
+// overflows (below about 4e-304) is measured 2^1000 times wider, also exactly. Whatever the
+// extent, no NaN or infinity reaches the conversion to integers.
 template <int D>
 class HilbertGrid {
  public:
-  explicit HilbertGrid(const Box<D>& extent) : min_(extent.min) {
-    constexpr double kMax = double((1u << hilbert_bits<D>()) - 1);
-    for (int a = 0; a < D; ++a)
-      scale_[a] = extent.extent(a) > 0 ? kMax / extent.extent(a) : 0.0;
+  explicit HilbertGrid(const Box<D>& extent) {
+    for (int a = 0; a < D; ++a) {
+      const double half = extent.max[a] / 2 - extent.min[a] / 2;
+      magnify_[a] = half > 0 && !std::isfinite(kMax / half) ? 0x1p1000 : 1.0;
+      scale_[a] = half > 0 ? kMax / (half * magnify_[a]) : 0.0;
+      half_min_[a] = extent.min[a] / 2;
+    }
   }
   std::uint64_t key(const Point<D>& p) const {
     std::uint32_t x[D];
-    for (int a = 0; a < D; ++a)
-      x[a] = static_cast<std::uint32_t>((p[a] - min_[a]) * scale_[a]);
+    for (int a = 0; a < D; ++a) {
+      const double q = (p[a] / 2 - half_min_[a]) * magnify_[a] * scale_[a];
+      x[a] = static_cast<std::uint32_t>(q > 0 ? std::min(q, kMax) : 0.0);
+    }
     return hilbert_key<D>(x);
   }
 
  private:
-  Point<D> min_;
-  double scale_[D];
+  static constexpr double kMax = double((1u << hilbert_bits<D>()) - 1);
+  Point<D> half_min_;
+  double magnify_[D], scale_[D];
 };
 
 }  // namespace loci::detail
