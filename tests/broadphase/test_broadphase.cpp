@@ -312,6 +312,13 @@ TYPED_TEST(BroadPhaseTest, Errors) {
   EXPECT_THROW(bp.move(1, bad), InvalidGeometry);
   bad.min[0] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(bp.add(3, bad), InvalidGeometry);
+  // Query windows are checked as proxies are: a NaN window would meet every proxy and an
+  // inverted one some.
+  EXPECT_THROW(bp.query(bad), InvalidGeometry);
+  bad.min[0] = 0.8, bad.max[0] = 0.2;
+  EXPECT_THROW(bp.query(bad), InvalidGeometry);
+  bad.min[0] = -std::numeric_limits<double>::infinity();
+  EXPECT_THROW(bp.query(bad, [](Id, const Box<D>&) { return true; }), InvalidGeometry);
   bp.validate();
 }
 

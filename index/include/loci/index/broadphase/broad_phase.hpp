@@ -18,7 +18,8 @@
 //                           sorted pair lists. Stopping early stops the reports, not the
 //                           bookkeeping: the next update() diffs against the full current set.
 //   query(box, visitor)     every proxy whose box meets `box`, as visitor(id, box), the
-//                           WindowVisitor of query.hpp; const, may run concurrently.
+//                           WindowVisitor of query.hpp; const, may run concurrently. Throws
+//                           InvalidGeometry on a NaN, infinite or inverted box.
 //
 // Each returns a QueryStats counted the same way by every broad phase: nodes_visited is the
 // sweep starts, grid cells or tree nodes examined; entries_tested is the box-against-box

@@ -150,6 +150,7 @@ class DynamicAabbTree {
 
   template <WindowVisitor<D> F>
   QueryStats query(const Box<D>& w, F&& visit) const {
+    check_box(w, "query window");
     QueryStats st;
     detail::Scratch<std::uint32_t> stack;
     traverse(w, *stack, st, [&](std::uint32_t s) {

@@ -146,8 +146,11 @@ class ProxyTable {
   }
 
   // Visits every live proxy meeting w (the linear scan behind the sweep and grid queries).
+  // Throws InvalidGeometry on a NaN, infinite or inverted window, whose tests would otherwise
+  // report every proxy or an arbitrary few.
   template <class F>
   QueryStats scan(const Box<D>& w, F&& visit) const {
+    check_box(w, "query window");
     QueryStats st;
     st.nodes_visited = 1;
     for (std::uint32_t s = 0; s < slots(); ++s) {
