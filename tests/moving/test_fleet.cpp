@@ -124,6 +124,10 @@ TYPED_TEST(FleetTest, LaterReportReplacesAndStoppedObjectsKeepMoving) {
   EXPECT_EQ(fleet.query(MovingWindow<2>::at({{59, 59}, {61, 61}}, 5)), std::vector<Id>{2});
   fleet.validate();
   EXPECT_THROW(fleet.report(3, {std::nan(""), {0, 0}, {0, 0}}), InvalidGeometry);
+  // k = 0 is refused as the indexes refuse it, before the clock as after.
+  EXPECT_THROW(fleet.nearest(Point2{0, 0}, 30, 0), InvalidArgument);
+  EXPECT_THROW(fleet.nearest(Point2{0, 0}, 12, 0), InvalidArgument);
+  EXPECT_THROW(Fleet<TypeParam>().nearest(Point2{0, 0}, 0, 0), InvalidArgument);
 }
 
 }  // namespace

@@ -159,13 +159,15 @@ TYPED_TEST(MovingIndexTest, UpdatesErasuresAndTicks) {
 
 TYPED_TEST(MovingIndexTest, RefusesBadInput) {
   TypeParam index;
+  EXPECT_THROW(index.nearest(Point2{0, 0}, 0, 0), InvalidArgument);
   index.insert(1, Motion2{0, {0, 0}, {1, 1}});
   EXPECT_THROW(index.insert(1, Motion2{0, {0, 0}, {1, 1}}), InvalidArgument);
   EXPECT_THROW(index.insert(2, Motion2{std::nan(""), {0, 0}, {1, 1}}), InvalidGeometry);
   EXPECT_THROW(index.update(1, Motion2{0, {0, 0}, {INFINITY, 1}}), InvalidGeometry);
   EXPECT_THROW(index.query(MovingWindow<2>::during({{0, 0}, {1, 1}}, 3, 2)), InvalidGeometry);
   EXPECT_FALSE(index.erase(99));
-  EXPECT_TRUE(index.nearest(Point2{0, 0}, 0, 0).empty());
+  EXPECT_THROW(index.nearest(Point2{0, 0}, 0, 0), InvalidArgument);
+  EXPECT_THROW(index.nearest(Point2{0, 0}, -5, 0), InvalidArgument);  // before the clock
   EXPECT_EQ(index.size(), 1u);
   index.validate();
 }

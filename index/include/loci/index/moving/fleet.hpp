@@ -99,6 +99,7 @@ class Fleet {
     if (s >= index_.clock()) return index_.nearest(q, s, k, visit);
     check_point(q, "nearest point");
     detail::check_nearest_time(s);
+    detail::check_nearest_count(k);
     QueryStats st;
     st.nodes_visited = 1;
     std::vector<std::pair<Id, const Motion<D>*>> live;

@@ -17,7 +17,8 @@
 //                            [w.t1, w.t2]: a timeslice (t1 == t2), a window over an interval,
 //                            or a window that itself moves; visit(id, motion)
 //   nearest(p, s, k, visit)  the k objects nearest the point p at time s, nearest first (ties
-//                            in any order), visit(id, motion, distance)
+//                            in any order), visit(id, motion, distance); k = 0 throws
+//                            InvalidArgument, as it does for the static indexes
 //   for_each(visit)          every object, in the structure's order
 //
 // Times. Queries may ask about any time. The trees keep bounds that hold from their clock
@@ -73,6 +74,9 @@ namespace detail {
 inline void check_nearest_time(double s) {
   check_coordinate(s, "nearest time");
   if (!(std::abs(s) <= kMaxCoordinate)) throw InvalidArgument("nearest time is beyond 1e150");
+}
+inline void check_nearest_count(std::size_t k) {
+  if (k == 0) throw InvalidArgument("nearest-n query needs k >= 1");
 }
 inline void check_nearest_distance(double d) {
   if (!(d < std::numeric_limits<double>::infinity()))

@@ -124,10 +124,10 @@ class MovingScan {
   QueryStats nearest(const Point<D>& q, double s, std::size_t k, F&& visit) const {
     check_point(q, "nearest point");
     detail::check_nearest_time(s);
+    detail::check_nearest_count(k);
     QueryStats st;
     st.nodes_visited = 1;
     st.entries_tested = ids_.size();
-    if (k == 0) return st;
     const auto out = detail::k_smallest(ids_.size(), k, [&](std::size_t i) {
       const double dt = s - t_[i];
       double dd = 0;

@@ -287,7 +287,8 @@ class MovingRTree {
   QueryStats nearest(const Point<D>& q, double s, std::size_t k, F&& visit) const {
     check_point(q, "nearest point");
     detail::check_nearest_time(s);
-    if (root_ == kNone || k == 0) return {};
+    detail::check_nearest_count(k);
+    if (root_ == kNone) return {};
     const double r = s - epoch_;
     const bool prune = s >= clock_;
     auto expand = [&](std::uint64_t ref, detail::BestFirstSink& sink) -> std::size_t {
