@@ -338,6 +338,7 @@ const LayerIndex::Features& LayerIndex::features() const {
       at += std::size_t(size);
     }
     if (at != m.nodes) f.corrupt();
+    f.node_count = m.nodes;
     f.root_tree = PackedRTree2::adopt(m.features, Packing::hilbert, m.root_blocks, m.root_items,
                                       keep_alive_, check_);
   });
@@ -459,8 +460,10 @@ LayerIndex::Features LayerIndex::build_features(const PackedRTree2* t, Per per,
     f.own_levels.push_back(std::move(level));
     level = std::move(up);
   }
-  for (const auto& l : f.own_levels)
+  for (const auto& l : f.own_levels) {
     f.levels.emplace_back(l.data(), l.size());
+    f.node_count += l.size();
+  }
   f.roots = f.own_roots;
   std::vector<Box2> boxes;
   boxes.reserve(f.roots.size());
@@ -501,6 +504,7 @@ std::vector<std::uint32_t> containing_features(const LayerIndex& index, const Po
   const PackedRTree2* tree = index.packed();
   if (!index.has_polygons() || !tree || tree->size() == 0) return out;
   std::vector<HierarchyRoot> stack;
+  std::size_t visits = 0;  // at most every node once (Features::node_count)
   features.root_tree.query(Box2::of_point(p), [&](Id r, const Box2&) {
     const HierarchyRoot root = features.root(r);
     const LayerIndex::Features::Node& top = features.node(root.level, root.node);
@@ -531,6 +535,7 @@ std::vector<std::uint32_t> containing_features(const LayerIndex& index, const Po
     while (!stack.empty()) {
       const auto [level, i] = stack.back();
       stack.pop_back();
+      if (++visits > features.node_count) features.corrupt();
       const LayerIndex::Features::Node& node = features.node(level, i);
       if (level > 0) {
         const auto below = features.children(node, level);
@@ -575,8 +580,10 @@ struct FeatureDescent {
   const PackedRTree2& tree;
   Point2 p;
   bool boxes_only;
+  mutable std::size_t visits = 0;  // nodes read by this query's walks (Features::node_count)
 
   void operator()(std::uint32_t level, std::uint32_t i, double& best, bool touched) const {
+    if (++visits > 2 * features.node_count) features.corrupt();
     const LayerIndex::Features::Node& node = features.node(level, i, touched);
     if (level == 0) {
       const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
@@ -629,6 +636,7 @@ struct FeatureDescent {
   double dive(std::uint32_t level, std::uint32_t i) const {
     bool touched = false;  // node (level, i) was read as a child
     for (; level > 0; --level, touched = true) {
+      if (++visits > 2 * features.node_count) features.corrupt();
       const LayerIndex::Features::Node& node = features.node(level, i, touched);
       const auto below = features.children(node, level);
       double nearest = std::numeric_limits<double>::infinity();

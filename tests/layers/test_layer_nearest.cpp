@@ -248,6 +248,19 @@ TEST(LayerNearest, ForgedHierarchiesAreRefusedWhenRead) {
          for (auto& r : roots)
            r.level = 70;
        }},
+      {"nodes sharing their children",
+       [](Levels& levels, std::vector<HierarchyRoot>& roots) {
+         // 63 levels of 16 nodes above level 0, each over the first 16 nodes below it, every
+         // box holding the layer: a walk of 16^63 paths, each node within the arrays.
+         levels.resize(1);
+         Box2 all = Box2::empty();
+         for (const auto& n : levels[0])
+           all.expand(n.box);
+         for (int l = 1; l < 64; ++l)
+           levels.emplace_back(16, HierarchyNode{all, 0, 0, 16, 0});
+         for (auto& r : roots)
+           r = {63, 0};
+       }},
   };
   for (const auto& [what, tamper] : forgeries) {
     const std::string path = scratch("forged");

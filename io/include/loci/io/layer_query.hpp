@@ -215,7 +215,12 @@ class LayerIndex {
 
     const loci::detail::LazyCheck* check = nullptr;  // stored: what is read is touched first
     std::size_t leaves = 0;                          // hierarchical: the tree's leaves
-    std::string path;                                // stored: the sidecar, for messages
+    // Hierarchical: the nodes of every level. In a valid file a node belongs to one feature
+    // and one parent, so a query's walks visit at most twice as many (its dives, then its
+    // descents); a forged file whose nodes share children (a walk of 16^levels paths) is
+    // refused when its walks go past that.
+    std::size_t node_count = 0;
+    std::string path;  // stored: the sidecar, for messages
     // What fid, levels and roots view when they are built here.
     std::vector<std::int64_t> own_fid;
     std::vector<loci::detail::LargeVector<Node>> own_levels;
