@@ -322,7 +322,6 @@ const LayerIndex::Features& LayerIndex::features() const {
     const MappedHierarchies& m = *stored_;
     f.hierarchical = true;
     f.records = records_;
-    f.tree = t;
     f.items = mapped_items_;
     f.check = check_;
     f.path = m.path;
@@ -330,14 +329,16 @@ const LayerIndex::Features& LayerIndex::features() const {
     f.fid = {m.fids, m.features};
     f.roots = {m.roots, m.features};
     check_->touch(m.level_sizes, 8 * m.levels);
+    std::vector<std::span<const Features::Node>> levels;  // kept only when all are sound
     std::size_t at = 0;
     for (std::size_t l = 0; l < m.levels; ++l) {
       const std::uint64_t size = m.level_sizes[l];
       if (size == 0 || size > m.nodes - at) f.corrupt();
-      f.levels.push_back({m.nodes_at + at, std::size_t(size)});
+      levels.push_back({m.nodes_at + at, std::size_t(size)});
       at += std::size_t(size);
     }
     if (at != m.nodes) f.corrupt();
+    f.levels = std::move(levels);
     f.node_count = m.nodes;
     f.root_tree = PackedRTree2::adopt(m.features, Packing::hilbert, m.root_blocks, m.root_items,
                                       keep_alive_, check_);
@@ -369,7 +370,6 @@ LayerIndex::Features LayerIndex::build_features(const PackedRTree2* t, Per per,
   }
   f.fid = fids;
   if (!hierarchies) return f;
-  f.tree = t;
   const std::size_t n = t->size(), features = fids.size();
   f.leaves = (n + PackedRTree2::node_size - 1) / PackedRTree2::node_size;
   f.items = t->item_indices();

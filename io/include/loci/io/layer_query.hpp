@@ -153,7 +153,6 @@ class LayerIndex {
     // Every record: verified whole, or with stored hierarchies as mapped (read through
     // record()).
     std::span<const ItemRecord> records;
-    const PackedRTree2* tree = nullptr;  // hierarchical: the index's tree
     // Hierarchical: the tree's item indices (PackedRTree2::item_indices()), read through
     // leaf_items().
     std::span<const std::uint32_t> items;
