@@ -19,6 +19,7 @@
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
+#include "loci/index/detail/hilbert.hpp"
 #include "loci/io/sidecar.hpp"
 
 namespace loci::io {
@@ -272,6 +273,31 @@ bool same_hierarchies(const LayerIndex::Features& stored, const LayerIndex::Feat
   return true;
 }
 
+// The order in which a batch's queries run: by the Hilbert key, over the layer's extent, of
+// each query's point (a window's centre, a segment's midpoint), ties in query order.
+std::vector<std::size_t> run_order(const std::vector<std::pair<std::size_t, Query>>& queries,
+                                   const Box2& extent) {
+  const loci::detail::HilbertGrid<2> grid(extent);
+  auto point = [](const Query& q) -> Point2 {
+    switch (q.kind) {
+      case Query::Kind::bbox:
+        return {q.box.min[0] / 2 + q.box.max[0] / 2, q.box.min[1] / 2 + q.box.max[1] / 2};
+      case Query::Kind::segment:
+        return {q.segment.a[0] / 2 + q.segment.b[0] / 2, q.segment.a[1] / 2 + q.segment.b[1] / 2};
+      default:
+        return q.point;
+    }
+  };
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(queries.size());
+  for (std::size_t i = 0; i < queries.size(); ++i)
+    keyed[i] = {grid.key(point(queries[i].second)), i};
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::size_t> order(queries.size());
+  for (std::size_t i = 0; i < keyed.size(); ++i)
+    order[i] = keyed[i].second;
+  return order;
+}
+
 }  // namespace
 
 std::string check_sidecar(const std::string& path) {
@@ -357,7 +383,6 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   const auto geometries =
       std::make_shared<LayerGeometries>(options.load.layer_path, options.load.layer_name);
   const LayerIndex index = load_index(options.load, &report.index_origin, geometries.get());
-  std::vector<Answer> answers;
   bool with_distance = false, with_point = false;
   for (const auto& [number, q] : options.queries) {
     with_distance |= q.kind == Query::Kind::within || q.kind == Query::Kind::nearest || q.first;
@@ -365,23 +390,40 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   }
   const std::size_t n = options.queries.size();
   ProgressTicker ticker(options.progress, double(n));
-  // A batch is cut into chunks that threads take in turn, each thread with its own
-  // LayerQuery (its geometry cache and layer handle) over the one immutable index; the
-  // chunks' answers are joined in query order.
+  // The queries run in the order of their points along a Hilbert curve, cut into chunks that
+  // threads take in turn, each thread with its own LayerQuery (its geometry cache and layer
+  // handle) over the one immutable index; the answers are joined in query order. Queries
+  // near each other in that order read the same nodes and pages of the index: on a large
+  // sidecar a batch of random points runs about twice as fast as in file order.
+  const std::vector<std::size_t> order = run_order(options.queries, index.bounds());
   constexpr std::size_t kChunk = 64;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<Answer>> parts(chunks);
+  struct Place {
+    std::size_t chunk, begin, end;  // query i's answers: parts[chunk][begin, end)
+  };
+  std::vector<Place> place(n);
+  auto run_chunk = [&](LayerQuery& lq, std::size_t c) {
+    const std::size_t end = std::min(n, (c + 1) * kChunk);
+    for (std::size_t s = c * kChunk; s < end; ++s) {
+      const std::size_t i = order[s];
+      const auto& [number, q] = options.queries[i];
+      const std::size_t begin = parts[c].size();
+      lq.run(q, number, options.candidates, parts[c]);
+      place[i] = {c, begin, parts[c].size()};
+    }
+    return end - c * kChunk;
+  };
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t jobs =
-      std::min<std::size_t>(options.jobs ? options.jobs : cores, (n + kChunk - 1) / kChunk);
+  const std::size_t jobs = std::min<std::size_t>(options.jobs ? options.jobs : cores, chunks);
   if (jobs <= 1) {
     LayerQuery lq(index, options.load.layer_path, index.layer_name(), geometries);
     std::size_t done = 0;
-    for (const auto& [number, q] : options.queries) {
-      lq.run(q, number, options.candidates, answers);
-      ticker.tick(double(++done));
+    for (std::size_t c = 0; c < chunks; ++c) {
+      done += run_chunk(lq, c);
+      ticker.tick(double(done));
     }
   } else {
-    const std::size_t chunks = (n + kChunk - 1) / kChunk;
-    std::vector<std::vector<Answer>> parts(chunks);
     std::atomic<std::size_t> next{0}, done{0};
     std::atomic<bool> failed{false};
     std::exception_ptr error;
@@ -391,12 +433,7 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
       try {
         LayerQuery lq(index, options.load.layer_path, index.layer_name(), geometries);
         for (std::size_t c; !failed && (c = next++) < chunks;) {
-          const std::size_t end = std::min(n, (c + 1) * kChunk);
-          for (std::size_t i = c * kChunk; i < end; ++i) {
-            const auto& [number, q] = options.queries[i];
-            lq.run(q, number, options.candidates, parts[c]);
-          }
-          done += end - c * kChunk;
+          done += run_chunk(lq, c);
           if (reporting) ticker.tick(double(done));
         }
       } catch (...) {
@@ -413,13 +450,15 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
       t.join();
     if (error) std::rethrow_exception(error);
     ticker.tick(double(n));
-    std::size_t total = 0;
-    for (const auto& p : parts)
-      total += p.size();
-    answers.reserve(total);
-    for (auto& p : parts)
-      answers.insert(answers.end(), p.begin(), p.end());
   }
+  std::vector<Answer> answers;
+  std::size_t total = 0;
+  for (const auto& p : parts)
+    total += p.size();
+  answers.reserve(total);
+  for (const Place& at : place)
+    answers.insert(answers.end(), parts[at.chunk].begin() + std::ptrdiff_t(at.begin),
+                   parts[at.chunk].begin() + std::ptrdiff_t(at.end));
   write_answers({options.load.layer_path, index.layer_name()}, answers, options.format,
                 options.numbered, with_distance, with_point, options.out_path, fallback);
   report.answers = answers.size();

@@ -538,34 +538,80 @@ void expect_error(const std::string& args, const std::string& fragment) {
   EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
 }
 
+namespace {
+
+// The answers of a numbered batch output ("N fid" or "N,fid,..." rows), by query number: each
+// query's rows after its number, in their order. The rows must come in query order.
+std::map<std::size_t, std::vector<std::string>> by_query(const std::string& out, bool csv) {
+  std::map<std::size_t, std::vector<std::string>> rows;
+  auto all = lines(out);
+  std::size_t last = 0;
+  for (std::size_t i = csv ? 1 : 0; i < all.size(); ++i) {
+    const std::size_t cut = all[i].find(csv ? ',' : ' ');
+    const std::size_t q = std::stoul(all[i].substr(0, cut));
+    EXPECT_GE(q, last) << "rows out of query order at " << all[i];
+    last = q;
+    rows[q].push_back(all[i].substr(cut + 1));
+  }
+  return rows;
+}
+
+}  // namespace
+
 // Batches run on threads (chunks of 64 queries each) answer exactly what one thread does, in
-// the same order; the batches here are long enough to be cut.
+// the same order; the batches here are long enough to be cut. Queries run in an order of
+// their own (along a curve through their points) whatever the order of the file: the same
+// batch reversed gives each query the same answer under its reversed number.
 TEST_F(LayersCli, BatchesOnThreadsMatchOneThread) {
   std::mt19937_64 rng(77);
   std::uniform_real_distribution<double> pos(-5, 105), size(0.5, 20);
   const std::string windows = path("batch.windows"), points = path("batch.points");
+  const std::string windows_reversed = path("batch.windows.reversed");
+  const std::string points_reversed = path("batch.points.reversed");
   {
-    std::ofstream w(windows), p(points);
-    w.precision(17);
-    p.precision(17);
+    std::vector<std::string> w_rows, p_rows;
+    char buf[200];
     for (int i = 0; i < 700; ++i) {
-      const double x = pos(rng), y = pos(rng);
-      w << x << ',' << y << ',' << x + size(rng) << ',' << y + size(rng) << '\n';
-      p << pos(rng) << ',' << pos(rng) << '\n';
+      const double x = pos(rng), y = pos(rng), w = size(rng), h = size(rng);
+      std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g,%.17g\n", x, y, x + w, y + h);
+      w_rows.push_back(buf);
+      const double px = pos(rng), py = pos(rng);
+      std::snprintf(buf, sizeof buf, "%.17g,%.17g\n", px, py);
+      p_rows.push_back(buf);
+    }
+    std::ofstream w(windows), p(points), wr(windows_reversed), pr(points_reversed);
+    for (std::size_t i = 0; i < w_rows.size(); ++i) {
+      w << w_rows[i];
+      p << p_rows[i];
+      wr << w_rows[w_rows.size() - 1 - i];
+      pr << p_rows[p_rows.size() - 1 - i];
     }
   }
   for (const char* layer : {"polys.shp", "lines.shp"}) {
     for (const char* per : {"feature", "segment"}) {
-      for (const std::string batch : {" --bbox-file " + shell_quote(windows),
-                                      " --nearest-file " + shell_quote(points) + " -k 4 -f csv"}) {
-        const std::string cmd =
-            "query " + shell_quote(path(layer)) + batch + " --per " + per + " -q";
+      for (const bool nearest : {false, true}) {
+        auto batch = [&](const std::string& file) {
+          return "query " + shell_quote(path(layer)) +
+                 (nearest ? " --nearest-file " + shell_quote(file) + " -k 4 -f csv"
+                          : " --bbox-file " + shell_quote(file)) +
+                 " --per " + per + " -q";
+        };
+        const std::string cmd = batch(nearest ? points : windows);
         const CliRun one = run_loci(cmd + " -j 1");
         const CliRun three = run_loci(cmd + " -j 3");
+        const CliRun reversed = run_loci(batch(nearest ? points_reversed : windows_reversed));
         ASSERT_EQ(one.status, 0) << one.err;
         ASSERT_EQ(three.status, 0) << three.err;
+        ASSERT_EQ(reversed.status, 0) << reversed.err;
         EXPECT_GT(lines(one.out).size(), 700u) << cmd;
         EXPECT_EQ(one.out, three.out) << cmd;
+        const auto forward = by_query(one.out, nearest), backward = by_query(reversed.out, nearest);
+        EXPECT_EQ(forward.size(), backward.size()) << cmd;
+        for (const auto& [q, rows] : forward) {
+          const auto it = backward.find(701 - q);
+          ASSERT_NE(it, backward.end()) << cmd << " query " << q;
+          EXPECT_EQ(rows, it->second) << cmd << " query " << q;
+        }
       }
     }
   }
