@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -40,13 +41,27 @@ OGRFeatureUniquePtr fetch(detail::OpenLayer& ol, const AnswerSource& src, std::i
   return found(OGRFeatureUniquePtr(ol.layer->GetFeature(fid)), src, fid);
 }
 
+// The rows formatted into a buffer written in blocks (a batch has millions of rows).
 void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
+  constexpr std::size_t kBlock = 1 << 16;
+  std::string buf;
+  buf.reserve(kBlock + 64);
   for (const auto& a : answers) {
-    if (numbered)
-      std::fprintf(out, "%zu %lld\n", a.query, static_cast<long long>(a.fid));
-    else
-      std::fprintf(out, "%lld\n", static_cast<long long>(a.fid));
+    char row[64];  // two 20-digit numbers, a space and a newline
+    char* at = row;
+    if (numbered) {
+      at = std::to_chars(at, row + 21, a.query).ptr;
+      *at++ = ' ';
+    }
+    at = std::to_chars(at, at + 21, a.fid).ptr;
+    *at++ = '\n';
+    buf.append(row, at);
+    if (buf.size() >= kBlock) {
+      std::fwrite(buf.data(), 1, buf.size(), out);
+      buf.clear();
+    }
   }
+  std::fwrite(buf.data(), 1, buf.size(), out);
 }
 
 void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
