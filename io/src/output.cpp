@@ -8,6 +8,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <unordered_map>
 #include <vector>
 
 #include "gdal_layer.hpp"
@@ -37,9 +39,46 @@ OGRFeatureUniquePtr found(OGRFeatureUniquePtr f, const AnswerSource& src, std::i
   if (!f) throw Error(detail::where(src.layer_path, fid) + " is not in the layer");
   return f;
 }
-OGRFeatureUniquePtr fetch(detail::OpenLayer& ol, const AnswerSource& src, std::int64_t fid) {
-  return found(OGRFeatureUniquePtr(ol.layer->GetFeature(fid)), src, fid);
-}
+
+// The features a list of answers names, each read once whatever the number of answers naming
+// it: by FID where the driver reads by FID in place, or else (GeoJSON and the other text
+// formats, where GDAL finds a feature by FID by parsing the file from its start) kept from one
+// pass over the layer.
+class AnswerFeatures {
+ public:
+  // `by_fid` reads one feature by FID (null when there is none) on a layer read in place.
+  AnswerFeatures(detail::OpenLayer& ol, const AnswerSource& src, std::span<const Answer> answers,
+                 std::function<OGRFeatureUniquePtr(std::int64_t)> by_fid)
+      : src_(src), by_fid_(std::move(by_fid)), whole_(!detail::fast_random_read(*ol.dataset)) {
+    if (!whole_ || answers.empty()) return;
+    for (const Answer& a : answers)
+      kept_.emplace(a.fid, nullptr);
+    ol.layer->ResetReading();
+    for (OGRFeatureUniquePtr f(ol.layer->GetNextFeature()); f;
+         f.reset(ol.layer->GetNextFeature())) {
+      const auto it = kept_.find(f->GetFID());
+      if (it != kept_.end() && !it->second) it->second = std::move(f);
+    }
+  }
+  // The feature `fid`, valid until the next call. Throws loci::Error when the layer has none.
+  const OGRFeature& at(std::int64_t fid) {
+    if (!whole_) {
+      last_ = found(by_fid_(fid), src_, fid);
+      return *last_;
+    }
+    const auto it = kept_.find(fid);
+    if (it == kept_.end() || !it->second)
+      throw Error(detail::where(src_.layer_path, fid) + " is not in the layer");
+    return *it->second;
+  }
+
+ private:
+  const AnswerSource& src_;
+  std::function<OGRFeatureUniquePtr(std::int64_t)> by_fid_;
+  bool whole_;
+  std::unordered_map<std::int64_t, OGRFeatureUniquePtr> kept_;
+  OGRFeatureUniquePtr last_;
+};
 
 // The rows formatted into a buffer written in blocks (a batch has millions of rows).
 void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
@@ -78,8 +117,11 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
   for (int i = 0; i < defn->GetFieldCount(); ++i)
     line += "," + csv_quoted(defn->GetFieldDefn(i)->GetNameRef());
   std::fprintf(out, "%s\n", line.c_str());
+  AnswerFeatures features(ol, src, answers, [&](std::int64_t fid) {
+    return OGRFeatureUniquePtr(ol.layer->GetFeature(fid));
+  });
   for (const auto& a : answers) {
-    const auto f = fetch(ol, src, a.fid);
+    const OGRFeature* f = &features.at(a.fid);
     line = numbered ? std::to_string(a.query) + "," : "";
     line += std::to_string(a.fid);
     if (with_distance) line += "," + number(a.distance);
@@ -129,8 +171,9 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
   }
   // A shapefile's polygons of many rings are built without GDAL's sorting of rings.
   detail::ShapefilePolygons polygons(src.layer_path, *ol.layer);
+  AnswerFeatures features(ol, src, answers, [&](std::int64_t fid) { return polygons.fetch(fid); });
   for (const auto& a : answers) {
-    const auto f = found(polygons.fetch(a.fid), src, a.fid);
+    const OGRFeature* f = &features.at(a.fid);
     OGRFeature out(layer->GetLayerDefn());
     if (query_field >= 0) out.SetField(query_field, static_cast<GIntBig>(a.query));
     out.SetField(fid_field, static_cast<GIntBig>(a.fid));

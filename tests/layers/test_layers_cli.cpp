@@ -4,6 +4,7 @@
 // features through OGR's geometry (GEOS), for both granularities, with and without a sidecar;
 // then every error the command line promises to report, and the sidecar's defences against
 // truncation, corruption and a layer that changed after indexing.
+#include <gdal_utils.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <tuple>
 
 #include "layers/cli_support.hpp"
 
@@ -454,6 +456,69 @@ TEST_F(LayersCli, CsvAndGeoJsonCarryAttributes) {
   const OgrFeatureSet s = read_with_ogr(out);
   EXPECT_EQ(s.fids.size(), 60u);
   fs::remove(out);
+}
+
+// A text layer (GeoJSON, where GDAL finds a feature by FID by parsing) gives the same CSV and
+// GeoJSON answers as the shapefile it was converted from with all 17 digits, features named
+// by many answers included (the answers' features are read in one pass over the layer).
+TEST_F(LayersCli, CsvAndGeoJsonFromATextLayerMatchTheShapefile) {
+  const std::string shp = path("polys.shp"), text = path("polys-text.geojson");
+  {
+    GDALDatasetH src = GDALOpenEx(shp.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+    ASSERT_TRUE(src);
+    const char* argv[] = {"-f", "GeoJSON", "-lco", "SIGNIFICANT_FIGURES=17", nullptr};
+    GDALVectorTranslateOptions* opts =
+        GDALVectorTranslateOptionsNew(const_cast<char**>(argv), nullptr);
+    fs::remove(text);
+    GDALDatasetH out = GDALVectorTranslate(text.c_str(), nullptr, 1, &src, opts, nullptr);
+    GDALVectorTranslateOptionsFree(opts);
+    GDALClose(src);
+    ASSERT_TRUE(out);
+    GDALClose(out);
+  }
+  const std::string points = path("text.points");
+  {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> pos(-10, 110);
+    std::ofstream p(points);
+    p.precision(17);
+    for (int i = 0; i < 40; ++i)
+      p << pos(rng) << ',' << pos(rng) << '\n';
+  }
+  // The answers' rows of a GeoJSON output: query, fid and label of each feature, in order,
+  // with its geometry's envelope.
+  auto rows = [](const std::string& file) {
+    std::vector<std::tuple<long long, long long, std::string, double, double, double, double>> r;
+    GDALDatasetUniquePtr ds(GDALDataset::Open(file.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+    if (!ds) return r;
+    for (auto& f : *ds->GetLayer(0)) {
+      OGREnvelope e;
+      if (f->GetGeometryRef()) f->GetGeometryRef()->getEnvelope(&e);
+      r.emplace_back(f->GetFieldAsInteger64("query"), f->GetFieldAsInteger64("fid"),
+                     f->GetFieldAsString("label"), e.MinX, e.MinY, e.MaxX, e.MaxY);
+    }
+    return r;
+  };
+  for (const char* per : {"feature", "segment"}) {
+    const std::string batch =
+        " --nearest-file " + shell_quote(points) + " -k 6 --per " + per + " -q";
+    const CliRun a = run_loci("query " + shell_quote(shp) + batch + " -f csv");
+    const CliRun b = run_loci("query " + shell_quote(text) + batch + " -f csv");
+    ASSERT_EQ(a.status, 0) << a.err;
+    ASSERT_EQ(b.status, 0) << b.err;
+    EXPECT_EQ(lines(a.out).size(), 1u + 40 * 6) << per;
+    EXPECT_EQ(a.out, b.out) << per;
+    const std::string out_a = path("text-a.geojson"), out_b = path("text-b.geojson");
+    ASSERT_EQ(run_loci("query " + shell_quote(shp) + batch + " -f geojson -o " + out_a).status, 0);
+    ASSERT_EQ(run_loci("query " + shell_quote(text) + batch + " -f geojson -o " + out_b).status, 0);
+    const auto ra = rows(out_a), rb = rows(out_b);
+    EXPECT_EQ(ra.size(), 40u * 6) << per;
+    EXPECT_EQ(ra, rb) << per;
+    fs::remove(out_a);
+    fs::remove(out_b);
+  }
+  fs::remove(text);
+  fs::remove(text + ".loci");
 }
 
 TEST_F(LayersCli, ClipCutsToTheWindow) {
