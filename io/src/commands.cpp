@@ -459,6 +459,7 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   for (const Place& at : place)
     answers.insert(answers.end(), parts[at.chunk].begin() + std::ptrdiff_t(at.begin),
                    parts[at.chunk].begin() + std::ptrdiff_t(at.end));
+  parts = {};  // not held while the answers are written
   write_answers({options.load.layer_path, index.layer_name()}, answers, options.format,
                 options.numbered, with_distance, with_point, options.out_path, fallback);
   report.answers = answers.size();
