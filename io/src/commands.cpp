@@ -274,19 +274,15 @@ bool same_hierarchies(const LayerIndex::Features& stored, const LayerIndex::Feat
 }
 
 // The order in which a batch's queries run: by the Hilbert key, over the layer's extent, of
-// each query's point (a window's centre, a segment's midpoint), ties in query order.
+// each query's point (a window's centre, a segment's start), ties in query order. The grid
+// takes any point (one outside the extent, or a centre that overflows, keys to its border).
 std::vector<std::size_t> run_order(const std::vector<std::pair<std::size_t, Query>>& queries,
                                    const Box2& extent) {
   const loci::detail::HilbertGrid<2> grid(extent);
-  auto point = [](const Query& q) -> Point2 {
-    switch (q.kind) {
-      case Query::Kind::bbox:
-        return {q.box.min[0] / 2 + q.box.max[0] / 2, q.box.min[1] / 2 + q.box.max[1] / 2};
-      case Query::Kind::segment:
-        return {q.segment.a[0] / 2 + q.segment.b[0] / 2, q.segment.a[1] / 2 + q.segment.b[1] / 2};
-      default:
-        return q.point;
-    }
+  auto point = [](const Query& q) {
+    return q.kind == Query::Kind::bbox      ? q.box.center()
+           : q.kind == Query::Kind::segment ? q.segment.a
+                                            : q.point;
   };
   std::vector<std::pair<std::uint64_t, std::size_t>> keyed(queries.size());
   for (std::size_t i = 0; i < queries.size(); ++i)
