@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -336,6 +338,82 @@ TYPED_TEST(BroadPhaseTest, EarlyStop) {
   EXPECT_EQ(st.results, 5u);
   EXPECT_EQ(bp.pairs().size(), 45u);
   bp.validate();
+}
+
+// entry_pairs against pairs(): the ids it lays out, mapped through the partners it hands
+// over, are the same pairs, each once, partners after their entry, separators never visited;
+// with and without stripes, in 2 and 3 dimensions; a visit returning false stops the sweep.
+template <class BP>
+void expect_entry_pairs_match(Scene scene, std::uint64_t seed, int n) {
+  constexpr int D = BP::dimension;
+  SCOPED_TRACE(name(scene) + " seed " + std::to_string(seed));
+  World<D> world(scene, seed);
+  BP bp;
+  for (int i = 0; i < n; ++i) {
+    const auto o = world.make();
+    if (bp.contains(o.id)) continue;
+    bp.add(o.id, o.box);
+    world.objs.push_back(o);
+  }
+  std::vector<Id> laid;
+  std::vector<IdPair> got;
+  const QueryStats st =
+      bp.entry_pairs([&](std::span<const Id> ids) { laid.assign(ids.begin(), ids.end()); },
+                     [&](std::size_t e, std::span<const std::uint32_t> partners) {
+                       EXPECT_LT(e, laid.size());
+                       EXPECT_NE(laid[e], Id(kNone));
+                       EXPECT_FALSE(partners.empty());
+                       for (const std::uint32_t f : partners) {
+                         EXPECT_GT(f, e);
+                         EXPECT_NE(laid[f], Id(kNone));
+                         got.push_back({std::min(laid[e], laid[f]), std::max(laid[e], laid[f])});
+                       }
+                       return true;
+                     });
+  EXPECT_EQ(st.results, got.size());
+  EXPECT_EQ(sorted(got), world.brute_pairs());
+  ASSERT_FALSE(got.empty());
+  int runs = 0;
+  bp.entry_pairs([](std::span<const Id>) {},
+                 [&](std::size_t, std::span<const std::uint32_t>) { return ++runs < 3; });
+  EXPECT_EQ(runs, 3);
+}
+
+TEST(SweepPrune, EntryPairsMatchPairs) {
+  for (Scene scene : {Scene::mixed, Scene::identical, Scene::sizes, Scene::sparse_ids}) {
+    expect_entry_pairs_match<SweepPrune<2>>(scene, 7, 300);
+    expect_entry_pairs_match<StripedSweep<2>>(scene, 8, 300);
+    expect_entry_pairs_match<StripedSweep<3>>(scene, 9, 300);
+    expect_entry_pairs_match<IncrementalSweepPrune<2>>(scene, 10, 300);
+  }
+}
+
+// The sweep orders runs by mins rounded down to floats: boxes that touch exactly at a value
+// a float rounds up (0.1, 1/3), rounds to -0 (-1e-50) or to infinity (1e39), or where floats
+// are sparse (1e30 plus a few ulps), are still paired, as in brute force.
+TEST(SweepPrune, TouchingWhereFloatsRound) {
+  for (double x : {0.1, 1.0 / 3, -1e-50, 1e-50, 1e39, -1e39, 1e30, -0.7, 1e300, -1e300}) {
+    SCOPED_TRACE(x);
+    for (bool striped : {false, true}) {
+      SweepPrune<2> bp(striped ? 4 : 4096);
+      std::vector<Box2> boxes;
+      const double u = std::nextafter(x, std::numeric_limits<double>::infinity());
+      for (int k = 0; k < 6; ++k) {
+        const double y = k * 1e-3;                  // x varies most: the sweep runs along x
+        boxes.push_back({{x - 1, y}, {x, y + 1}});  // ends exactly at x
+        boxes.push_back({{x, y}, {x + 1, y + 1}});  // starts exactly at x
+        boxes.push_back({{u, y}, {u, y + 2}});      // starts an ulp after x
+        boxes.push_back({{std::nextafter(u, u + 1), y}, {u + 1, y}});
+      }
+      std::vector<IdPair> want;
+      for (std::size_t i = 0; i < boxes.size(); ++i) {
+        bp.add(i, boxes[i]);
+        for (std::size_t j = i + 1; j < boxes.size(); ++j)
+          if (intersects(boxes[i], boxes[j])) want.push_back({i, j});
+      }
+      EXPECT_EQ(sorted(bp.pairs()), want);
+    }
+  }
 }
 
 }  // namespace

@@ -97,6 +97,39 @@ TEST(SphereContact, HandCases) {
   EXPECT_NEAR(t.exit, 0.52, 1e-12);
 }
 
+// Lengths and speeds scaled together by powers of two leave the contact times unchanged,
+// bit for bit, from 2^-400 to 2^480 (where the contact equation's terms would overflow or
+// underflow unscaled); by 1e140 and 1e-140, to rounding.
+TEST(SphereContact, ScaleInvariant) {
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(-10, 10), pos(0.5, 3);
+  int met = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Point2 ca{u(rng), u(rng)}, va{u(rng), u(rng)}, cb{u(rng), u(rng)}, vb{u(rng), u(rng)};
+    const double ra = pos(rng), rb = pos(rng);
+    const auto want = sphere_contact(ca, ra, va, cb, rb, vb, 0.0, 5.0);
+    met += !want.empty();
+    auto scaled = [&](double f) {
+      auto m = [f](Point2 p) { return Point2{p[0] * f, p[1] * f}; };
+      return sphere_contact(m(ca), ra * f, m(va), m(cb), rb * f, m(vb), 0.0, 5.0);
+    };
+    for (int e : {-400, -250, 250, 480}) {
+      const auto got = scaled(std::ldexp(1.0, e));
+      ASSERT_EQ(got.empty(), want.empty()) << i << " 2^" << e;
+      if (want.empty()) continue;
+      EXPECT_EQ(got.enter, want.enter) << i << " 2^" << e;
+      EXPECT_EQ(got.exit, want.exit) << i << " 2^" << e;
+    }
+    for (double f : {1e140, 1e-140}) {
+      const auto got = scaled(f);
+      if (want.empty() || got.empty()) continue;  // a grazing pair may round either way
+      EXPECT_NEAR(got.enter, want.enter, 1e-9) << i << " " << f;
+      EXPECT_NEAR(got.exit, want.exit, 1e-9) << i << " " << f;
+    }
+  }
+  EXPECT_GT(met, 30);
+}
+
 TEST(SweptBox, ContainsTheMotion) {
   const Box2 b = box(0, 0, 1, 2);
   const Point2 v{2, -1};

@@ -138,6 +138,56 @@ TEST(Conflicts, PositionsBeyondTheRangeAreRefused) {
   EXPECT_EQ(monitor.conflicts().size(), 1u);
 }
 
+// Pairs that only graze the D-circle (parallel courses exactly D apart, head-on passes offset
+// by exactly D, a closest approach of exactly D at the end of the horizon) beside pairs that
+// miss it by a little, at magnitudes from 1e-100 to 1e140: the quick test before the exact
+// one must never drop a pair the exact test keeps, whatever the scale, and the entry times
+// must stay right where the contact equation's terms pass 1e300 (a head-on pair entering
+// at the horizon's end, given an entry time of 0, was lost by the slices that hold 0).
+TEST(Conflicts, GrazingPairsAtEveryScale) {
+  for (double scale : {1e-100, 1.0, 1e12, 1e138}) {
+    for (double offset : {0.0, 3e5}) {
+      const double d = 4 * scale, o = offset * scale;
+      std::vector<Motion2> fleet;
+      auto add = [&](double x, double y, double vx, double vy) {
+        fleet.push_back({0, {o + x * scale, o + y * scale}, {vx * scale, vy * scale}});
+      };
+      for (int k = 0; k < 40; ++k) {
+        const double x = 100.0 * k;
+        add(x, 0, 1, 0.5);  // parallel, exactly D apart (4 = 4 * 1 on the y axis)
+        add(x, 4, 1, 0.5);
+        add(x + 30, 20, 1, 0);  // head-on, offset exactly D
+        add(x + 50, 24, -1, 0);
+        add(x + 60, 40, 0, 0);  // closest at the end of the horizon (10), exactly D
+        add(x + 60, 54, 0, -1);
+        add(x + 80, 60, 1, 0);  // a hair beyond D all along
+        add(x + 80, 64 + 1e-9, 1, 0);
+      }
+      std::vector<Id> ids(fleet.size());
+      for (std::size_t i = 0; i < ids.size(); ++i)
+        ids[i] = i;
+      const std::string what = "scale " + std::to_string(scale) + " offset " + std::to_string(o);
+      const auto want = brute(ids, fleet, d, 0, 10);
+      // Exactly the three grazing kinds where the inputs are exact; far from the origin the
+      // positions round, and some grazing pairs end a hair beyond D.
+      if (scale == 1.0 && offset == 0.0) EXPECT_EQ(want.size(), 120u) << what;
+      EXPECT_GE(want.size(), 40u) << what;
+      for (std::size_t slices : {0, 1, 3}) {
+        std::vector<Conflict> got;
+        find_conflicts<2>(
+            fleet, d, 0, 10,
+            [&](std::uint32_t i, std::uint32_t j, const Approach& ap) {
+              got.push_back({ids[i], ids[j], ap});
+              return true;
+            },
+            slices);
+        sort_conflicts(got);
+        expect_same(got, want, what + " slices " + std::to_string(slices));
+      }
+    }
+  }
+}
+
 TEST(Conflicts, VisitorStops) {
   const auto fleet = test::make_fleet(test::Fleet::identical, 300, 2);
   int seen = 0;

@@ -118,6 +118,31 @@ TEST(RadixSort, MatchesStableSort) {
   }
 }
 
+// The kept second buffer gives the same order as a fresh one, sort after sort, on keys whose
+// sorted bits start above bit 0 (the bits below them left in input order).
+TEST(RadixSort, KeptBufferAndOffsetBits) {
+  std::mt19937_64 rng(6);
+  std::vector<KeyedIndex> spare;
+  for (int round = 0; round < 4; ++round) {
+    const int first = round * 9, bits = 64 - first - 3 * round;
+    std::vector<KeyedIndex> v(5000 + 3000 * round);
+    for (std::uint32_t i = 0; i < v.size(); ++i)
+      v[i] = {rng() >> (round * 3), i};
+    auto mask = [&](std::uint64_t k) {
+      return bits >= 64 ? k >> first : (k >> first) & ((std::uint64_t(1) << bits) - 1);
+    };
+    auto ref = v;
+    std::stable_sort(ref.begin(), ref.end(),
+                     [&](auto& a, auto& b) { return mask(a.key) < mask(b.key); });
+    radix_sort(
+        v, first, bits, [](const KeyedIndex& k) { return k.key; }, spare);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      ASSERT_EQ(v[i].key, ref[i].key) << round;
+      ASSERT_EQ(v[i].index, ref[i].index) << round;
+    }
+  }
+}
+
 TEST(StrTile, GroupsAreSlabsThenTiles) {
   std::mt19937_64 rng(5);
   std::vector<Point2> pts(1000);

@@ -97,15 +97,30 @@ template <int D>
 ContactInterval sphere_contact(const Point<D>& ca, double ra, const Point<D>& va,
                                const Point<D>& cb, double rb, const Point<D>& vb, double t0,
                                double t1) {
+  Point<D> rel, vel;
+  double r = ra + rb, big = r;
+  for (int k = 0; k < D; ++k) {
+    rel[k] = ca[k] - cb[k];
+    vel[k] = va[k] - vb[k];
+    big = std::max({big, std::abs(rel[k]), std::abs(vel[k])});
+  }
+  // The discriminant below is of the fourth degree in lengths: beyond about 1e77 it would
+  // overflow (below 1e-77 underflow), and the roots, which depend only on the ratios, would
+  // be lost. Lengths and speeds are then scaled by a power of two (exactly) first.
+  if (big > 0x1p200 || (big < 0x1p-200 && big > 0)) {
+    int e = 0;
+    std::frexp(big, &e);
+    const double f = std::ldexp(1.0, -e);
+    r *= f;
+    for (int k = 0; k < D; ++k)
+      rel[k] *= f, vel[k] *= f;
+  }
   double dd = 0, dv = 0, vv = 0;
   for (int k = 0; k < D; ++k) {
-    const double d = ca[k] - cb[k];
-    const double v = va[k] - vb[k];
-    dd += d * d;
-    dv += d * v;
-    vv += v * v;
+    dd += rel[k] * rel[k];
+    dv += rel[k] * vel[k];
+    vv += vel[k] * vel[k];
   }
-  const double r = ra + rb;
   const double c = dd - r * r;
   double enter, exit;
   if (vv == 0) {

@@ -35,6 +35,10 @@
 // the test's result (left-packed output), so the only unpredictable branch is the end of the
 // run.
 //
+// Callers with data of their own per proxy (find_conflicts keeps each object's motion) use
+// entry_pairs: it gives them the sweep's order once, then each entry with its run's hits by
+// position in that order, so that their own test of a pair reads neighbouring memory.
+//
 // Queries: query(box) scans the proxies (O(n)); a structure answering windows in O(log n)
 // is DynamicAabbTree.
 //
@@ -50,6 +54,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -143,16 +148,42 @@ class BasicSweepPrune {
 
   template <PairVisitor F>
   QueryStats pairs(F&& visit) {
-    if constexpr (Incremental) {
-      sort_incremental();
-      begin_gather(order_.size());
-      for (const std::uint32_t s : order_)
-        gather(s, proxies_.box(s).min[axis_], true);
-      gather_sentinel();
-    } else {
-      sort_striped();
-    }
-    return sweep(visit);
+    sort_and_gather();
+    const Id* ids = ids_.data();
+    std::size_t visited = 0;
+    auto by_id = [&](std::size_t e, std::span<const std::uint32_t> partners) {
+      const Id a = ids[e];
+      for (const std::uint32_t f : partners) {
+        const Id b = ids[f];
+        ++visited;
+        if (!(a < b ? visit(a, b) : visit(b, a))) return false;
+      }
+      return true;
+    };
+    QueryStats st = sweep(by_id);
+    st.results = visited;
+    return st;
+  }
+
+  // pairs() for a caller that keeps data of its own per proxy in the sweep's order, so that
+  // its test of a pair reads neighbouring memory: after sorting, order(ids) is called once
+  // with the proxy id of every entry of the sweep in that order (a proxy has an entry in each
+  // stripe it spans; the entries that separate stripes hold kNone and are never visited),
+  // then visit(e, partners) for each entry e whose box meets others': partners holds the
+  // positions f > e in `ids` of those entries, each pair once over the whole sweep; a visit
+  // returning false stops.
+  template <class Order, class F>
+  QueryStats entry_pairs(Order&& order, F&& visit) {
+    sort_and_gather();
+    order(std::span<const Id>(ids_.data(), count_));
+    std::size_t handed = 0;
+    auto counted = [&](std::size_t e, std::span<const std::uint32_t> partners) {
+      handed += partners.size();
+      return visit(e, partners);
+    };
+    QueryStats st = sweep(counted);
+    st.results = handed;
+    return st;
   }
   std::vector<IdPair> pairs() {
     return collect_pairs([&](auto&& v) { return pairs(v); });
@@ -194,6 +225,19 @@ class BasicSweepPrune {
   static constexpr std::size_t kStripedFrom = 4096;
   static constexpr double kMaxStripes = 4096;
 
+  // Sorts the proxies and gathers the sweep's arrays.
+  void sort_and_gather() {
+    if constexpr (Incremental) {
+      sort_incremental();
+      begin_gather(order_.size());
+      for (const std::uint32_t s : order_)
+        gather(s, proxies_.box(s).min[axis_], true);
+      gather_sentinel();
+    } else {
+      sort_striped();
+    }
+  }
+
   // Leaves order_ holding the live slots by increasing min on axis_ (incremental).
   void sort_incremental() {
     double var[D];
@@ -219,7 +263,8 @@ class BasicSweepPrune {
     keyed_.resize(order_.size());
     for (std::size_t p = 0; p < order_.size(); ++p)
       keyed_[p] = {detail::ordered_key(proxies_.box(order_[p]).min[axis_]), order_[p]};
-    detail::radix_sort(keyed_, 64);
+    detail::radix_sort(
+        keyed_, 0, 64, [](const detail::KeyedIndex& e) { return e.key; }, spare_);
     for (std::size_t p = 0; p < order_.size(); ++p)
       order_[p] = keyed_[p].index;
   }
@@ -253,8 +298,10 @@ class BasicSweepPrune {
 
   // The stripes of the bucketed sweep: stripe_of(y) for y on stripe_axis_.
   std::uint32_t stripe_of(double y) const {
-    const double k = std::floor((y - stripe_origin_) * stripe_inv_);
-    return std::uint32_t(std::clamp(k, 0.0, double(stripes_ - 1)));
+    // Truncation is the floor of the non-negative values that reach it (no libm call).
+    const double k = (y - stripe_origin_) * stripe_inv_;
+    if (!(k > 0)) return 0;
+    return k < double(stripes_ - 1) ? std::uint32_t(k) : stripes_ - 1;
   }
 
   // Chooses the sweep axis and the stripes: about four mean box extents high, so that a box
@@ -288,9 +335,11 @@ class BasicSweepPrune {
   // Key of x rounded down to a float, in the float order (32 bits): a conservative start
   // for the run, refined by the exact test.
   static std::uint32_t float_key(double x) {
-    float f = static_cast<float>(x);
-    if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-    const auto bits = std::bit_cast<std::uint32_t>(f);
+    const auto f = static_cast<float>(x);
+    auto bits = std::bit_cast<std::uint32_t>(f);
+    // Rounded up: the next float down, one step of the bits away from zero when negative
+    // (-0 to the least negative float) and towards it when positive (+inf to the largest).
+    if (double(f) > x) bits += (bits >> 31) ? 1 : std::uint32_t(-1);
     return (bits >> 31) ? ~bits : bits | 0x80000000u;
   }
   static double from_float_key(std::uint32_t k) {
@@ -311,8 +360,9 @@ class BasicSweepPrune {
       for (std::uint32_t t = stripe_of(b.min[stripe_axis_]); t <= last; ++t)
         keyed_.push_back({std::uint64_t(t) << 32 | k, s});
     }
-    detail::radix_sort(keyed_, 0, 32 + std::bit_width(stripes_ - 1),
-                       [](const detail::KeyedIndex& e) { return e.key; });
+    detail::radix_sort(
+        keyed_, 0, 32 + std::bit_width(stripes_ - 1),
+        [](const detail::KeyedIndex& e) { return e.key; }, spare_);
     begin_gather(keyed_.size() + stripes_);
     std::uint32_t stripe = 0;
     for (const detail::KeyedIndex& e : keyed_) {
@@ -361,12 +411,13 @@ class BasicSweepPrune {
   void gather_sentinel() {
     start_[count_] = std::numeric_limits<double>::infinity();
     hi_[count_] = -std::numeric_limits<double>::infinity();
+    ids_[count_] = kNone;
     ++count_;
   }
 
-  // The runs over the gathered entries. A pair met in several stripes is reported from the
-  // stripe holding the larger of the two mins on the stripe axis, the one where either box is
-  // at home.
+  // The runs over the gathered entries, visit(e, partners) by entry positions. A pair met in
+  // several stripes is reported from the stripe holding the larger of the two mins on the stripe
+  // axis, the one where either box is at home.
   template <class F>
   QueryStats sweep(F& visit) {
     constexpr int kOther = D - 1;
@@ -395,12 +446,7 @@ class BasicSweepPrune {
         found += meet;
       }
       st.entries_tested += j - i - 1;
-      const Id a = ids_[i];
-      for (std::size_t h = 0; h < found; ++h) {
-        const Id b = ids_[hits[h]];
-        ++st.results;
-        if (!(a < b ? visit(a, b) : visit(b, a))) return st;
-      }
+      if (found && !visit(i, std::span<const std::uint32_t>(hits, found))) return st;
     }
     return st;
   }
@@ -414,6 +460,7 @@ class BasicSweepPrune {
   std::vector<std::uint32_t> pos_;            // incremental: position of each slot in order_
   std::size_t holes_ = 0;                     // incremental: kNone entries in order_
   detail::LargeVector<detail::KeyedIndex> keyed_;  // sort records (key, slot)
+  detail::LargeVector<detail::KeyedIndex> spare_;  // the radix sort's second buffer
   std::vector<double> key_;                        // incremental: min on axis_ in order_
   int stripe_axis_ = 1;                            // the axis cut into stripes
   std::uint32_t stripes_ = 1;                      // stripe count (1: a plain sweep)

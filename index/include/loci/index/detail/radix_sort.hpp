@@ -5,6 +5,7 @@
 // times. Stable, so equal keys keep their input order and builds are deterministic.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -17,28 +18,44 @@ struct KeyedIndex {
   std::uint32_t index;
 };
 
-// Sorts v by bits [first_bit, first_bit + bits) of key_of(element).
+// Sorts v by bits [first_bit, first_bit + bits) of key_of(element), using `tmp` as the second
+// buffer (kept by a caller that sorts every tick, so that its memory is not faulted in again).
+// One pass counts every digit; each digit then costs one scatter pass.
 template <class T, class A, class KeyOf>
-void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of) {
+void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of,
+                std::vector<T, A>& tmp) {
   constexpr int kDigit = 11;
   constexpr std::size_t kBuckets = std::size_t(1) << kDigit;
-  std::vector<T, A> tmp(v.size());
-  for (int shift = first_bit; shift < first_bit + bits; shift += kDigit) {
-    std::array<std::size_t, kBuckets> count{};
-    for (const auto& x : v)
-      ++count[(key_of(x) >> shift) & (kBuckets - 1)];
+  constexpr int kMaxPasses = (64 + kDigit - 1) / kDigit;
+  const int passes = std::min((bits + kDigit - 1) / kDigit, kMaxPasses);
+  if (v.size() < 2 || passes <= 0) return;
+  std::vector<std::array<std::size_t, kBuckets>> count(static_cast<std::size_t>(passes));
+  for (const auto& x : v) {
+    const std::uint64_t k = key_of(x);
+    for (int p = 0; p < passes; ++p)
+      ++count[std::size_t(p)][(k >> (first_bit + p * kDigit)) & (kBuckets - 1)];
+  }
+  tmp.resize(v.size());
+  for (int p = 0; p < passes; ++p) {
+    const int shift = first_bit + p * kDigit;
+    auto& c = count[std::size_t(p)];
     // A digit every key shares orders nothing: skip its pass.
-    if (!v.empty() && count[(key_of(v[0]) >> shift) & (kBuckets - 1)] == v.size()) continue;
+    if (c[(key_of(v[0]) >> shift) & (kBuckets - 1)] == v.size()) continue;
     std::size_t sum = 0;
-    for (auto& c : count) {
-      const std::size_t n = c;
-      c = sum;
+    for (auto& b : c) {
+      const std::size_t n = b;
+      b = sum;
       sum += n;
     }
     for (const auto& x : v)
-      tmp[count[(key_of(x) >> shift) & (kBuckets - 1)]++] = x;
+      tmp[c[(key_of(x) >> shift) & (kBuckets - 1)]++] = x;
     v.swap(tmp);
   }
+}
+template <class T, class A, class KeyOf>
+void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of) {
+  std::vector<T, A> tmp;
+  radix_sort(v, first_bit, bits, key_of, tmp);
 }
 
 // A 64-bit key whose unsigned order is the order of the doubles (no NaN): negative numbers

@@ -9,8 +9,11 @@
 // D/2 around their positions that meet (the L-infinity distance is at most the Euclidean
 // one); so the boxes they sweep over any slice of the horizon containing s, grown by D/2,
 // meet too. The horizon is cut into `slices` equal slices; for each slice the grown swept
-// boxes go through a sort-and-sweep broad phase (broadphase/sweep_prune.hpp), and each
-// candidate pair gets the exact closest-approach test. A pair is reported from the slice that
+// boxes go through a sort-and-sweep broad phase (broadphase/sweep_prune.hpp, entry_pairs:
+// the reports are copied into the sweep's order, so that a run's candidates are read from
+// neighbouring memory), each candidate pair gets a quick test without division or branch
+// (its closest approach from the positions at `now`, with a margin for rounding), and the
+// pairs that pass get the exact closest-approach test. A pair is reported from the slice that
 // holds its entry time t_enter only, so pairs found in several slices are reported once
 // without a set of seen pairs; at its entry time the pair is within D, so that slice's boxes
 // meet and the pair is not missed. Boxes are grown by a hair more than D/2 so that rounding in
@@ -158,24 +161,29 @@ class ConflictFinder {
     broad_.reserve(n);
     // Pairs whose closest approach computed from the positions at `now` is clearly beyond D
     // (by more than rounding can explain) are dropped before the exact test, which alone
-    // decides the rest.
+    // decides the rest. The quick test has no division and no branch: with d and w the
+    // relative position at `now` and velocity, the least squared distance over the horizon
+    // is |d|^2 when d.w >= 0 (moving apart), |d + wH|^2 when the closest approach is past H,
+    // and |d|^2 - (d.w)^2 / |w|^2 otherwise, compared multiplied by |w|^2 and with a slack
+    // of 1e-14 |d|^2 |w|^2 that covers its rounding (an overflow makes it false: not apart).
     const double reach = within * (1 + 1e-9) + 1e-9 * scale_;
     const double reach2 = reach * reach;
-    auto clearly_apart = [&](std::uint32_t a, std::uint32_t b) {
-      double dw = 0, ww = 0, dd = 0;
-      Point<D> d{}, w{};
+    auto clearly_apart = [&](const Kinematics& p, const Kinematics& q) {
+      double dw = 0, ww = 0, dd = 0, ee = 0;
       for (int k = 0; k < D; ++k) {
-        d[k] = at_now_[b][k] - at_now_[a][k];
-        w[k] = motion_[b].v[k] - motion_[a].v[k];
-        dw += d[k] * w[k];
-        ww += w[k] * w[k];
+        const double d = q.p[k] - p.p[k], w = q.v[k] - p.v[k];
+        const double e = d + w * horizon;
+        dw += d * w;
+        ww += w * w;
+        dd += d * d;
+        ee += e * e;
       }
-      const double u = std::min(std::max(-dw / std::max(ww, 1e-300), 0.0), horizon);
-      for (int k = 0; k < D; ++k) {
-        const double c = d[k] + w[k] * u;
-        dd += c * c;
-      }
-      return dd > reach2;
+      const double ddww = dd * ww;
+      const bool apart_now = dd > reach2, apart_end = ee > reach2;
+      const bool apart_mid = ddww - dw * dw - 1e-14 * ddww > reach2 * ww;
+      const bool receding = dw >= 0, past = -dw >= horizon * ww;
+      return (receding & apart_now) | (!receding & past & apart_end) |
+             (!receding & !past & apart_mid);
     };
     const double step = horizon / double(slices);
     for (std::size_t s = 0; s < slices; ++s) {
@@ -193,21 +201,46 @@ class ConflictFinder {
         broad_.remove(k);
       held_ = n;
       bool go = true;
-      const QueryStats bs = broad_.pairs([&](Id a, Id b) {
-        ++st.entries_tested;
-        if (clearly_apart(std::uint32_t(a), std::uint32_t(b))) return true;
-        std::uint32_t i = order_[a], j = order_[b];
-        if (j < i) std::swap(i, j), std::swap(a, b);
-        // The same reports as objects[i] and objects[j], copied in proxy order.
-        const auto ap = closest_approach(motion_[a], motion_[b], now, horizon, within);
-        if (!ap) return true;
-        // Reported from the slice holding the entry time only.
-        const bool first = s == 0 || ap->t_enter > t0;
-        const bool last = s + 1 == slices || ap->t_enter <= t1;
-        if (!first || !last) return true;
-        ++st.results;
-        return go = visit(i, j, *ap);
-      });
+      const Id* proxy = nullptr;
+      // The reports copied into the sweep's order, so that the candidates of a run are tested
+      // on neighbouring memory.
+      auto lay_out = [&](std::span<const Id> ids) {
+        proxy = ids.data();
+        entry_.resize(ids.size());
+        kin_.resize(ids.size());
+        near_.resize(ids.size());
+        for (std::size_t e = 0; e < ids.size(); ++e) {
+          if (ids[e] == kNone) continue;
+          entry_[e] = motion_[ids[e]];
+          kin_[e] = {position(entry_[e], now), entry_[e].v};
+        }
+      };
+      auto run = [&](std::size_t e, std::span<const std::uint32_t> partners) {
+        st.entries_tested += partners.size();
+        const Kinematics p = kin_[e];
+        // The quick test over the run, its survivors left-packed into near_.
+        std::size_t kept = 0;
+        for (const std::uint32_t f : partners) {
+          near_[kept] = f;
+          kept += !clearly_apart(p, kin_[f]);
+        }
+        for (std::size_t h = 0; h < kept; ++h) {
+          std::size_t a = e, b = near_[h];
+          std::uint32_t i = order_[proxy[a]], j = order_[proxy[b]];
+          if (j < i) std::swap(i, j), std::swap(a, b);
+          // The reports of objects[i] and objects[j].
+          const auto ap = closest_approach(entry_[a], entry_[b], now, horizon, within);
+          if (!ap) continue;
+          // Reported from the slice holding the entry time only.
+          const bool first = s == 0 || ap->t_enter > t0;
+          const bool last = s + 1 == slices || ap->t_enter <= t1;
+          if (!first || !last) continue;
+          ++st.results;
+          if (!(go = visit(i, j, *ap))) return false;
+        }
+        return true;
+      };
+      const QueryStats bs = broad_.entry_pairs(lay_out, run);
       st.nodes_visited += bs.nodes_visited;
       if (!go) break;
     }
@@ -222,7 +255,6 @@ class ConflictFinder {
     for (std::size_t i = 0; i < n; ++i)
       if (!detail::stays_in_range(objects[i], now, now + horizon))
         detail::out_of_range("object " + std::to_string(i) + " of the input");
-    at_now_.resize(n);
     motion_.resize(n);
     Box<D> extent = Box<D>::empty();
     for (const Motion<D>& m : objects)
@@ -231,27 +263,36 @@ class ConflictFinder {
     keyed_.resize(n);
     for (std::uint32_t i = 0; i < n; ++i)
       keyed_[i] = {grid.key(position(objects[i], now + 0.5 * horizon)), i};
-    detail::radix_sort(keyed_, D * detail::hilbert_bits<D>());
+    detail::radix_sort(
+        keyed_, 0, D * detail::hilbert_bits<D>(), [](const detail::KeyedIndex& e) { return e.key; },
+        spare_);
     order_.resize(n);
     scale_ = 0;
     for (std::uint32_t k = 0; k < n; ++k) {
       const std::uint32_t i = keyed_[k].index;
       order_[k] = i;
-      at_now_[k] = position(objects[i], now);
       motion_[k] = objects[i];
+      const Point<D> at_now = position(objects[i], now);
       for (int a = 0; a < D; ++a)
-        scale_ = std::max(scale_, std::abs(at_now_[k][a]) + std::abs(motion_[k].v[a]) * horizon);
+        scale_ = std::max(scale_, std::abs(at_now[a]) + std::abs(motion_[k].v[a]) * horizon);
     }
   }
+
+  // An object's position at `now` and its velocity: what the quick test of a pair reads.
+  struct Kinematics {
+    Point<D> p, v;
+  };
 
   SweepPrune<D> broad_;
   std::size_t held_ = 0;  // proxies 0 .. held_ - 1 are in broad_
   // Large arrays, so that a search made once does not spend its time faulting pages in.
-  detail::LargeVector<detail::KeyedIndex> keyed_;
-  detail::LargeVector<std::uint32_t> order_;  // input index by proxy number
-  detail::LargeVector<Point<D>> at_now_;      // positions at `now` by proxy number
-  detail::LargeVector<Motion<D>> motion_;     // the reports by proxy number
-  double scale_ = 0;                          // largest coordinate magnitude reached
+  detail::LargeVector<detail::KeyedIndex> keyed_, spare_;  // Hilbert sort, and its second buffer
+  detail::LargeVector<std::uint32_t> order_;               // input index by proxy number
+  detail::LargeVector<Motion<D>> motion_;                  // the reports by proxy number
+  detail::LargeVector<Motion<D>> entry_;                   // the reports by entry of the sweep
+  detail::LargeVector<Kinematics> kin_;      // their positions at `now` and velocities
+  detail::LargeVector<std::uint32_t> near_;  // a run's partners that pass the quick test
+  double scale_ = 0;                         // largest coordinate magnitude reached
 };
 
 template <int D, ConflictVisitor F>
