@@ -10,11 +10,11 @@
 // one); so the boxes they sweep over any slice of the horizon containing s, grown by D/2,
 // meet too. The horizon is cut into `slices` equal slices; for each slice the grown swept
 // boxes go through a sort-and-sweep broad phase (broadphase/sweep_prune.hpp, entry_pairs:
-// the reports are copied into the sweep's order, so that a run's candidates are read from
-// neighbouring memory), each candidate pair gets a quick test without division or branch
-// (its closest approach from the positions at `now`, with a margin for rounding), and the
-// pairs that pass get the exact closest-approach test. A pair is reported from the slice that
-// holds its entry time t_enter only, so pairs found in several slices are reported once
+// positions and velocities are copied into the sweep's order, so that a run's candidates
+// are read from neighbouring memory), each candidate pair gets a quick test without division
+// or branch (its closest approach from the positions at `now`, with a margin for rounding),
+// and the pairs that pass get the exact closest-approach test. A pair is reported from the slice
+// that holds its entry time t_enter only, so pairs found in several slices are reported once
 // without a set of seen pairs; at its entry time the pair is within D, so that slice's boxes
 // meet and the pair is not missed. Boxes are grown by a hair more than D/2 so that rounding in
 // the positions cannot lose a pair that touches the D-circle.
@@ -202,17 +202,16 @@ class ConflictFinder {
       held_ = n;
       bool go = true;
       const Id* proxy = nullptr;
-      // The reports copied into the sweep's order, so that the candidates of a run are tested
-      // on neighbouring memory.
+      // Positions at `now` and velocities copied into the sweep's order, so that the quick
+      // test of a run's candidates reads neighbouring memory.
       auto lay_out = [&](std::span<const Id> ids) {
         proxy = ids.data();
-        entry_.resize(ids.size());
         kin_.resize(ids.size());
         near_.resize(ids.size());
         for (std::size_t e = 0; e < ids.size(); ++e) {
           if (ids[e] == kNone) continue;
-          entry_[e] = motion_[ids[e]];
-          kin_[e] = {position(entry_[e], now), entry_[e].v};
+          const Motion<D>& m = motion_[ids[e]];
+          kin_[e] = {position(m, now), m.v};
         }
       };
       auto run = [&](std::size_t e, std::span<const std::uint32_t> partners) {
@@ -228,8 +227,9 @@ class ConflictFinder {
           std::size_t a = e, b = near_[h];
           std::uint32_t i = order_[proxy[a]], j = order_[proxy[b]];
           if (j < i) std::swap(i, j), std::swap(a, b);
-          // The reports of objects[i] and objects[j].
-          const auto ap = closest_approach(entry_[a], entry_[b], now, horizon, within);
+          // The reports of objects[i] and objects[j], copied in proxy order.
+          const auto ap =
+              closest_approach(motion_[proxy[a]], motion_[proxy[b]], now, horizon, within);
           if (!ap) continue;
           // Reported from the slice holding the entry time only.
           const bool first = s == 0 || ap->t_enter > t0;
@@ -289,8 +289,7 @@ class ConflictFinder {
   detail::LargeVector<detail::KeyedIndex> keyed_, spare_;  // Hilbert sort, and its second buffer
   detail::LargeVector<std::uint32_t> order_;               // input index by proxy number
   detail::LargeVector<Motion<D>> motion_;                  // the reports by proxy number
-  detail::LargeVector<Motion<D>> entry_;                   // the reports by entry of the sweep
-  detail::LargeVector<Kinematics> kin_;      // their positions at `now` and velocities
+  detail::LargeVector<Kinematics> kin_;  // positions at `now` and velocities by entry of the sweep
   detail::LargeVector<std::uint32_t> near_;  // a run's partners that pass the quick test
   double scale_ = 0;                         // largest coordinate magnitude reached
 };
