@@ -343,7 +343,7 @@ TYPED_TEST(BroadPhaseTest, EarlyStop) {
 // entry_pairs against pairs(): the ids it lays out, mapped through the partners it hands
 // over, are the same pairs, each once, partners after their entry, separators never visited;
 // with and without stripes, in 2 and 3 dimensions; a visit returning false stops the sweep.
-template <class BP>
+template <class BP, bool kStriped>
 void expect_entry_pairs_match(Scene scene, std::uint64_t seed, int n) {
   constexpr int D = BP::dimension;
   SCOPED_TRACE(name(scene) + " seed " + std::to_string(seed));
@@ -361,17 +361,37 @@ void expect_entry_pairs_match(Scene scene, std::uint64_t seed, int n) {
       bp.entry_pairs([&](std::span<const Id> ids) { laid.assign(ids.begin(), ids.end()); },
                      [&](std::size_t e, std::span<const std::uint32_t> partners) {
                        EXPECT_LT(e, laid.size());
-                       EXPECT_NE(laid[e], Id(kNone));
+                       EXPECT_NE(laid[e], BP::kSeparator);
                        EXPECT_FALSE(partners.empty());
                        for (const std::uint32_t f : partners) {
                          EXPECT_GT(f, e);
-                         EXPECT_NE(laid[f], Id(kNone));
+                         EXPECT_NE(laid[f], BP::kSeparator);
                          got.push_back({std::min(laid[e], laid[f]), std::max(laid[e], laid[f])});
                        }
                        return true;
                      });
   EXPECT_EQ(st.results, got.size());
   EXPECT_EQ(sorted(got), world.brute_pairs());
+  // The separators: one after each stripe, the last entry among them; without stripes every
+  // proxy once and one separator.
+  ASSERT_FALSE(laid.empty());
+  EXPECT_EQ(laid.back(), BP::kSeparator);
+  const auto separators = std::count(laid.begin(), laid.end(), BP::kSeparator);
+  std::vector<Id> proxies;
+  for (const Id id : laid)
+    if (id != BP::kSeparator) proxies.push_back(id);
+  std::sort(proxies.begin(), proxies.end());
+  std::vector<Id> live;
+  for (const auto& o : world.objs)
+    live.push_back(o.id);
+  std::sort(live.begin(), live.end());
+  std::vector<Id> distinct = proxies;
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  EXPECT_EQ(distinct, live);
+  if (!kStriped) {
+    EXPECT_EQ(separators, 1);
+    EXPECT_EQ(proxies, live);
+  }
   ASSERT_FALSE(got.empty());
   int runs = 0;
   bp.entry_pairs([](std::span<const Id>) {},
@@ -381,10 +401,10 @@ void expect_entry_pairs_match(Scene scene, std::uint64_t seed, int n) {
 
 TEST(SweepPrune, EntryPairsMatchPairs) {
   for (Scene scene : {Scene::mixed, Scene::identical, Scene::sizes, Scene::sparse_ids}) {
-    expect_entry_pairs_match<SweepPrune<2>>(scene, 7, 300);
-    expect_entry_pairs_match<StripedSweep<2>>(scene, 8, 300);
-    expect_entry_pairs_match<StripedSweep<3>>(scene, 9, 300);
-    expect_entry_pairs_match<IncrementalSweepPrune<2>>(scene, 10, 300);
+    expect_entry_pairs_match<SweepPrune<2>, false>(scene, 7, 300);
+    expect_entry_pairs_match<StripedSweep<2>, true>(scene, 8, 300);
+    expect_entry_pairs_match<StripedSweep<3>, true>(scene, 9, 300);
+    expect_entry_pairs_match<IncrementalSweepPrune<2>, false>(scene, 10, 300);
   }
 }
 

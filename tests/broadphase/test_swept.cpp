@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "loci/geom/swept.hpp"
 
@@ -97,9 +98,10 @@ TEST(SphereContact, HandCases) {
   EXPECT_NEAR(t.exit, 0.52, 1e-12);
 }
 
-// Lengths and speeds scaled together by powers of two leave the contact times unchanged,
-// bit for bit, from 2^-400 to 2^480 (where the contact equation's terms would overflow or
-// underflow unscaled); by 1e140 and 1e-140, to rounding.
+// Lengths scaled by 2^a and speeds by 2^b scale the contact times by 2^(a - b), bit for bit:
+// together from 2^-400 to 2^480 (where the contact equation's terms would overflow or
+// underflow unscaled), and apart by up to 900 (speeds of 1e150 against lengths of 1e-100);
+// by 1e140 and 1e-140 together, to rounding.
 TEST(SphereContact, ScaleInvariant) {
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> u(-10, 10), pos(0.5, 3);
@@ -109,25 +111,43 @@ TEST(SphereContact, ScaleInvariant) {
     const double ra = pos(rng), rb = pos(rng);
     const auto want = sphere_contact(ca, ra, va, cb, rb, vb, 0.0, 5.0);
     met += !want.empty();
-    auto scaled = [&](double f) {
-      auto m = [f](Point2 p) { return Point2{p[0] * f, p[1] * f}; };
-      return sphere_contact(m(ca), ra * f, m(va), m(cb), rb * f, m(vb), 0.0, 5.0);
+    // Lengths times fl, speeds times fv, so times times fl / fv.
+    auto scaled = [&](double fl, double fv) {
+      auto l = [fl](Point2 p) { return Point2{p[0] * fl, p[1] * fl}; };
+      auto v = [fv](Point2 p) { return Point2{p[0] * fv, p[1] * fv}; };
+      return sphere_contact(l(ca), ra * fl, v(va), l(cb), rb * fl, v(vb), 0.0, 5.0 * fl / fv);
     };
-    for (int e : {-400, -250, 250, 480}) {
-      const auto got = scaled(std::ldexp(1.0, e));
-      ASSERT_EQ(got.empty(), want.empty()) << i << " 2^" << e;
+    for (auto [a, b] : {std::pair{-400, -400},
+                        {-250, -250},
+                        {250, 250},
+                        {480, 480},
+                        {0, 480},
+                        {-400, 300},
+                        {300, -400},
+                        {-450, 450},
+                        {200, 0}}) {
+      const double ft = std::ldexp(1.0, a - b);
+      const auto got = scaled(std::ldexp(1.0, a), std::ldexp(1.0, b));
+      ASSERT_EQ(got.empty(), want.empty()) << i << " 2^" << a << " 2^" << b;
       if (want.empty()) continue;
-      EXPECT_EQ(got.enter, want.enter) << i << " 2^" << e;
-      EXPECT_EQ(got.exit, want.exit) << i << " 2^" << e;
+      EXPECT_EQ(got.enter, want.enter * ft) << i << " 2^" << a << " 2^" << b;
+      EXPECT_EQ(got.exit, want.exit * ft) << i << " 2^" << a << " 2^" << b;
     }
     for (double f : {1e140, 1e-140}) {
-      const auto got = scaled(f);
+      const auto got = scaled(f, f);
       if (want.empty() || got.empty()) continue;  // a grazing pair may round either way
       EXPECT_NEAR(got.enter, want.enter, 1e-9) << i << " " << f;
       EXPECT_NEAR(got.exit, want.exit, 1e-9) << i << " " << f;
     }
   }
   EXPECT_GT(met, 30);
+  // Lengths of 1e-100 closing at 1e150: in contact from (2 - sqrt(3/4)) 1e-250 to
+  // (2 + sqrt(3/4)) 1e-250, not from 0.
+  const auto c = sphere_contact(Point2{0, 0}, 0.5e-100, Point2{0, 0}, Point2{2e-100, 0.5e-100},
+                                0.5e-100, Point2{-1e150, 0}, 0.0, 4e-250);
+  ASSERT_FALSE(c.empty());
+  EXPECT_NEAR(c.enter / 1e-250, 2 - std::sqrt(0.75), 1e-12);
+  EXPECT_NEAR(c.exit / 1e-250, 2 + std::sqrt(0.75), 1e-12);
 }
 
 TEST(SweptBox, ContainsTheMotion) {

@@ -2,6 +2,7 @@
 // fixed-seed fleets with the degenerate cases, for several slicings of the horizon.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <unordered_map>
 #include <vector>
@@ -185,6 +186,75 @@ TEST(Conflicts, GrazingPairsAtEveryScale) {
         expect_same(got, want, what + " slices " + std::to_string(slices));
       }
     }
+  }
+}
+
+// Pairs that graze D in general position (2D and 3D), at magnitudes where the quick test's
+// products near the subnormal range (lengths of 1e-60 to 1e-120), against the exact test;
+// and two pairs that it once dropped: a relative speed whose square underflows, and a 3D
+// pair at 1e-67.
+template <int D>
+void expect_grazing_in_general_position(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1), lg(-120, 60);
+  for (int round = 0; round < 40; ++round) {
+    const double scale = std::pow(10.0, lg(rng)), horizon = std::pow(10.0, lg(rng) / 6);
+    const double within = scale * std::pow(10.0, u(rng));
+    std::vector<Motion<D>> fleet;
+    for (int k = 0; k < 25; ++k) {
+      // b passes a at distance within * (1 +- 1e-9) at a time inside or beyond the horizon.
+      Point<D> dir, side, pa, va, pb, vb;
+      for (int i = 0; i < D; ++i)
+        dir[i] = u(rng), side[i] = u(rng);
+      double dot = 0, dn = 0, sn = 0;
+      for (int i = 0; i < D; ++i)
+        dot += dir[i] * side[i], dn += dir[i] * dir[i];
+      for (int i = 0; i < D; ++i)
+        side[i] -= dot / dn * dir[i], sn += side[i] * side[i];
+      const double at = horizon * (0.2 + 1.1 * (u(rng) + 1) / 2);
+      const double off = within * (1 + 1e-9 * u(rng)) / std::sqrt(sn);
+      for (int i = 0; i < D; ++i) {
+        const double w = dir[i] * scale / horizon;
+        pa[i] = 1e3 * scale * (k + u(rng)), va[i] = u(rng) * scale / horizon;
+        pb[i] = pa[i] - w * at + side[i] * off, vb[i] = va[i] + w;
+      }
+      fleet.push_back({0, pa, va});
+      fleet.push_back({0, pb, vb});
+    }
+    std::size_t want = 0;
+    for (std::size_t i = 0; i < fleet.size(); ++i)
+      for (std::size_t j = i + 1; j < fleet.size(); ++j)
+        want += bool(closest_approach(fleet[i], fleet[j], 0.0, horizon, within));
+    for (std::size_t slices : {1, 4}) {
+      std::size_t got = 0;
+      find_conflicts<D>(
+          fleet, within, 0, horizon,
+          [&](std::uint32_t, std::uint32_t, const Approach&) { return ++got, true; }, slices);
+      EXPECT_EQ(got, want) << "D " << D << " round " << round << " scale " << scale;
+    }
+  }
+}
+
+TEST(Conflicts, GrazingInGeneralPosition) {
+  expect_grazing_in_general_position<2>(21);
+  expect_grazing_in_general_position<3>(22);
+  const std::vector<Motion2> slow{{0, {0, 0}, {1e-170, 0}}, {0, {0.5, 0}, {0, 0}}};
+  EXPECT_EQ(find_conflicts<2>(std::vector<Id>{1, 2}, slow, 1, 0, 1e300).size(), 1u);
+  const std::vector<Motion<3>> tiny{
+      {0,
+       {-1.5411274592206388e-67, 1.0743316230688597e-67, 2.2433971993613862e-68},
+       {3.595844584064295e-91, 2.210333233838407e-91, 2.1966860670337807e-91}},
+      {0,
+       {-1.5410184458802649e-67, 1.0749543087614888e-67, 2.2536425475648634e-68},
+       {3.456947881201562e-91, 1.0558370491966411e-92, -5.2989627518512658e-92}}};
+  const double h = 8.4419069874504949e+21, d = 1.478470266883014e-71;
+  ASSERT_TRUE(closest_approach(tiny[0], tiny[1], 0.0, h, d));
+  for (std::size_t slices : {1, 4}) {
+    int got = 0;
+    find_conflicts<3>(
+        tiny, d, 0, h, [&](std::uint32_t, std::uint32_t, const Approach&) { return ++got, true; },
+        slices);
+    EXPECT_EQ(got, 1) << slices;
   }
 }
 

@@ -98,22 +98,29 @@ ContactInterval sphere_contact(const Point<D>& ca, double ra, const Point<D>& va
                                const Point<D>& cb, double rb, const Point<D>& vb, double t0,
                                double t1) {
   Point<D> rel, vel;
-  double r = ra + rb, big = r;
+  double r = ra + rb, len = r, speed = 0;
   for (int k = 0; k < D; ++k) {
     rel[k] = ca[k] - cb[k];
     vel[k] = va[k] - vb[k];
-    big = std::max({big, std::abs(rel[k]), std::abs(vel[k])});
+    len = std::max(len, std::abs(rel[k]));
+    speed = std::max(speed, std::abs(vel[k]));
   }
-  // The discriminant below is of the fourth degree in lengths: beyond about 1e77 it would
-  // overflow (below 1e-77 underflow), and the roots, which depend only on the ratios, would
-  // be lost. Lengths and speeds are then scaled by a power of two (exactly) first.
-  if (big > 0x1p200 || (big < 0x1p-200 && big > 0)) {
-    int e = 0;
-    std::frexp(big, &e);
-    const double f = std::ldexp(1.0, -e);
+  // The discriminant below is of the fourth degree: lengths far from 1, or speeds far from a
+  // length per unit of time, would overflow or underflow it and lose the roots. Lengths are
+  // then scaled by a power of two near their largest, and time by another so that speeds
+  // come near a length per unit of time (velocities take the time unit first, so that neither
+  // product leaves the range of doubles); both are exact, and the roots are scaled back
+  // exactly. Ratios of speed to length beyond 2^1000 stay out of reach.
+  double unit = 1;  // the time unit of the equation solved
+  if (len > 0 && (len > 0x1p100 || len < 0x1p-100 ||
+                  (speed > 0 && (speed > len * 0x1p100 || speed * 0x1p100 < len)))) {
+    const int el = std::max(std::ilogb(len), -1000);
+    const int gap = speed > 0 ? std::clamp(std::ilogb(speed) - el, -1000, 1000) : 0;
+    const double f = std::ldexp(1.0, -el);
+    unit = std::ldexp(1.0, -gap);
     r *= f;
     for (int k = 0; k < D; ++k)
-      rel[k] *= f, vel[k] *= f;
+      rel[k] *= f, vel[k] = vel[k] * unit * f;
   }
   double dd = 0, dv = 0, vv = 0;
   for (int k = 0; k < D; ++k) {
@@ -131,8 +138,8 @@ ContactInterval sphere_contact(const Point<D>& ca, double ra, const Point<D>& va
     const double disc = dv * dv - vv * c;
     if (disc < 0) return ContactInterval::none();
     const double q = -(dv + std::copysign(std::sqrt(disc), dv));
-    double r1 = q / vv;
-    double r2 = q != 0 ? c / q : r1;
+    double r1 = q / vv * unit;
+    double r2 = (q != 0 ? c / q : q / vv) * unit;
     if (r1 > r2) std::swap(r1, r2);
     enter = std::max(t0, r1);
     exit = std::min(t1, r2);

@@ -102,6 +102,8 @@ class BasicSweepPrune {
 
  public:
   static constexpr int dimension = D;
+  // The id of the entries that separate stripes in entry_pairs' order.
+  static constexpr Id kSeparator = std::numeric_limits<Id>::max();
 
   // SweepPrune cuts space into stripes once it holds `striped_from` proxies (see above).
   explicit BasicSweepPrune(std::size_t striped_from = kStripedFrom) : striped_from_(striped_from) {}
@@ -168,10 +170,11 @@ class BasicSweepPrune {
   // pairs() for a caller that keeps data of its own per proxy in the sweep's order, so that
   // its test of a pair reads neighbouring memory: after sorting, order(ids) is called once
   // with the proxy id of every entry of the sweep in that order (a proxy has an entry in each
-  // stripe it spans; the entries that separate stripes hold kNone and are never visited),
-  // then visit(e, partners) for each entry e whose box meets others': partners holds the
-  // positions f > e in `ids` of those entries, each pair once over the whole sweep; a visit
-  // returning false stops.
+  // stripe it spans; the entries that separate stripes hold kSeparator, the largest Id, and
+  // are never visited: a proxy with that id looks like one there), then visit(e, partners)
+  // for each entry e whose box meets others': partners holds the positions f > e in `ids` of
+  // those entries, each pair once over the whole sweep; a visit returning false stops. The
+  // stats count as results every partner handed over.
   template <class Order, class F>
   QueryStats entry_pairs(Order&& order, F&& visit) {
     sort_and_gather();
@@ -411,7 +414,7 @@ class BasicSweepPrune {
   void gather_sentinel() {
     start_[count_] = std::numeric_limits<double>::infinity();
     hi_[count_] = -std::numeric_limits<double>::infinity();
-    ids_[count_] = kNone;
+    ids_[count_] = kSeparator;
     ++count_;
   }
 

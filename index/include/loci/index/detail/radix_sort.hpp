@@ -18,15 +18,17 @@ struct KeyedIndex {
   std::uint32_t index;
 };
 
-// Sorts v by bits [first_bit, first_bit + bits) of key_of(element), using `tmp` as the second
-// buffer (kept by a caller that sorts every tick, so that its memory is not faulted in again).
-// One pass counts every digit; each digit then costs one scatter pass.
+// Sorts v by bits [first_bit, first_bit + bits) of key_of(element) (first_bit + bits <= 64;
+// the last digit also reads the bits just above them, which callers leave at 0), using `tmp` as the
+// second buffer (kept by a caller that sorts every tick, so that its memory is not faulted in
+// again). One pass counts every digit; each digit then costs one scatter pass.
 template <class T, class A, class KeyOf>
 void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of,
                 std::vector<T, A>& tmp) {
   constexpr int kDigit = 11;
   constexpr std::size_t kBuckets = std::size_t(1) << kDigit;
   constexpr int kMaxPasses = (64 + kDigit - 1) / kDigit;
+  bits = std::min(bits, 64 - first_bit);  // no shift reaches 64
   const int passes = std::min((bits + kDigit - 1) / kDigit, kMaxPasses);
   if (v.size() < 2 || passes <= 0) return;
   std::vector<std::array<std::size_t, kBuckets>> count(static_cast<std::size_t>(passes));

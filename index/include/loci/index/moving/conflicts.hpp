@@ -165,7 +165,10 @@ class ConflictFinder {
     // relative position at `now` and velocity, the least squared distance over the horizon
     // is |d|^2 when d.w >= 0 (moving apart), |d + wH|^2 when the closest approach is past H,
     // and |d|^2 - (d.w)^2 / |w|^2 otherwise, compared multiplied by |w|^2 and with a slack
-    // of 1e-14 |d|^2 |w|^2 that covers its rounding (an overflow makes it false: not apart).
+    // of 1e-14 |d|^2 |w|^2 that covers its rounding while the products are normal numbers
+    // (about 10 ulps of |d|^2 |w|^2 in 3D); an overflow makes it false (not apart), and so do
+    // products near the subnormal range. d and w are computed as the exact test computes
+    // them, whose own rounding the margin of `reach` covers.
     const double reach = within * (1 + 1e-9) + 1e-9 * scale_;
     const double reach2 = reach * reach;
     auto clearly_apart = [&](const Kinematics& p, const Kinematics& q) {
@@ -182,8 +185,11 @@ class ConflictFinder {
       const bool apart_now = dd > reach2, apart_end = ee > reach2;
       const bool apart_mid = ddww - dw * dw - 1e-14 * ddww > reach2 * ww;
       const bool receding = dw >= 0, past = -dw >= horizon * ww;
-      return (receding & apart_now) | (!receding & past & apart_end) |
-             (!receding & !past & apart_mid);
+      // Where |w|^2 or |d|^2 |w|^2 nears the subnormal range the products lose their
+      // relative precision (and a |w|^2 of 0 sends the exact test to u = 0): not decided here.
+      const bool normal = (ww >= 0x1p-1000) & (dd >= 0x1p-1000) & (ddww >= 0x1p-960);
+      return (receding & apart_now) | (!receding & normal & past & apart_end) |
+             (!receding & normal & !past & apart_mid);
     };
     const double step = horizon / double(slices);
     for (std::size_t s = 0; s < slices; ++s) {
@@ -209,7 +215,7 @@ class ConflictFinder {
         kin_.resize(ids.size());
         near_.resize(ids.size());
         for (std::size_t e = 0; e < ids.size(); ++e) {
-          if (ids[e] == kNone) continue;
+          if (ids[e] == SweepPrune<D>::kSeparator) continue;
           const Motion<D>& m = motion_[ids[e]];
           kin_[e] = {position(m, now), m.v};
         }
