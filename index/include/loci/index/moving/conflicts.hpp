@@ -131,6 +131,12 @@ inline void check_conflict_query(double within, double now, double horizon) {
 }
 
 namespace detail {
+// An object's position at some time and its velocity: what a quick test of a pair reads.
+template <int D>
+struct Kinematics {
+  Point<D> p, v;
+};
+
 // Closest approaches square differences of positions and velocities: every object must stay
 // within +-kMaxCoordinate over [t0, t1] (it moves linearly: checked at both ends), or the
 // arithmetic could overflow and lose pairs; out_of_range throws the error naming `who`.
@@ -171,7 +177,7 @@ class ConflictFinder {
     // them, whose own rounding the margin of `reach` covers.
     const double reach = within * (1 + 1e-9) + 1e-9 * scale_;
     const double reach2 = reach * reach;
-    auto clearly_apart = [&](const Kinematics& p, const Kinematics& q) {
+    auto clearly_apart = [&](const detail::Kinematics<D>& p, const detail::Kinematics<D>& q) {
       double dw = 0, ww = 0, dd = 0, ee = 0;
       for (int k = 0; k < D; ++k) {
         const double d = q.p[k] - p.p[k], w = q.v[k] - p.v[k];
@@ -222,7 +228,7 @@ class ConflictFinder {
       };
       auto run = [&](std::size_t e, std::span<const std::uint32_t> partners) {
         st.entries_tested += partners.size();
-        const Kinematics p = kin_[e];
+        const detail::Kinematics<D> p = kin_[e];
         // The quick test over the run, its survivors left-packed into near_.
         std::size_t kept = 0;
         for (const std::uint32_t f : partners) {
@@ -284,18 +290,14 @@ class ConflictFinder {
     }
   }
 
-  // An object's position at `now` and its velocity: what the quick test of a pair reads.
-  struct Kinematics {
-    Point<D> p, v;
-  };
-
   SweepPrune<D> broad_;
   std::size_t held_ = 0;  // proxies 0 .. held_ - 1 are in broad_
   // Large arrays, so that a search made once does not spend its time faulting pages in.
   detail::LargeVector<detail::KeyedIndex> keyed_, spare_;  // Hilbert sort, and its second buffer
   detail::LargeVector<std::uint32_t> order_;               // input index by proxy number
   detail::LargeVector<Motion<D>> motion_;                  // the reports by proxy number
-  detail::LargeVector<Kinematics> kin_;  // positions at `now` and velocities by entry of the sweep
+  // Positions at `now` and velocities by entry of the sweep.
+  detail::LargeVector<detail::Kinematics<D>> kin_;
   detail::LargeVector<std::uint32_t> near_;  // a run's partners that pass the quick test
   double scale_ = 0;                         // largest coordinate magnitude reached
 };
@@ -452,8 +454,8 @@ class ConflictMonitor {
         if (t == s || dirty_seen_[t]) return true;
         // comes_within(motion_[s], motion_[t], base_, t1 - base_, keep_), from the positions
         // at the base kept for every object
-        const State& x = at_base_[s];
-        const State& y = at_base_[t];
+        const detail::Kinematics<D>& x = at_base_[s];
+        const detail::Kinematics<D>& y = at_base_[t];
         if (detail::closest_at(x.p, x.v, y.p, y.v, t1 - base_).dcpa <= keep_) keep(s, t);
         return true;
       };
@@ -513,9 +515,6 @@ class ConflictMonitor {
   }
 
  private:
-  struct State {
-    Point<D> p, v;  // position at the base, velocity
-  };
   // A kept pair, by slots, with the versions of their reports when it was found and its
   // closest approach within D over the span (dcpa = infinity when it comes within keep_ only).
   struct Kept {
@@ -615,11 +614,11 @@ class ConflictMonitor {
   std::vector<Motion<D>> motion_;
   std::vector<std::uint8_t> alive_, dirty_, dirty_seen_, moved_;
   std::vector<std::uint32_t> dirty_list_, free_;
-  std::vector<std::uint32_t> version_;  // reports and removals of each slot, counted
-  std::vector<std::uint32_t> degree_;   // kept pairs of each slot since the last sweep
-  detail::LargeVector<Kept> kept_;      // on huge pages: tens of megabytes in a dense fleet
-  std::vector<State> at_base_;          // by slot
-  std::size_t forgotten_ = 0;           // kept pairs whose versions no longer match, at most
+  std::vector<std::uint32_t> version_;          // reports and removals of each slot, counted
+  std::vector<std::uint32_t> degree_;           // kept pairs of each slot since the last sweep
+  detail::LargeVector<Kept> kept_;              // on huge pages: tens of megabytes in a dense fleet
+  std::vector<detail::Kinematics<D>> at_base_;  // by slot
+  std::size_t forgotten_ = 0;  // kept pairs whose versions no longer match, at most
   detail::IdMap slots_;
   std::size_t count_ = 0;
   PackedRTree<D> packed_;                   // grown swept boxes at the base
