@@ -33,6 +33,10 @@
 #include <string>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "loci/index/broadphase/detail/proxy_table.hpp"
 #include "loci/index/detail/best_first.hpp"
 #include "loci/index/detail/node_pool.hpp"
@@ -352,6 +356,10 @@ class MovingRTree {
   // run as one vectorized loop; box[e] reads (and, on a mutable node, writes) one entry.
   struct BoxArray {
     double lo[D][kSlots], hi[D][kSlots], vlo[D][kSlots], vhi[D][kSlots];
+    // Each entry's TPR* cost at relative time costed_at, kept by enlargements() for
+    // Choose_Path; NaN: not known (set() forgets it, so every write of an entry does).
+    double cost[kSlots];
+    double costed_at = std::numeric_limits<double>::quiet_NaN();
 
     Box_ get(int e) const {
       Box_ b;
@@ -362,6 +370,7 @@ class MovingRTree {
     void set(int e, const Box_& b) {
       for (int i = 0; i < D; ++i)
         lo[i][e] = b.lo[i], hi[i][e] = b.hi[i], vlo[i][e] = b.vlo[i], vhi[i][e] = b.vhi[i];
+      cost[e] = std::numeric_limits<double>::quiet_NaN();
     }
     struct Ref {
       BoxArray& a;
@@ -461,49 +470,123 @@ class MovingRTree {
     }
   }
 
+  // The TPR* cost of a box given per axis by its bounds at the clock (l, u) and the velocities
+  // of its bounds (vl, vh): the arithmetic of detail::swept_cost, in the same order.
+  static double swept(const double* l, const double* u, const double* vl, const double* vh,
+                      double h, const Point<D>& extent) {
+    double e1[D], e2[D], s[D];
+    for (int i = 0; i < D; ++i) {
+      e1[i] = u[i] - l[i] + extent[i];
+      e2[i] = e1[i] + (vh[i] - vl[i]) * h;
+      s[i] = vl[i] > 0 ? vh[i] : vh[i] < 0 ? -vl[i] : vh[i] - vl[i];
+    }
+    double area = 1;
+    for (int i = 0; i < D; ++i)
+      area *= e1[i];
+    for (int i = 0; i < D; ++i) {
+      double up = 1, down = 1;
+      for (int j = 0; j < D; ++j)
+        if (j != i) up *= e1[j], down *= e2[j];
+      area += 0.5 * (up + down) * s[i] * h;
+    }
+    return area;
+  }
+  // The cost of entry e of a at relative time c.
+  double entry_cost(const BoxArray& a, int e, double c) const {
+    double l[D], u[D], vl[D], vh[D];
+    for (int i = 0; i < D; ++i) {
+      vl[i] = a.vlo[i][e], vh[i] = a.vhi[i][e];
+      l[i] = a.lo[i][e] + vl[i] * c, u[i] = a.hi[i][e] + vh[i] * c;
+    }
+    return swept(l, u, vl, vh, Policy::horizon(params_), Policy::extent(params_));
+  }
+
   // pen[e]: the rise of the TPR* cost of entry e's box when it takes b (0 when it holds b),
-  // for all entries of a node in one vectorized loop; the arithmetic of detail::swept_cost.
-  void enlargements(const Node& n, const Box_& b, double* pen) const {
+  // for all entries of a node in one vectorized loop. The entries' own costs at the clock
+  // come from the node's cache (BoxArray::cost), filled here: all of them when the clock has
+  // moved since, otherwise those of entries written since.
+  void enlargements(Node& n, const Box_& b, double* pen) {
     const double c = rel_clock(), h = Policy::horizon(params_);
     const Point<D> extent = Policy::extent(params_);
-    const BoxArray& a = n.box;
-    double bl[D], bh[D];
-    for (int i = 0; i < D; ++i)
+    BoxArray& a = n.box;
+    if (a.costed_at != c) {
+      a.costed_at = c;
+      for (int e = 0; e < n.count; ++e)
+        a.cost[e] = entry_cost(a, e, c);
+    } else {
+      for (int e = 0; e < n.count; ++e)
+        if (std::isnan(a.cost[e])) a.cost[e] = entry_cost(a, e, c);
+    }
+    double bl[D], bh[D], bvl[D], bvh[D];
+    for (int i = 0; i < D; ++i) {
       bl[i] = b.lo_at(i, c), bh[i] = b.hi_at(i, c);
+      bvl[i] = b.vlo[i], bvh[i] = b.vhi[i];
+    }
     for (int e = 0; e < n.count; ++e) {
-      double e1[D], e2[D], sp[D], g1[D], g2[D], gs[D];
+      double g1[D], g2[D], gs[D];
       for (int i = 0; i < D; ++i) {
         const double l = a.lo[i][e] + a.vlo[i][e] * c, u = a.hi[i][e] + a.vhi[i][e] * c;
         const double vl = a.vlo[i][e], vh = a.vhi[i][e];
-        e1[i] = u - l + extent[i];
-        e2[i] = e1[i] + (vh - vl) * h;
-        sp[i] = vl > 0 ? vh : vh < 0 ? -vl : vh - vl;
         const double gl = std::min(l, bl[i]), gu = std::max(u, bh[i]);
-        const double gvl = std::min(vl, b.vlo[i]), gvh = std::max(vh, b.vhi[i]);
+        const double gvl = std::min(vl, bvl[i]), gvh = std::max(vh, bvh[i]);
         g1[i] = gu - gl + extent[i];
         g2[i] = g1[i] + (gvh - gvl) * h;
         gs[i] = gvl > 0 ? gvh : gvh < 0 ? -gvl : gvh - gvl;
       }
-      double before = 1, after = 1;
+      double after = 1;
       for (int i = 0; i < D; ++i)
-        before *= e1[i], after *= g1[i];
+        after *= g1[i];
       for (int i = 0; i < D; ++i) {
-        double up = 1, down = 1, gup = 1, gdown = 1;
+        double up = 1, down = 1;
         for (int j = 0; j < D; ++j)
-          if (j != i) up *= e1[j], down *= e2[j], gup *= g1[j], gdown *= g2[j];
-        before += 0.5 * (up + down) * sp[i] * h;
-        after += 0.5 * (gup + gdown) * gs[i] * h;
+          if (j != i) up *= g1[j], down *= g2[j];
+        after += 0.5 * (up + down) * gs[i] * h;
       }
-      pen[e] = std::max(0.0, after - before);
+      pen[e] = std::max(0.0, after - a.cost[e]);
     }
   }
   double cost(const Box_& b) const {
     return detail::swept_cost(b, rel_clock(), Policy::horizon(params_), Policy::extent(params_));
   }
+  // The bounds of n's entries from the clock on: per axis the least lower bound at the clock
+  // and the least lower velocity (the greatest for the upper side), as Tpbr::enclose takes
+  // them, gathered in one pass over the node's arrays (two entries a step with SSE2).
   Box_ bound(const Node& n) const {
-    Box_ b = n.box[0];
-    for (int e = 1; e < n.count; ++e)
-      b.enclose(n.box[e], rel_clock());
+    const double c = rel_clock();
+    const BoxArray& a = n.box;
+    Box_ b;
+    for (int i = 0; i < D; ++i) {
+      double l = a.lo[i][0] + a.vlo[i][0] * c, h = a.hi[i][0] + a.vhi[i][0] * c;
+      double vl = a.vlo[i][0], vh = a.vhi[i][0];
+      int e = 1;
+#if defined(__SSE2__)
+      if (n.count >= 3) {
+        const __m128d cc = _mm_set1_pd(c);
+        __m128d l2 = _mm_set1_pd(l), h2 = _mm_set1_pd(h), vl2 = _mm_set1_pd(vl),
+                vh2 = _mm_set1_pd(vh);
+        for (; e + 2 <= n.count; e += 2) {
+          const __m128d lo = _mm_loadu_pd(&a.lo[i][e]), hi = _mm_loadu_pd(&a.hi[i][e]);
+          const __m128d vlo = _mm_loadu_pd(&a.vlo[i][e]), vhi = _mm_loadu_pd(&a.vhi[i][e]);
+          l2 = _mm_min_pd(l2, _mm_add_pd(lo, _mm_mul_pd(vlo, cc)));
+          h2 = _mm_max_pd(h2, _mm_add_pd(hi, _mm_mul_pd(vhi, cc)));
+          vl2 = _mm_min_pd(vl2, vlo);
+          vh2 = _mm_max_pd(vh2, vhi);
+        }
+        l = std::min(_mm_cvtsd_f64(l2), _mm_cvtsd_f64(_mm_unpackhi_pd(l2, l2)));
+        h = std::max(_mm_cvtsd_f64(h2), _mm_cvtsd_f64(_mm_unpackhi_pd(h2, h2)));
+        vl = std::min(_mm_cvtsd_f64(vl2), _mm_cvtsd_f64(_mm_unpackhi_pd(vl2, vl2)));
+        vh = std::max(_mm_cvtsd_f64(vh2), _mm_cvtsd_f64(_mm_unpackhi_pd(vh2, vh2)));
+      }
+#endif
+      for (; e < n.count; ++e) {
+        l = std::min(l, a.lo[i][e] + a.vlo[i][e] * c);
+        h = std::max(h, a.hi[i][e] + a.vhi[i][e] * c);
+        vl = std::min(vl, a.vlo[i][e]);
+        vh = std::max(vh, a.vhi[i][e]);
+      }
+      b.vlo[i] = vl, b.vhi[i] = vh;
+      b.lo[i] = l - vl * c, b.hi[i] = h - vh * c;
+    }
     return b;
   }
 
@@ -560,14 +643,17 @@ class MovingRTree {
   }
 
   // Choose_Path: the node of `level` whose taking `b` raises the summed cost of the path to
-  // it least. Partial paths wait in a heap by their cost so far; the children of a node just
-  // above the target level are candidates, compared with the best found (minpen), and the
-  // search ends when no waiting path is cheaper than it.
+  // it least, by branch and bound. A greedy descent (the cheapest entry of each node on the
+  // way) gives a first candidate and its cost, minpen; partial paths cheaper than minpen then
+  // wait in a heap by their cost so far, the children of a node just above the target level
+  // are candidates compared with minpen, and the search ends when no waiting path is cheaper.
+  // Rises are never negative, so no path left out could have done better: the answer is the
+  // best path of the whole tree, as a best-first search from the root finds it, but paths
+  // that cannot win never enter the heap.
   //
   // Costs of boxes spread over more than about 1e102 in 3D overflow to inf (the rises are
-  // never NaN: enlargements() clamps them with std::max), and inf is not less than the initial
-  // minpen. Until a candidate is found, paths are therefore followed and candidates taken
-  // whatever their cost, so that there is always an answer: the first cheapest one met.
+  // never NaN: enlargements() clamps them with std::max); then the greedy candidate's minpen
+  // is inf and any path of finite cost replaces it.
   std::uint32_t choose_path(const Box_& b, int level) {
     if (nodes_[root_].level == level) return root_;
     struct Waiting {
@@ -575,25 +661,61 @@ class MovingRTree {
       std::uint32_t node;
       bool operator<(const Waiting& o) const { return key > o.key; }
     };
+    // The greedy descent, each node's rises kept for the bound below.
+    struct Step {
+      std::uint32_t node;
+      int taken;
+      double key;
+      double rise[kSlots];
+    };
+    thread_local std::vector<Step> path;
     thread_local std::vector<Waiting> heap;
+    path.clear();
     heap.clear();
-    heap.push_back({0, root_});
     std::size_t explored = 0;
-    double minpen = std::numeric_limits<double>::infinity();
-    std::uint32_t best = kNone;
+    double minpen;
+    std::uint32_t best;
+    for (std::uint32_t x = root_, depth = 0;; ++depth) {
+      if (path.size() <= depth) path.emplace_back();
+      Step& st = path[depth];
+      Node& n = nodes_[x];
+      ++explored;
+      enlargements(n, b, st.rise);
+      int arg = 0;
+      for (int e = 1; e < n.count; ++e)
+        if (st.rise[e] < st.rise[arg]) arg = e;
+      st.node = x;
+      st.taken = arg;
+      st.key = depth == 0 ? 0.0 : path[depth - 1].key + path[depth - 1].rise[path[depth - 1].taken];
+      if (n.level == level + 1) {
+        minpen = st.key + st.rise[arg];
+        best = n.child[arg];
+        path.resize(depth);  // the last node's other entries cost no less than the candidate
+        break;
+      }
+      x = n.child[arg];
+    }
+    for (const Step& st : path) {
+      const Node& n = nodes_[st.node];
+      for (int e = 0; e < n.count; ++e) {
+        const double pen = st.key + st.rise[e];
+        if (e != st.taken && pen < minpen) heap.push_back({pen, n.child[e]});
+      }
+    }
+    std::make_heap(heap.begin(), heap.end());
     while (!heap.empty()) {
       std::pop_heap(heap.begin(), heap.end());
       const Waiting top = heap.back();
       heap.pop_back();
-      if (best != kNone && !(top.key < minpen)) break;
-      const Node& n = nodes_[top.node];
+      if (!(top.key < minpen)) break;
+      Node& n = nodes_[top.node];
       ++explored;
       const bool last = n.level == level + 1;
       double rise[kSlots];
       enlargements(n, b, rise);
       for (int e = 0; e < n.count; ++e) {
         const double pen = top.key + rise[e];
-        if (best != kNone && !(pen < minpen)) continue;
+        if (!(pen < minpen)) continue;
         if (last) {
           minpen = pen;
           best = n.child[e];
@@ -604,8 +726,6 @@ class MovingRTree {
       }
     }
     max_choose_nodes_ = std::max(max_choose_nodes_, explored);
-    if (best == kNone)
-      throw Error(std::string(kName) + ": no node of level " + std::to_string(level) + " found");
     return best;
   }
 
@@ -634,7 +754,6 @@ class MovingRTree {
     }
   }
 
-  // Sort key k of entry b: k / D picks lo at now, hi at now, vlo, vhi; k % D the axis.
   // Sort key k of entry e: k / D picks lo at the clock, hi at the clock, vlo, vhi; k % D the
   // axis.
   double key(const Node& node, int e, int k) const {
@@ -652,25 +771,42 @@ class MovingRTree {
     }
   }
 
-  void order_by(const Node& node, int k, bool descending, std::uint8_t* order) const {
+  // The node's entries in ascending order of sort key k.
+  void order_by(const Node& node, int k, std::uint8_t* order) const {
     double keys[kSlots];
     for (int e = 0; e < node.count; ++e) {
       order[e] = std::uint8_t(e);
-      keys[e] = descending ? -key(node, e, k) : key(node, e, k);
+      keys[e] = key(node, e, k);
     }
     std::sort(order, order + node.count, [&](int x, int y) { return keys[x] < keys[y]; });
   }
 
+  // The bounds from the clock on of entries order[from, to) of node, as bound() takes them.
   Box_ union_of(const Node& node, const std::uint8_t* order, int from, int to) const {
-    Box_ b = node.box[order[from]];
-    for (int e = from + 1; e < to; ++e)
-      b.enclose(node.box[order[e]], rel_clock());
+    const double c = rel_clock();
+    const BoxArray& a = node.box;
+    Box_ b;
+    for (int i = 0; i < D; ++i) {
+      const int f = order[from];
+      double l = a.lo[i][f] + a.vlo[i][f] * c, h = a.hi[i][f] + a.vhi[i][f] * c;
+      double vl = a.vlo[i][f], vh = a.vhi[i][f];
+      for (int k = from + 1; k < to; ++k) {
+        const int e = order[k];
+        l = std::min(l, a.lo[i][e] + a.vlo[i][e] * c);
+        h = std::max(h, a.hi[i][e] + a.vhi[i][e] * c);
+        vl = std::min(vl, a.vlo[i][e]);
+        vh = std::max(vh, a.vhi[i][e]);
+      }
+      b.vlo[i] = vl, b.vhi[i] = vh;
+      b.lo[i] = l - vl * c, b.hi[i] = h - vh * c;
+    }
     return b;
   }
 
   // Pick_Worst: removes the entries whose absence shrinks the node's cost most and reinserts
-  // them. Costs that overflow to inf (or NaN, from inf * 0) gain nothing: when no order does
-  // better, the first is taken.
+  // them. Each order is sorted once and serves both ends: the `taken` greatest entries
+  // (descending) and the `taken` least (ascending). Costs that overflow to inf (or NaN, from
+  // inf * 0) gain nothing: when no order does better, the first is taken.
   void pick_worst(std::uint32_t n, std::uint32_t& reinserted) {
     Node& node = nodes_[n];
     const int total = node.count;
@@ -678,17 +814,23 @@ class MovingRTree {
     std::uint8_t order[M + 1], best_order[M + 1];
     double best_gain = -std::numeric_limits<double>::infinity();
     bool chosen = false;
-    for (int k = 0; k < 4 * D; ++k)
+    for (int k = 0; k < 4 * D; ++k) {
+      order_by(node, k, order);
       for (bool descending : {true, false}) {
-        order_by(node, k, descending, order);
-        const double rest = cost(union_of(node, order, taken, total));
+        const double rest = descending ? cost(union_of(node, order, 0, total - taken))
+                                       : cost(union_of(node, order, taken, total));
         const double gain = std::isnan(rest) ? -std::numeric_limits<double>::infinity() : -rest;
         if (!chosen || gain > best_gain) {
           chosen = true;
           best_gain = gain;
-          std::copy(order, order + total, best_order);
+          // The taken entries first.
+          if (descending)
+            std::reverse_copy(order, order + total, best_order);
+          else
+            std::copy(order, order + total, best_order);
         }
       }
+    }
     // Take the chosen entries out, keep the rest in place.
     Item out[M + 1];
     bool leaving[M + 1] = {};
@@ -722,7 +864,7 @@ class MovingRTree {
     double best = std::numeric_limits<double>::infinity();
     Box_ prefix[M + 1], suffix[M + 1];
     for (int k = 0; k < 4 * D; ++k) {
-      order_by(node, k, false, order);
+      order_by(node, k, order);
       prefix[0] = node.box[order[0]];
       for (int e = 1; e < total; ++e)
         (prefix[e] = prefix[e - 1]).enclose(node.box[order[e]], rel_clock());
