@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <unordered_map>
@@ -13,6 +14,86 @@
 #include "loci/index/moving/star_tree.hpp"
 #include "loci/index/moving/tpr_tree.hpp"
 #include "support/fleet_data.hpp"
+
+namespace loci::detail {
+
+// What the Choose_Path test reads of a tree's internals.
+struct MovingRTreeAccess {
+  template <int D, int M, class P>
+  static Tpbr<D> box_of(const MovingRTree<D, M, P>& t, const Motion<D>& m) {
+    return Tpbr<D>::of(m, t.epoch_);
+  }
+  template <int D, int M, class P>
+  static std::uint32_t choose_path(MovingRTree<D, M, P>& t, const Tpbr<D>& b, int level) {
+    return t.choose_path(b, level);
+  }
+  template <int D, int M, class P>
+  static std::uint32_t root(const MovingRTree<D, M, P>& t) {
+    return t.root_;
+  }
+  template <int D, int M, class P>
+  static std::uint32_t parent(const MovingRTree<D, M, P>& t, std::uint32_t x) {
+    return t.nodes_[x].parent;
+  }
+  template <int D, int M, class P>
+  static int level(const MovingRTree<D, M, P>& t, std::uint32_t x) {
+    return t.nodes_[x].level;
+  }
+  // The summed rises of cost along the path from the root to node x, from the top down (the
+  // order in which Choose_Path adds them).
+  template <int D, int M, class P>
+  static double path_cost(MovingRTree<D, M, P>& t, std::uint32_t x, const Tpbr<D>& b) {
+    std::vector<std::pair<std::uint32_t, int>> steps;  // (node, entry leading down)
+    for (; t.nodes_[x].parent != kNone; x = t.nodes_[x].parent)
+      steps.push_back({t.nodes_[x].parent, t.slot_in_parent(x)});
+    double key = 0;
+    for (auto it = steps.rbegin(); it != steps.rend(); ++it) {
+      double rise[M + 1];
+      t.enlargements(t.nodes_[it->first], b, rise);
+      key += rise[it->second];
+    }
+    return key;
+  }
+  // The largest difference between the rises enlargements() gives for the entries of node x
+  // and those of detail::swept_cost on the entry's box before and after taking b, relative to
+  // the costs involved.
+  template <int D, int M, class P>
+  static double rise_error(MovingRTree<D, M, P>& t, std::uint32_t x, const Tpbr<D>& b) {
+    double rise[M + 1];
+    auto& node = t.nodes_[x];
+    t.enlargements(node, b, rise);
+    const double c = t.rel_clock(), h = P::horizon(t.params());
+    const Point<D> extent = P::extent(t.params());
+    double worst = 0;
+    for (int e = 0; e < node.count; ++e) {
+      const Tpbr<D> before = node.box[e];
+      Tpbr<D> after = before;
+      after.enclose(b, c);
+      const double cb = swept_cost(before, c, h, extent), ca = swept_cost(after, c, h, extent);
+      worst = std::max(worst, std::abs(rise[e] - std::max(0.0, ca - cb)) / (ca + cb));
+    }
+    return worst;
+  }
+  // The least such sum over every node of `level`, by visiting all paths.
+  template <int D, int M, class P>
+  static double best_cost(MovingRTree<D, M, P>& t, const Tpbr<D>& b, int level) {
+    double best = std::numeric_limits<double>::infinity();
+    auto walk = [&](auto&& self, std::uint32_t x, double key) -> void {
+      if (t.nodes_[x].level == level) {
+        best = std::min(best, key);
+        return;
+      }
+      double rise[M + 1];
+      t.enlargements(t.nodes_[x], b, rise);
+      for (int e = 0; e < t.nodes_[x].count; ++e)
+        self(self, t.nodes_[x].child[e], key + rise[e]);
+    };
+    walk(walk, t.root_, 0.0);
+    return best;
+  }
+};
+
+}  // namespace loci::detail
 
 namespace loci {
 namespace {
@@ -430,6 +511,55 @@ void check_overflowing_costs() {
     for (std::size_t i = 0; i < near.size(); ++i)
       EXPECT_DOUBLE_EQ(near[i].distance, d[i]) << "nearest " << q << " rank " << i;
   }
+}
+
+// Choose_Path's branch and bound finds the path of least summed cost rise of the whole tree,
+// the one a search of every path finds, at every level, through updates at moving clocks, on
+// every fleet (the identical and stationary ones are all ties).
+template <class Tree>
+void check_choose_path() {
+  using Access = detail::MovingRTreeAccess;
+  for (test::Fleet f : test::kAllFleets) {
+    const auto fleet = test::make_fleet(f, 1200, 11);
+    Tree tree;
+    for (std::size_t i = 0; i < fleet.size(); ++i)
+      tree.insert(i, fleet[i]);
+    ASSERT_GE(tree.height(), 3) << test::name(f);
+    std::mt19937_64 rng(17);
+    std::uniform_int_distribution<std::size_t> pick(0, fleet.size() - 1);
+    std::uniform_real_distribution<double> u(-100, 1100), v(-4, 4);
+    const double t0 = test::fleet_epoch(f);
+    std::size_t checked = 0;
+    for (int tick = 1; tick <= 4; ++tick) {
+      const double now = t0 + tick;
+      for (int k = 0; k < 150; ++k) {
+        // Half of the probes are where an object of the fleet is now, half anywhere.
+        const Motion2& near = fleet[pick(rng)];
+        const Motion2 m = k % 2 ? Motion2{now, position(near, now), near.v}
+                                : Motion2{now, {u(rng), u(rng)}, {v(rng), v(rng)}};
+        tree.update(pick(rng), m);  // moves the clock and reshapes the tree
+        const auto b = Access::box_of(tree, m);
+        for (int level = 0; level + 1 < tree.height(); ++level) {
+          const std::uint32_t got = Access::choose_path(tree, b, level);
+          ASSERT_EQ(Access::level(tree, got), level);
+          ASSERT_LE(Access::rise_error(tree, Access::root(tree), b), 1e-12);
+          ASSERT_LE(Access::rise_error(tree, Access::parent(tree, got), b), 1e-12);
+          ASSERT_EQ(Access::path_cost(tree, got, b), Access::best_cost(tree, b, level))
+              << test::name(f) << " tick " << tick << " probe " << k << " level " << level;
+          ++checked;
+        }
+      }
+      tree.validate();
+    }
+    EXPECT_GE(checked, 4u * 150 * 2) << test::name(f);
+  }
+}
+
+TEST(TprTree, ChoosePathFindsTheCheapestPath) {
+  check_choose_path<TprEraseInsert>();
+}
+TEST(StarTree, ChoosePathFindsTheCheapestPath) {
+  check_choose_path<StarTree<2, 6>>();
 }
 
 TEST(TprTree, CostsOverflowingInThreeDimensions) {

@@ -49,6 +49,9 @@ namespace loci {
 
 namespace detail {
 
+// Reaches the internals of MovingRTree (defined by its tests only).
+struct MovingRTreeAccess;
+
 template <int D, int M, class Policy>
 class MovingRTree {
   static_assert(M >= 4 && M <= 63, "node entries are tracked in 64-bit masks");
@@ -350,6 +353,7 @@ class MovingRTree {
   }
 
  private:
+  friend struct MovingRTreeAccess;
   using Box_ = detail::Tpbr<D>;
   static constexpr int kSlots = M + 1;  // one spare entry while overflowing
 
@@ -1145,6 +1149,13 @@ class MovingRTree {
     if (n != root_ && node.count < kMinFill) throw Error(who + ": node under the minimum fill");
     if (n == root_ && node.level > 0 && node.count < 2) throw Error(who + ": root with one child");
     const double c = rel_clock();
+    // Entry costs kept for Choose_Path at the clock are those of the entries' boxes.
+    if (node.box.costed_at == c)
+      for (int e = 0; e < node.count; ++e) {
+        const double kept = node.box.cost[e], now = entry_cost(node.box, e, c);
+        if (!(node.box.stale >> e & 1) && kept != now && !(std::isnan(kept) && std::isnan(now)))
+          throw Error(who + ": node " + std::to_string(n) + " keeps a stale entry cost");
+      }
     if (n != root_) {
       const Box_& mine = nodes_[node.parent].box[slot_in_parent(n)];
       for (int e = 0; e < node.count; ++e)
