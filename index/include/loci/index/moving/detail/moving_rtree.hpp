@@ -756,16 +756,22 @@ class MovingRTree {
       if (!(top.key < minpen)) break;
       Node& n = nodes_[top.node];
       ++explored;
-      const bool last = n.level == level + 1;
       double rise[kSlots];
       enlargements(n, b, rise);
+      if (n.level == level + 1) {
+        // Candidates: the cheapest entry (the first of equals) against the best so far.
+        int arg = 0;
+        for (int e = 1; e < n.count; ++e)
+          if (rise[e] < rise[arg]) arg = e;
+        if (const double pen = top.key + rise[arg]; pen < minpen) {
+          minpen = pen;
+          best = n.child[arg];
+        }
+        continue;
+      }
       for (int e = 0; e < n.count; ++e) {
         const double pen = top.key + rise[e];
-        if (!(pen < minpen)) continue;
-        if (last) {
-          minpen = pen;
-          best = n.child[e];
-        } else {
+        if (pen < minpen) {
           heap.push_back({pen, n.child[e]});
           std::push_heap(heap.begin(), heap.end());
         }
