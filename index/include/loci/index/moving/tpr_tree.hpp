@@ -10,10 +10,13 @@
 // the horizon visits the node), and uses it everywhere:
 //
 // - Choose_Path (section 5.1): the insertion path is the one with the least total increase of
-//   that cost over all its nodes, found by a best-first search over the whole tree: partial
-//   paths wait in a priority queue keyed by the cost increase so far, and since increases are
-//   never negative the first node of the target level taken from the queue ends the best path.
-//   The greedy descent of R-trees looks at one node per level and can miss it.
+//   that cost over all its nodes, over the whole tree. The paper finds it best-first (partial
+//   paths in a priority queue keyed by the increase so far; increases are never negative, so
+//   the first node of the target level taken from the queue ends the best path). Here the
+//   greedy descent of R-trees (the cheapest entry of each node) gives a first path, and only
+//   partial paths cheaper than it enter the queue: the same best path, with the queue holding
+//   a few paths instead of every child of every node opened. Each node keeps its entries'
+//   own costs at the current time, so an increase costs one evaluation, not two.
 // - Pick_Worst (section 5.2): on the first overflow of a level during one insertion, the
 //   entries whose removal shrinks the node's cost most are reinserted instead of splitting:
 //   for each of the 4 D orders (lower or upper end, position at now or velocity, per axis) the

@@ -7,13 +7,14 @@
 // condensing. Objects are in flat arrays by slot (id, report, leaf) and ids map to slots through
 // detail::IdMap, so an update finds its leaf at once.
 //
-// What the structures share: Choose_Path (best-first search for the path of least total cost
-// rise), Pick_Worst reinsertion and splits over the 4 D sort orders, deletion with condensing
-// and tightening, in-place updates, packing (build), and exact queries (vectorized timeslice
-// tests; windows over an interval and moving windows by linear constraints; nearest-n
-// best-first). What they do not share comes from the Policy: the name, the parameters, the
-// cost of a box (Policy::horizon and Policy::extent feed detail::swept_cost: the TPR* swept
-// area, or with both zero the area at the clock) and, for the STAR-tree, local regrouping.
+// What the structures share: Choose_Path (branch and bound for the path of least total cost
+// rise, with each node's entry costs kept at the clock), Pick_Worst reinsertion and splits over the
+// 4 D sort orders, deletion with condensing and tightening, in-place updates, packing (build), and
+// exact queries (vectorized timeslice tests; windows over an interval and moving windows by linear
+// constraints; nearest-n best-first). What they do not share comes from the Policy: the name, the
+// parameters, the cost of a box (Policy::horizon and Policy::extent feed detail::swept_cost: the
+// TPR* swept area, or with both zero the area at the clock) and, for the STAR-tree, local
+// regrouping.
 //
 // Time. Bounds are kept relative to the tree's epoch (the time of its first report), so that
 // epoch-second timestamps lose no precision. A node's bounds are tightened at the tree's
