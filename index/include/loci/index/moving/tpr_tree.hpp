@@ -14,8 +14,9 @@
 //   paths in a priority queue keyed by the increase so far; increases are never negative, so
 //   the first node of the target level taken from the queue ends the best path). Here the
 //   greedy descent of R-trees (the cheapest entry of each node) gives a first path, and only
-//   partial paths cheaper than it enter the queue: the same best path, with the queue holding
-//   a few paths instead of every child of every node opened. Each node keeps its entries'
+//   partial paths cheaper than it enter the queue: a path of the same least cost (among equal
+//   ones the greedy path), with the queue holding a few paths instead of every child of every
+//   node opened. Each node keeps its entries'
 //   own costs at the current time, so an increase costs one evaluation, not two.
 // - Pick_Worst (section 5.2): on the first overflow of a level during one insertion, the
 //   entries whose removal shrinks the node's cost most are reinserted instead of splitting:
@@ -41,7 +42,8 @@
 // Complexity: insertion O(explored nodes x M) (the best-first search is usually a few paths);
 // erasure O(log n) plus reinsertion of dissolved nodes; window queries O(log n + visited);
 // nearest-n best-first (detail/best_first.hpp) over the boxes at the query time. Memory
-// about (4 D + 1) x 8 bytes an entry.
+// about (6 D + 4) x 8 bytes a slot of a node (the box, its kept cost, the child, and in
+// leaves the report and id), nodes 40% to 100% full.
 //
 // Thread-safety: const members may run concurrently with each other.
 #pragma once

@@ -362,8 +362,9 @@ class MovingRTree {
   // run as one vectorized loop; box[e] reads (and, on a mutable node, writes) one entry.
   struct BoxArray {
     double lo[D][kSlots], hi[D][kSlots], vlo[D][kSlots], vhi[D][kSlots];
-    // Each entry's TPR* cost at relative time costed_at, kept by enlargements() for
-    // Choose_Path, except for the entries set() has written since (bits of `stale`).
+    // The cost (Policy's) at relative time costed_at of each entry below the node's count,
+    // kept by enlargements() for Choose_Path, except for the entries set() has written since
+    // (bits of `stale`).
     double cost[kSlots];
     double costed_at = std::numeric_limits<double>::quiet_NaN();
     std::uint64_t stale = ~std::uint64_t(0);
@@ -477,127 +478,136 @@ class MovingRTree {
     }
   }
 
-  // The TPR* cost of a box given per axis by its bounds at the clock (l, u) and the velocities
-  // of its bounds (vl, vh): the arithmetic of detail::swept_cost, in the same order.
-  static double swept(const double* l, const double* u, const double* vl, const double* vh,
-                      double h, const Point<D>& extent) {
-    double e1[D], e2[D], s[D];
-    for (int i = 0; i < D; ++i) {
-      e1[i] = u[i] - l[i] + extent[i];
-      e2[i] = e1[i] + (vh[i] - vl[i]) * h;
-      s[i] = vl[i] > 0 ? vh[i] : vh[i] < 0 ? -vl[i] : vh[i] - vl[i];
-    }
-    double area = 1;
-    for (int i = 0; i < D; ++i)
-      area *= e1[i];
-    for (int i = 0; i < D; ++i) {
-      double up = 1, down = 1;
-      for (int j = 0; j < D; ++j)
-        if (j != i) up *= e1[j], down *= e2[j];
-      area += 0.5 * (up + down) * s[i] * h;
-    }
-    return area;
-  }
-  // The cost of entry e of a at relative time c.
-  double entry_cost(const BoxArray& a, int e, double c) const {
+  // A box as grown_costs() takes it: per axis its bounds at the clock and their velocities.
+  // nothing() grows no entry.
+  struct Taken {
     double l[D], u[D], vl[D], vh[D];
-    for (int i = 0; i < D; ++i) {
-      vl[i] = a.vlo[i][e], vh[i] = a.vhi[i][e];
-      l[i] = a.lo[i][e] + vl[i] * c, u[i] = a.hi[i][e] + vh[i] * c;
-    }
-    return swept(l, u, vl, vh, Policy::horizon(params_), Policy::extent(params_));
-  }
 
-  // pen[e]: the rise of the TPR* cost of entry e's box when it takes b (0 when it holds b),
-  // for all entries of a node in one vectorized loop. The entries' own costs at the clock
-  // come from the node's cache (BoxArray::cost), filled here: all of them when the clock has
-  // moved since, otherwise those of entries written since.
-  void enlargements(Node& n, const Box_& b, double* pen) {
-    const double c = rel_clock(), h = Policy::horizon(params_);
+    static Taken of(const Box_& b, double c) {
+      Taken t;
+      for (int i = 0; i < D; ++i) {
+        t.l[i] = b.lo_at(i, c), t.u[i] = b.hi_at(i, c);
+        t.vl[i] = b.vlo[i], t.vh[i] = b.vhi[i];
+      }
+      return t;
+    }
+    static Taken nothing() {
+      Taken t;
+      constexpr double inf = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < D; ++i)
+        t.l[i] = t.vl[i] = inf, t.u[i] = t.vh[i] = -inf;
+      return t;
+    }
+  };
+
+  // out[e - from] for the entries e in [from, to) of a: the cost (detail::swept_cost's
+  // arithmetic, in its order) at relative time c of the entry's box grown to take t. Entries'
+  // own costs (t = nothing()) and their costs after taking a box come from this one code, so
+  // that an entry holding the box rises by exactly 0 whatever a compiler fuses. With SSE2 two
+  // entries a step (a last odd entry in both lanes); s_i is max(vh, 0) - min(vl, 0), the
+  // value of swept_cost's cases.
+  void grown_costs(const BoxArray& a, int from, int to, const Taken& t, double c,
+                   double* out) const {
+    const double h = Policy::horizon(params_);
     const Point<D> extent = Policy::extent(params_);
-    BoxArray& a = n.box;
-    if (a.costed_at != c) {
-      a.costed_at = c;
-      for (int e = 0; e < n.count; ++e)
-        a.cost[e] = entry_cost(a, e, c);
-    } else {
-      for (std::uint64_t m = a.stale & ((std::uint64_t(1) << n.count) - 1); m != 0; m &= m - 1) {
-        const int e = std::countr_zero(m);
-        a.cost[e] = entry_cost(a, e, c);
-      }
-    }
-    a.stale = 0;
-    double bl[D], bh[D], bvl[D], bvh[D];
-    for (int i = 0; i < D; ++i) {
-      bl[i] = b.lo_at(i, c), bh[i] = b.hi_at(i, c);
-      bvl[i] = b.vlo[i], bvh[i] = b.vhi[i];
-    }
-    int e = 0;
 #if defined(__SSE2__)
-    // Two entries a step, the same arithmetic in the same order as the loop below (s_i as
-    // max(vh, 0) - min(vl, 0), the same value).
-    {
-      const __m128d cc = _mm_set1_pd(c), hh = _mm_set1_pd(h), half = _mm_set1_pd(0.5),
-                    zero = _mm_setzero_pd();
-      for (; e + 2 <= n.count; e += 2) {
-        __m128d g1[D], g2[D], gs[D];
-        for (int i = 0; i < D; ++i) {
-          const __m128d vl = _mm_loadu_pd(&a.vlo[i][e]), vh = _mm_loadu_pd(&a.vhi[i][e]);
-          const __m128d l = _mm_add_pd(_mm_loadu_pd(&a.lo[i][e]), _mm_mul_pd(vl, cc));
-          const __m128d u = _mm_add_pd(_mm_loadu_pd(&a.hi[i][e]), _mm_mul_pd(vh, cc));
-          const __m128d gl = _mm_min_pd(l, _mm_set1_pd(bl[i]));
-          const __m128d gu = _mm_max_pd(u, _mm_set1_pd(bh[i]));
-          const __m128d gvl = _mm_min_pd(vl, _mm_set1_pd(bvl[i]));
-          const __m128d gvh = _mm_max_pd(vh, _mm_set1_pd(bvh[i]));
-          g1[i] = _mm_add_pd(_mm_sub_pd(gu, gl), _mm_set1_pd(extent[i]));
-          g2[i] = _mm_add_pd(g1[i], _mm_mul_pd(_mm_sub_pd(gvh, gvl), hh));
-          gs[i] = _mm_sub_pd(_mm_max_pd(gvh, zero), _mm_min_pd(gvl, zero));
-        }
-        __m128d after = _mm_set1_pd(1.0);
-        for (int i = 0; i < D; ++i)
-          after = _mm_mul_pd(after, g1[i]);
-        for (int i = 0; i < D; ++i) {
-          __m128d up = _mm_set1_pd(1.0), down = _mm_set1_pd(1.0);
-          for (int j = 0; j < D; ++j)
-            if (j != i) up = _mm_mul_pd(up, g1[j]), down = _mm_mul_pd(down, g2[j]);
-          const __m128d term =
-              _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(half, _mm_add_pd(up, down)), gs[i]), hh);
-          after = _mm_add_pd(after, term);
-        }
-        // max(x, 0) gives 0 for NaN, as std::max(0.0, x) does.
-        _mm_storeu_pd(&pen[e], _mm_max_pd(_mm_sub_pd(after, _mm_loadu_pd(&a.cost[e])), zero));
-      }
+    const __m128d cc = _mm_set1_pd(c), hh = _mm_set1_pd(h), half = _mm_set1_pd(0.5),
+                  zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
+    __m128d tl[D], tu[D], tvl[D], tvh[D], ext[D];
+    for (int i = 0; i < D; ++i) {
+      tl[i] = _mm_set1_pd(t.l[i]), tu[i] = _mm_set1_pd(t.u[i]);
+      tvl[i] = _mm_set1_pd(t.vl[i]), tvh[i] = _mm_set1_pd(t.vh[i]);
+      ext[i] = _mm_set1_pd(extent[i]);
     }
-#endif
-    for (; e < n.count; ++e) {
+    // Entries e and e + 1, or e twice when `pair` is false.
+    auto step = [&](int e, bool pair) {
+      __m128d g1[D], g2[D], gs[D];
+      for (int i = 0; i < D; ++i) {
+        const auto load = [&](const double* p) {
+          return pair ? _mm_loadu_pd(p + e) : _mm_set1_pd(p[e]);
+        };
+        const __m128d vl = load(a.vlo[i]), vh = load(a.vhi[i]);
+        const __m128d l = _mm_add_pd(load(a.lo[i]), _mm_mul_pd(vl, cc));
+        const __m128d u = _mm_add_pd(load(a.hi[i]), _mm_mul_pd(vh, cc));
+        const __m128d gl = _mm_min_pd(l, tl[i]), gu = _mm_max_pd(u, tu[i]);
+        const __m128d gvl = _mm_min_pd(vl, tvl[i]), gvh = _mm_max_pd(vh, tvh[i]);
+        g1[i] = _mm_add_pd(_mm_sub_pd(gu, gl), ext[i]);
+        g2[i] = _mm_add_pd(g1[i], _mm_mul_pd(_mm_sub_pd(gvh, gvl), hh));
+        gs[i] = _mm_sub_pd(_mm_max_pd(gvh, zero), _mm_min_pd(gvl, zero));
+      }
+      __m128d area = one;
+      for (int i = 0; i < D; ++i)
+        area = _mm_mul_pd(area, g1[i]);
+      for (int i = 0; i < D; ++i) {
+        __m128d up = one, down = one;
+        for (int j = 0; j < D; ++j)
+          if (j != i) up = _mm_mul_pd(up, g1[j]), down = _mm_mul_pd(down, g2[j]);
+        area = _mm_add_pd(
+            area, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(half, _mm_add_pd(up, down)), gs[i]), hh));
+      }
+      if (pair)
+        _mm_storeu_pd(out + (e - from), area);
+      else
+        _mm_store_sd(out + (e - from), area);
+    };
+    int e = from;
+    for (; e + 2 <= to; e += 2)
+      step(e, true);
+    if (e < to) step(e, false);
+#else
+    for (int e = from; e < to; ++e) {
       double g1[D], g2[D], gs[D];
       for (int i = 0; i < D; ++i) {
-        const double l = a.lo[i][e] + a.vlo[i][e] * c, u = a.hi[i][e] + a.vhi[i][e] * c;
         const double vl = a.vlo[i][e], vh = a.vhi[i][e];
-        const double gl = std::min(l, bl[i]), gu = std::max(u, bh[i]);
-        const double gvl = std::min(vl, bvl[i]), gvh = std::max(vh, bvh[i]);
+        const double l = a.lo[i][e] + vl * c, u = a.hi[i][e] + vh * c;
+        const double gl = std::min(l, t.l[i]), gu = std::max(u, t.u[i]);
+        const double gvl = std::min(vl, t.vl[i]), gvh = std::max(vh, t.vh[i]);
         g1[i] = gu - gl + extent[i];
         g2[i] = g1[i] + (gvh - gvl) * h;
-        gs[i] = gvl > 0 ? gvh : gvh < 0 ? -gvl : gvh - gvl;
+        gs[i] = std::max(gvh, 0.0) - std::min(gvl, 0.0);
       }
-      double after = 1;
+      double area = 1;
       for (int i = 0; i < D; ++i)
-        after *= g1[i];
+        area *= g1[i];
       for (int i = 0; i < D; ++i) {
         double up = 1, down = 1;
         for (int j = 0; j < D; ++j)
           if (j != i) up *= g1[j], down *= g2[j];
-        after += 0.5 * (up + down) * gs[i] * h;
+        area += 0.5 * (up + down) * gs[i] * h;
       }
-      pen[e] = std::max(0.0, after - a.cost[e]);
+      out[e - from] = area;
     }
+#endif
+  }
+
+  // pen[e]: the rise of the cost of entry e's box when it takes b (0 when it holds b), for all
+  // entries of a node. The entries' own costs at the clock come from the node's cache
+  // (BoxArray::cost), filled here: all of them when the clock has moved since, otherwise
+  // those of the entries written since.
+  void enlargements(Node& n, const Box_& b, double* pen) {
+    const double c = rel_clock();
+    BoxArray& a = n.box;
+    if (a.costed_at != c) {
+      a.costed_at = c;
+      grown_costs(a, 0, n.count, Taken::nothing(), c, a.cost);
+    } else {
+      for (std::uint64_t m = a.stale & ((std::uint64_t(1) << n.count) - 1); m != 0; m &= m - 1) {
+        const int e = std::countr_zero(m);
+        grown_costs(a, e, e + 1, Taken::nothing(), c, a.cost + e);
+      }
+    }
+    a.stale = 0;
+    double after[kSlots];
+    grown_costs(a, 0, n.count, Taken::of(b, c), c, after);
+    for (int e = 0; e < n.count; ++e)
+      pen[e] = std::max(0.0, after[e] - a.cost[e]);  // 0 for NaN, from inf - inf
   }
   double cost(const Box_& b) const {
     return detail::swept_cost(b, rel_clock(), Policy::horizon(params_), Policy::extent(params_));
   }
   // The bounds of n's entries from the clock on: per axis the least lower bound at the clock
-  // and the least lower velocity (the greatest for the upper side), as Tpbr::enclose takes
-  // them, gathered in one pass over the node's arrays (two entries a step with SSE2).
+  // and the least lower velocity (the greatest for the upper side), Tpbr::enclose's rule,
+  // gathered in one pass over the node's arrays (two entries a step with SSE2).
   Box_ bound(const Node& n) const {
     const double c = rel_clock();
     const BoxArray& a = n.box;
@@ -694,15 +704,18 @@ class MovingRTree {
   // way) gives a first candidate and its cost, minpen; partial paths cheaper than minpen then
   // wait in a heap by their cost so far, the children of a node just above the target level
   // are candidates compared with minpen, and the search ends when no waiting path is cheaper.
-  // Rises are never negative, so no path left out could have done better: the answer is the
-  // best path of the whole tree, as a best-first search from the root finds it, but paths
-  // that cannot win never enter the heap.
+  // Rises are never negative, so no path left out could have done better: the answer is a
+  // path of the least summed rise in the whole tree, the cost a best-first search from the
+  // root finds (among equals the greedy path is kept), but paths that cannot win never enter
+  // the heap.
   //
   // Costs of boxes spread over more than about 1e102 in 3D overflow to inf (the rises are
   // never NaN: enlargements() clamps them with std::max); then the greedy candidate's minpen
   // is inf and any path of finite cost replaces it.
   std::uint32_t choose_path(const Box_& b, int level) {
     if (nodes_[root_].level == level) return root_;
+    if (nodes_[root_].level < level)
+      throw Error(std::string(kName) + ": no node of level " + std::to_string(level));
     struct Waiting {
       double key;
       std::uint32_t node;
@@ -1159,7 +1172,9 @@ class MovingRTree {
     // Entry costs kept for Choose_Path at the clock are those of the entries' boxes.
     if (node.box.costed_at == c)
       for (int e = 0; e < node.count; ++e) {
-        const double kept = node.box.cost[e], now = entry_cost(node.box, e, c);
+        double now;
+        grown_costs(node.box, e, e + 1, Taken::nothing(), c, &now);
+        const double kept = node.box.cost[e];
         if (!(node.box.stale >> e & 1) && kept != now && !(std::isnan(kept) && std::isnan(now)))
           throw Error(who + ": node " + std::to_string(n) + " keeps a stale entry cost");
       }
