@@ -605,22 +605,41 @@ class MovingRTree {
   double cost(const Box_& b) const {
     return detail::swept_cost(b, rel_clock(), Policy::horizon(params_), Policy::extent(params_));
   }
-  // The bounds of n's entries from the clock on: per axis the least lower bound at the clock
-  // and the least lower velocity (the greatest for the upper side), Tpbr::enclose's rule,
-  // gathered in one pass over the node's arrays (two entries a step with SSE2).
+  // The bounds on one axis of a set of entries from the clock on, entry by entry: the least
+  // lower bound at the clock and the least lower velocity (the greatest for the upper side),
+  // Tpbr::enclose's rule.
+  struct AxisBounds {
+    double l, h, vl, vh;
+
+    static AxisBounds of(const BoxArray& a, int i, int e, double c) {
+      return {a.lo[i][e] + a.vlo[i][e] * c, a.hi[i][e] + a.vhi[i][e] * c, a.vlo[i][e], a.vhi[i][e]};
+    }
+    void add(const BoxArray& a, int i, int e, double c) {
+      l = std::min(l, a.lo[i][e] + a.vlo[i][e] * c);
+      h = std::max(h, a.hi[i][e] + a.vhi[i][e] * c);
+      vl = std::min(vl, a.vlo[i][e]);
+      vh = std::max(vh, a.vhi[i][e]);
+    }
+    void write(Box_& b, int i, double c) const {
+      b.vlo[i] = vl, b.vhi[i] = vh;
+      b.lo[i] = l - vl * c, b.hi[i] = h - vh * c;
+    }
+  };
+
+  // The bounds of n's entries from the clock on, gathered in one pass over the node's arrays
+  // (two entries a step with SSE2).
   Box_ bound(const Node& n) const {
     const double c = rel_clock();
     const BoxArray& a = n.box;
     Box_ b;
     for (int i = 0; i < D; ++i) {
-      double l = a.lo[i][0] + a.vlo[i][0] * c, h = a.hi[i][0] + a.vhi[i][0] * c;
-      double vl = a.vlo[i][0], vh = a.vhi[i][0];
+      AxisBounds f = AxisBounds::of(a, i, 0, c);
       int e = 1;
 #if defined(__SSE2__)
       if (n.count >= 3) {
         const __m128d cc = _mm_set1_pd(c);
-        __m128d l2 = _mm_set1_pd(l), h2 = _mm_set1_pd(h), vl2 = _mm_set1_pd(vl),
-                vh2 = _mm_set1_pd(vh);
+        __m128d l2 = _mm_set1_pd(f.l), h2 = _mm_set1_pd(f.h), vl2 = _mm_set1_pd(f.vl),
+                vh2 = _mm_set1_pd(f.vh);
         for (; e + 2 <= n.count; e += 2) {
           const __m128d lo = _mm_loadu_pd(&a.lo[i][e]), hi = _mm_loadu_pd(&a.hi[i][e]);
           const __m128d vlo = _mm_loadu_pd(&a.vlo[i][e]), vhi = _mm_loadu_pd(&a.vhi[i][e]);
@@ -629,20 +648,15 @@ class MovingRTree {
           vl2 = _mm_min_pd(vl2, vlo);
           vh2 = _mm_max_pd(vh2, vhi);
         }
-        l = std::min(_mm_cvtsd_f64(l2), _mm_cvtsd_f64(_mm_unpackhi_pd(l2, l2)));
-        h = std::max(_mm_cvtsd_f64(h2), _mm_cvtsd_f64(_mm_unpackhi_pd(h2, h2)));
-        vl = std::min(_mm_cvtsd_f64(vl2), _mm_cvtsd_f64(_mm_unpackhi_pd(vl2, vl2)));
-        vh = std::max(_mm_cvtsd_f64(vh2), _mm_cvtsd_f64(_mm_unpackhi_pd(vh2, vh2)));
+        f.l = std::min(_mm_cvtsd_f64(l2), _mm_cvtsd_f64(_mm_unpackhi_pd(l2, l2)));
+        f.h = std::max(_mm_cvtsd_f64(h2), _mm_cvtsd_f64(_mm_unpackhi_pd(h2, h2)));
+        f.vl = std::min(_mm_cvtsd_f64(vl2), _mm_cvtsd_f64(_mm_unpackhi_pd(vl2, vl2)));
+        f.vh = std::max(_mm_cvtsd_f64(vh2), _mm_cvtsd_f64(_mm_unpackhi_pd(vh2, vh2)));
       }
 #endif
-      for (; e < n.count; ++e) {
-        l = std::min(l, a.lo[i][e] + a.vlo[i][e] * c);
-        h = std::max(h, a.hi[i][e] + a.vhi[i][e] * c);
-        vl = std::min(vl, a.vlo[i][e]);
-        vh = std::max(vh, a.vhi[i][e]);
-      }
-      b.vlo[i] = vl, b.vhi[i] = vh;
-      b.lo[i] = l - vl * c, b.hi[i] = h - vh * c;
+      for (; e < n.count; ++e)
+        f.add(a, i, e, c);
+      f.write(b, i, c);
     }
     return b;
   }
@@ -850,21 +864,12 @@ class MovingRTree {
   // The bounds from the clock on of entries order[from, to) of node, as bound() takes them.
   Box_ union_of(const Node& node, const std::uint8_t* order, int from, int to) const {
     const double c = rel_clock();
-    const BoxArray& a = node.box;
     Box_ b;
     for (int i = 0; i < D; ++i) {
-      const int f = order[from];
-      double l = a.lo[i][f] + a.vlo[i][f] * c, h = a.hi[i][f] + a.vhi[i][f] * c;
-      double vl = a.vlo[i][f], vh = a.vhi[i][f];
-      for (int k = from + 1; k < to; ++k) {
-        const int e = order[k];
-        l = std::min(l, a.lo[i][e] + a.vlo[i][e] * c);
-        h = std::max(h, a.hi[i][e] + a.vhi[i][e] * c);
-        vl = std::min(vl, a.vlo[i][e]);
-        vh = std::max(vh, a.vhi[i][e]);
-      }
-      b.vlo[i] = vl, b.vhi[i] = vh;
-      b.lo[i] = l - vl * c, b.hi[i] = h - vh * c;
+      AxisBounds f = AxisBounds::of(node.box, i, order[from], c);
+      for (int k = from + 1; k < to; ++k)
+        f.add(node.box, i, order[k], c);
+      f.write(b, i, c);
     }
     return b;
   }
