@@ -591,7 +591,9 @@ class MovingRTree {
       a.costed_at = c;
       grown_costs(a, 0, n.count, Taken::nothing(), c, a.cost);
     } else {
-      for (std::uint64_t m = a.stale & ((std::uint64_t(1) << n.count) - 1); m != 0; m &= m - 1) {
+      const std::uint64_t held =
+          n.count < 64 ? (std::uint64_t(1) << n.count) - 1 : ~std::uint64_t(0);
+      for (std::uint64_t m = a.stale & held; m != 0; m &= m - 1) {
         const int e = std::countr_zero(m);
         grown_costs(a, e, e + 1, Taken::nothing(), c, a.cost + e);
       }
