@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 #include "loci/index/detail/hilbert.hpp"
@@ -173,34 +174,80 @@ TEST(StrTile, GroupsAreSlabsThenTiles) {
   }
 }
 
+// The cell of item c on `axis` of a D-axis tiling.
+template <int D>
+std::uint64_t axis_cell(const CellItem& c, int axis) {
+  constexpr int bits = cell_bits<D>();
+  return (c.cells >> (bits * axis)) & ((std::uint64_t(1) << bits) - 1);
+}
+
+// The slabs of a level of str_tile_cells: runs of `per` groups (single groups on the last axis).
+template <int D>
+std::size_t groups_per_slab(std::size_t k, int axis) {
+  if (axis == D - 1) return 1;
+  const auto slabs = std::size_t(std::ceil(std::pow(double(k), 1.0 / (D - axis)) - 1e-9));
+  return (k + slabs - 1) / slabs;
+}
+
 // Reference for str_tile_cells: at each level a stable comparison sort of the whole range by
 // the axis's cell, then the same slabs.
 template <int D>
 void reference_cells(CellItem* base, std::span<const std::size_t> groups, int axis = 0) {
   const std::size_t k = groups.size() - 1;
   if (k <= 1) return;
-  constexpr int bits = cell_bits<D>();
-  const auto cell = [&](const CellItem& c) {
-    return (c.cells >> (bits * axis)) & ((std::uint64_t(1) << bits) - 1);
-  };
   std::stable_sort(base + groups.front(), base + groups.back(),
-                   [&](const CellItem& x, const CellItem& y) { return cell(x) < cell(y); });
+                   [&](const CellItem& x, const CellItem& y) {
+                     return axis_cell<D>(x, axis) < axis_cell<D>(y, axis);
+                   });
   if (axis == D - 1) return;
-  const auto slabs = std::size_t(std::ceil(std::pow(double(k), 1.0 / (D - axis)) - 1e-9));
-  const std::size_t per = (k + slabs - 1) / slabs;
+  const std::size_t per = groups_per_slab<D>(k, axis);
   for (std::size_t first = 0; first < k; first += per)
     reference_cells<D>(base, groups.subspan(first, std::min(per, k - first) + 1), axis + 1);
+}
+
+// The tiling property at every level: no item of a slab has a greater cell on the level's axis
+// than an item of the next slab.
+template <int D>
+void expect_tiled(const CellItem* base, std::span<const std::size_t> groups, int axis = 0) {
+  const std::size_t k = groups.size() - 1;
+  if (k <= 1) return;
+  const std::size_t per = groups_per_slab<D>(k, axis);
+  std::uint64_t below = 0;  // the greatest cell of the slabs so far
+  for (std::size_t first = 0; first < k; first += per) {
+    const std::size_t last = std::min(first + per, k);
+    std::uint64_t lo = ~std::uint64_t(0), hi = 0;
+    for (std::size_t i = groups[first]; i < groups[last]; ++i) {
+      lo = std::min(lo, axis_cell<D>(base[i], axis));
+      hi = std::max(hi, axis_cell<D>(base[i], axis));
+    }
+    if (groups[first] < groups[last]) {
+      ASSERT_LE(below, lo) << "axis " << axis << " slab at group " << first;
+      below = hi;
+    }
+    if (axis < D - 1) expect_tiled<D>(base, groups.subspan(first, last - first + 1), axis + 1);
+  }
 }
 
 template <int D>
 void check_cells_tiling(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::vector<CellItem> tmp;
+  constexpr int bits = cell_bits<D>();
   for (std::size_t n : {0, 1, 5, 64, 65, 1000, 20000}) {
-    for (int form = 0; form < 3; ++form) {  // random cells, few distinct cells, all equal
+    // random cells, few distinct cells, all equal, and distinct cells on every axis
+    for (int form = 0; form < 4; ++form) {
+      if (form == 3 && n > (std::size_t(1) << bits)) continue;
       std::vector<CellItem> v(n);
       for (std::uint32_t i = 0; i < n; ++i)
         v[i] = {form == 0 ? rng() : form == 1 ? rng() & 0x0003000300030003 : 42, i};
+      if (form == 3)
+        for (int a = 0; a < D; ++a) {
+          std::vector<std::uint64_t> c(std::size_t(1) << bits);
+          std::iota(c.begin(), c.end(), 0);
+          std::shuffle(c.begin(), c.end(), rng);
+          for (std::uint32_t i = 0; i < n; ++i)
+            v[i].cells = (a == 0 ? 0 : v[i].cells) | c[i] << (bits * a);
+        }
       std::vector<std::size_t> groups;
       const std::size_t k = std::max<std::size_t>(1, n / (1 + rng() % 40));
       for (std::size_t g = 0; g <= k; ++g)
@@ -208,15 +255,35 @@ void check_cells_tiling(std::uint64_t seed) {
       auto ref = v;
       str_tile_cells<D>(v.data(), std::span<const std::size_t>(groups), tmp);
       reference_cells<D>(ref.data(), std::span<const std::size_t>(groups));
-      for (std::size_t i = 0; i < n; ++i) {
-        ASSERT_EQ(v[i].index, ref[i].index) << "D " << D << " n " << n << " form " << form;
-        ASSERT_EQ(v[i].cells, ref[i].cells);
-      }
+      const std::string where =
+          "D " + std::to_string(D) + " n " + std::to_string(n) + " form " + std::to_string(form);
+      // The same items, each whole.
+      auto by_index = [](const CellItem& x, const CellItem& y) { return x.index < y.index; };
+      auto sorted = v;
+      std::sort(sorted.begin(), sorted.end(), by_index);
+      for (std::uint32_t i = 0; i < n; ++i)
+        ASSERT_EQ(sorted[i].index, i) << where;
+      std::vector<CellItem> orig(n);
+      for (const CellItem& c : ref)
+        orig[c.index] = c;
+      for (std::uint32_t i = 0; i < n; ++i)
+        ASSERT_EQ(sorted[i].cells, orig[i].cells) << where;
+      expect_tiled<D>(v.data(), std::span<const std::size_t>(groups));
+      // Without ties the groups are those of full sorts at every level, item for item.
+      if (form == 3)
+        for (std::size_t g = 0; g < k; ++g) {
+          std::vector<std::uint32_t> got, want;
+          for (std::size_t i = groups[g]; i < groups[g + 1]; ++i)
+            got.push_back(v[i].index), want.push_back(ref[i].index);
+          std::sort(got.begin(), got.end());
+          std::sort(want.begin(), want.end());
+          ASSERT_EQ(got, want) << where << " group " << g;
+        }
     }
   }
 }
 
-TEST(StrTileCells, MatchesStableSortsLevelByLevel) {
+TEST(StrTileCells, TilesEveryLevelAsFullSortsWould) {
   check_cells_tiling<2>(11);
   check_cells_tiling<4>(12);
   check_cells_tiling<6>(13);  // 10 bits an axis

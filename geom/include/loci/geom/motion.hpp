@@ -63,17 +63,29 @@ constexpr Point<D> position(const Motion<D>& m, double s) {
   return q;
 }
 
-// Throws InvalidGeometry naming `what` for a NaN or infinite time, position or velocity, or
-// values beyond kMaxCoordinate (times too: differences of times then never overflow).
+namespace detail {
+// The message of check_motion for a report it refuses; kept out of line.
 template <int D>
-void check_motion(const Motion<D>& m, const char* what = "report") {
+[[gnu::noinline, gnu::cold]] void refuse_motion(const Motion<D>& m, const char* what) {
   if (!std::isfinite(m.t)) throw InvalidGeometry(std::string(what) + " has a NaN or infinite time");
   if (!(std::abs(m.t) <= kMaxCoordinate))
     throw InvalidGeometry(std::string(what) + " has a time beyond 1e150");
   check_point(m.p, what);
   check_point(m.v, what);
-  if (!within_coordinate_range(m.p) || !within_coordinate_range(m.v))
-    throw InvalidGeometry(std::string(what) + " has a position or velocity beyond 1e150");
+  throw InvalidGeometry(std::string(what) + " has a position or velocity beyond 1e150");
+}
+}  // namespace detail
+
+// Throws InvalidGeometry naming `what` for a NaN or infinite time, position or velocity, or
+// values beyond kMaxCoordinate (times too: differences of times then never overflow).
+template <int D>
+void check_motion(const Motion<D>& m, const char* what = "report") {
+  // Every value within the limits, tested without branches (a NaN fails each comparison).
+  bool ok = std::abs(m.t) <= kMaxCoordinate;
+  for (int i = 0; i < D; ++i)
+    ok &= (std::abs(m.p[i]) <= kMaxCoordinate) & (std::abs(m.v[i]) <= kMaxCoordinate);
+  if (!ok) [[unlikely]]
+    detail::refuse_motion(m, what);
 }
 
 // A closed interval of times, built by intersecting linear constraints a + b s <= 0.

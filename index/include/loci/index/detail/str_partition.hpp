@@ -80,53 +80,89 @@ constexpr int cell_bits() {
   return 64 / D < 16 ? 64 / D : 16;
 }
 
+// Stable sort of the n items at a whose cells (at `shift`) share their top bits, by the
+// Low bits below those; b is scratch of n items.
+template <int Low>
+void sort_low_bits(CellItem* a, std::size_t n, int shift, CellItem* b) {
+  constexpr std::uint64_t kMask = (std::uint64_t(1) << Low) - 1;
+  const auto low = [shift](const CellItem& x) { return (x.cells >> shift) & kMask; };
+  if (n <= 32) {  // insertion sort
+    for (std::size_t i = 1; i < n; ++i) {
+      const CellItem x = a[i];
+      std::size_t j = i;
+      for (; j > 0 && low(a[j - 1]) > low(x); --j)
+        a[j] = a[j - 1];
+      a[j] = x;
+    }
+    return;
+  }
+  std::size_t next[(1 << Low) + 1] = {};
+  for (std::size_t i = 0; i < n; ++i)
+    ++next[low(a[i]) + 1];
+  for (int j = 1; j <= (1 << Low); ++j)
+    next[j] += next[j - 1];
+  for (std::size_t i = 0; i < n; ++i)
+    b[next[low(a[i])]++] = a[i];
+  std::copy(b, b + n, a);
+}
+
 // The same tiling as str_tile, over keys quantized to cell_bits<D>() bits an axis (a grid of
 // 2^16 cells over each axis's range for D <= 4, so that items closer than 1/65536 of the range
-// may tie), found by sorting instead of selecting: each level is one stable counting sort of
-// 8-bit passes, so the whole tiling costs O(n D) and reads 16-byte items sequentially. What
-// rebuilding a moving index every tick needs. `tmp` is scratch, resized as needed.
+// may tie), found by counting instead of selecting, so the whole tiling costs O(n D) and reads
+// 16-byte items sequentially; what rebuilding a moving index every tick needs. Each level
+// distributes its range into 256 buckets by the top 8 bits of the axis's cell (a stable
+// counting sort into `tmp`) and brings the buckets back; only a bucket that a boundary of the
+// level cuts is sorted by the remaining bits on the way. Every slab, and in the end every
+// group, then holds the items a full stable sort of the level would give it; within a slab
+// only the top bits are in order. `tmp` is scratch, resized as needed.
 template <int D>
 void str_tile_cells(CellItem* base, std::span<const std::size_t> groups, std::vector<CellItem>& tmp,
                     int axis = 0) {
   constexpr int kBits = cell_bits<D>();
-  static_assert(D >= 1 && kBits >= 8, "at most 8 axes");
+  static_assert(D >= 1 && kBits >= 8 && kBits <= 16, "at most 8 axes");
+  constexpr int kLow = kBits - 8;  // the bits below the top 8
   const std::size_t k = groups.size() - 1;
   if (k <= 1) return;
   const std::size_t lo = groups.front(), n = groups.back() - lo;
   CellItem* const a = base + lo;
   const int shift = kBits * axis;
   constexpr std::uint64_t kMask = (std::uint64_t(1) << kBits) - 1;
+  const auto cell = [shift](const CellItem& x) { return (x.cells >> shift) & kMask; };
+  const auto by_cell = [&](const CellItem& x, const CellItem& y) { return cell(x) < cell(y); };
+  // The level's slabs: runs of per_slab groups, single groups on the last axis.
+  const bool last = axis == D - 1;
+  const std::size_t slabs =
+      last ? k : static_cast<std::size_t>(std::ceil(std::pow(double(k), 1.0 / (D - axis)) - 1e-9));
+  const std::size_t per_slab = (k + slabs - 1) / slabs;
   if (n <= 64) {
-    std::stable_sort(a, a + n, [&](const CellItem& x, const CellItem& y) {
-      return ((x.cells >> shift) & kMask) < ((y.cells >> shift) & kMask);
-    });
+    std::stable_sort(a, a + n, by_cell);
   } else {
-    // Two passes of 8 bits (the second of kBits - 8): the result lands back in place.
-    static_assert(kBits <= 16);
     if (tmp.size() < n) tmp.resize(n);
     CellItem* const b = tmp.data();
-    for (int pass = 0; pass < 2; ++pass) {
-      CellItem* const from = pass == 0 ? a : b;
-      CellItem* const to = pass == 0 ? b : a;
-      const int s = shift + 8 * pass;
-      const std::uint64_t mask = pass == 0 ? 0xff : (std::uint64_t(1) << (kBits - 8)) - 1;
-      std::size_t count[256] = {};
-      for (std::size_t i = 0; i < n; ++i)
-        ++count[(from[i].cells >> s) & mask];
-      std::size_t sum = 0;
-      for (std::size_t& c : count) {
-        const std::size_t m = c;
-        c = sum;
-        sum += m;
+    std::size_t start[257] = {};  // start[j]: first offset of bucket j; start[256] = n
+    for (std::size_t i = 0; i < n; ++i)
+      ++start[(cell(a[i]) >> kLow) + 1];
+    for (int j = 1; j <= 256; ++j)
+      start[j] += start[j - 1];
+    std::size_t next[256];
+    std::copy_n(start, 256, next);
+    for (std::size_t i = 0; i < n; ++i)
+      b[next[cell(a[i]) >> kLow]++] = a[i];
+    std::copy(b, b + n, a);
+    // Each boundary of the level inside a bucket (not at its start) has the bucket sorted.
+    if constexpr (kLow > 0) {
+      std::size_t sorted_end = 0;  // end of the last bucket sorted
+      for (std::size_t f = per_slab; f < k; f += per_slab) {
+        const std::size_t c = groups[f] - lo;
+        if (c < sorted_end) continue;
+        const std::size_t* j = std::upper_bound(start, start + 257, c);  // start[j-1] <= c
+        if (j[-1] == c) continue;
+        sort_low_bits<kLow>(a + j[-1], j[0] - j[-1], shift, b);
+        sorted_end = j[0];
       }
-      for (std::size_t i = 0; i < n; ++i)
-        to[count[(from[i].cells >> s) & mask]++] = from[i];
     }
   }
-  if (axis == D - 1) return;  // sorted along the last axis: consecutive groups are the tiles
-  const auto slabs =
-      static_cast<std::size_t>(std::ceil(std::pow(double(k), 1.0 / (D - axis)) - 1e-9));
-  const std::size_t per_slab = (k + slabs - 1) / slabs;
+  if (last) return;  // consecutive groups are the tiles
   for (std::size_t first = 0; first < k; first += per_slab) {
     const std::size_t count = std::min(per_slab, k - first);
     str_tile_cells<D>(base, groups.subspan(first, count + 1), tmp, axis + 1);

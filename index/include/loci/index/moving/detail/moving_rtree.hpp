@@ -132,15 +132,16 @@ class MovingRTree {
     };
     constexpr int kCellBits = detail::cell_bits<2 * D>();
     constexpr double kCellMax = double((1u << kCellBits) - 1);
-    double kmin[2 * D], kscale[2 * D];
-    for (int a = 0; a < 2 * D; ++a) {
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (const Motion<D>& m : objects) {
+    double kmin[2 * D], kmax[2 * D], kscale[2 * D];
+    std::fill_n(kmin, 2 * D, std::numeric_limits<double>::infinity());
+    std::fill_n(kmax, 2 * D, -std::numeric_limits<double>::infinity());
+    for (const Motion<D>& m : objects)  // one pass over the reports for all axes
+      for (int a = 0; a < 2 * D; ++a) {
         const double k = key(m, a);
-        lo = std::min(lo, k), hi = std::max(hi, k);
+        kmin[a] = std::min(kmin[a], k), kmax[a] = std::max(kmax[a], k);
       }
-      const double scale = kCellMax / (hi - lo);
-      kmin[a] = lo;
+    for (int a = 0; a < 2 * D; ++a) {
+      const double scale = kCellMax / (kmax[a] - kmin[a]);
       kscale[a] = std::isfinite(scale) ? scale : 0.0;  // one value, or beyond doubles
     }
     cells_.resize(n);
@@ -179,28 +180,40 @@ class MovingRTree {
     }
     std::vector<Item>& level = level_;
     level.resize(leaves);
-    constexpr std::size_t kAhead = 16;
+    // Leaves. Locals carry the count and the magnitudes, which stores through the nodes'
+    // arrays would otherwise force back to memory at every entry.
+    constexpr std::size_t kAhead = 32;
+    const double epoch = epoch_;
+    double mag = 0, vmag = 0;
     for (std::size_t g = 0; g < leaves; ++g) {
       const std::uint32_t node = nodes_.allocate(kName);
       Node& nd = nodes_[node];
       nd.parent = kNone;
       nd.level = 0;
-      nd.count = 0;
       nd.grouped = 0;
-      for (std::size_t k = n * g / leaves; k < n * (g + 1) / leaves; ++k) {
+      const std::size_t first = n * g / leaves, last = n * (g + 1) / leaves;
+      for (std::size_t k = first; k < last; ++k) {
         // Reports are read in tiling order, scattered over memory: ask for them ahead.
-        if (k + kAhead < n) __builtin_prefetch(&objects[cells_[k + kAhead].index]);
-        const std::uint32_t i = cells_[k].index;
-        const Box_ b = Box_::of(objects[i], epoch_);
-        for (int a = 0; a < D; ++a) {
-          mag_ = std::max(mag_, std::abs(b.lo[a]));
-          vmag_ = std::max(vmag_, std::abs(b.vlo[a]));
+        if (k + kAhead < n) {
+          const std::uint32_t ahead = cells_[k + kAhead].index;
+          __builtin_prefetch(&objects[ahead]);
+          __builtin_prefetch(reinterpret_cast<const char*>(&objects[ahead + 1]) - 1);
+          __builtin_prefetch(&ids[ahead]);
+          __builtin_prefetch(&obj_leaf_[ahead], 1);
         }
+        const std::uint32_t i = cells_[k].index;
+        const Box_ b = Box_::of(objects[i], epoch);
+        for (int a = 0; a < D; ++a) {
+          mag = std::max(mag, std::abs(b.lo[a]));
+          vmag = std::max(vmag, std::abs(b.vlo[a]));
+        }
+        put(nd, int(k - first), {b, i, objects[i], ids[i]});
         obj_leaf_[i] = node;
-        put(nd, nd.count++, {b, i, objects[i], ids[i]});
       }
+      nd.count = std::uint8_t(last - first);
       level[g] = {bound(nd), node, {}, 0};
     }
+    mag_ = mag, vmag_ = vmag;
     // Pack each level above into nodes of nearly equal counts, about 3/4 full.
     for (int height = 1; level.size() > 1; ++height) {
       const std::size_t groups = (level.size() + kFill - 1) / kFill;
