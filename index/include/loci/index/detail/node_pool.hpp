@@ -1,7 +1,8 @@
 // NodePool<T, Link, Group>: the node storage of every dynamic structure.
 //
-// Nodes live in one std::vector and are named by 32-bit indices, so a structure is copied,
-// moved or saved as plain arrays and a node costs no pointer. Released nodes form a free list
+// Nodes live in one vector (on huge pages once large: large_alloc.hpp) and are named by
+// 32-bit indices, so a structure is copied, moved or saved as plain arrays and a node costs
+// no pointer. Released nodes form a free list
 // threaded through the nodes themselves: while a node is free, its member `Link` (a field the
 // structure does not need in a free node, such as a child or parent link) holds the index of
 // the next free node, or kNone. Allocation pops the list or appends; nothing is ever returned
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "loci/geom/error.hpp"
+#include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci::detail {
@@ -80,7 +82,7 @@ class NodePool {
   }
 
  private:
-  std::vector<T> nodes_;
+  LargeVector<T> nodes_;
   std::uint32_t free_ = kNone;   // first node of the first free run
   std::uint32_t free_runs_ = 0;  // length of the free list
 };

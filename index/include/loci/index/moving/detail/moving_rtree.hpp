@@ -41,6 +41,7 @@
 
 #include "loci/index/broadphase/detail/proxy_table.hpp"
 #include "loci/index/detail/best_first.hpp"
+#include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/detail/node_pool.hpp"
 #include "loci/index/detail/str_partition.hpp"
 #include "loci/index/moving/detail/tpbr.hpp"
@@ -167,7 +168,7 @@ class MovingRTree {
     nodes_.reserve(leaves + leaves / (kFill - 1) + 8);
     root_ = kNone;
     free_slots_.clear();
-    obj_id_.assign(ids.begin(), ids.end());
+    if (!same_ids) obj_id_.assign(ids.begin(), ids.end());
     obj_motion_.assign(objects.begin(), objects.end());
     obj_leaf_.resize(n);
     if (!same_ids) map_ = std::move(map);
@@ -184,6 +185,7 @@ class MovingRTree {
     // arrays would otherwise force back to memory at every entry.
     constexpr std::size_t kAhead = 32;
     const double epoch = epoch_;
+    const Motion<D>* const motion = obj_motion_.data();
     double mag = 0, vmag = 0;
     for (std::size_t g = 0; g < leaves; ++g) {
       const std::uint32_t node = nodes_.allocate(kName);
@@ -193,21 +195,21 @@ class MovingRTree {
       nd.grouped = 0;
       const std::size_t first = n * g / leaves, last = n * (g + 1) / leaves;
       for (std::size_t k = first; k < last; ++k) {
-        // Reports are read in tiling order, scattered over memory: ask for them ahead.
+        // Reports (the table's copy) are read in tiling order, scattered: ask for them ahead.
         if (k + kAhead < n) {
           const std::uint32_t ahead = cells_[k + kAhead].index;
-          __builtin_prefetch(&objects[ahead]);
-          __builtin_prefetch(reinterpret_cast<const char*>(&objects[ahead + 1]) - 1);
-          __builtin_prefetch(&ids[ahead]);
+          __builtin_prefetch(&motion[ahead]);
+          __builtin_prefetch(reinterpret_cast<const char*>(&motion[ahead + 1]) - 1);
+          __builtin_prefetch(&obj_id_[ahead]);
           __builtin_prefetch(&obj_leaf_[ahead], 1);
         }
         const std::uint32_t i = cells_[k].index;
-        const Box_ b = Box_::of(objects[i], epoch);
+        const Box_ b = Box_::of(motion[i], epoch);
         for (int a = 0; a < D; ++a) {
           mag = std::max(mag, std::abs(b.lo[a]));
           vmag = std::max(vmag, std::abs(b.vlo[a]));
         }
-        put(nd, int(k - first), {b, i, objects[i], ids[i]});
+        put(nd, int(k - first), {b, i, motion[i], obj_id_[i]});
         obj_leaf_[i] = node;
       }
       nd.count = std::uint8_t(last - first);
@@ -1224,9 +1226,10 @@ class MovingRTree {
   Params params_;
   Pool nodes_;
   std::uint32_t root_ = kNone;
-  std::vector<Id> obj_id_;
-  std::vector<Motion<D>> obj_motion_;
-  std::vector<std::uint32_t> obj_leaf_;  // kNone: a free slot
+  // The object table by slot, on huge pages: build() reads it in tiling order, scattered.
+  detail::LargeVector<Id> obj_id_;
+  detail::LargeVector<Motion<D>> obj_motion_;
+  detail::LargeVector<std::uint32_t> obj_leaf_;  // kNone: a free slot
   std::vector<std::uint32_t> free_slots_;
   // Scratch of build, kept so that a tree rebuilt every tick touches no new pages.
   std::vector<detail::CellItem> cells_, cells_tmp_;
