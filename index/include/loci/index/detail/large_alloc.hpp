@@ -1,5 +1,5 @@
-// LargeAllocator: an allocator for the big temporary arrays of bulk work (a join's boxes and
-// tile lists, a radix sort's buffers), which asks the kernel to back blocks of 1 MB or more
+// LargeAllocator: an allocator for big arrays (a join's boxes and tile lists, a radix sort's
+// buffers, node pools, object tables), which asks the kernel to back blocks of 1 MB or more
 // with transparent huge pages (madvise(MADV_HUGEPAGE), where the system leaves huge pages to
 // programs that ask). Touching fresh memory costs a page fault per 4 KB page otherwise; on the
 // virtual machines a library runs on, that can cost more than the work done on the memory

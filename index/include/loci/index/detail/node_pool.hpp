@@ -2,11 +2,11 @@
 //
 // Nodes live in one vector (on huge pages once large: large_alloc.hpp) and are named by
 // 32-bit indices, so a structure is copied, moved or saved as plain arrays and a node costs
-// no pointer. Released nodes form a free list
-// threaded through the nodes themselves: while a node is free, its member `Link` (a field the
-// structure does not need in a free node, such as a child or parent link) holds the index of
-// the next free node, or kNone. Allocation pops the list or appends; nothing is ever returned
-// to the allocator until clear(), so indices stay valid for the structure's life.
+// no pointer. Released nodes form a free list threaded through the nodes themselves: while
+// a node is free, its member `Link` (a field the structure does not need in a free node, such
+// as a child or parent link) holds the index of the next free node, or kNone. Allocation pops
+// the list or appends; no node is given up before clear() (which keeps the memory), so
+// indices stay valid for the structure's life.
 //
 // Group > 1 hands out runs of Group consecutive nodes (the 2^D children of a quadtree node,
 // say); the free list then links the first node of each released run. A run's contents on

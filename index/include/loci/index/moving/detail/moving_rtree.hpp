@@ -100,7 +100,7 @@ class MovingRTree {
   // duplicate ids or lengths that differ, InvalidGeometry for a bad report.
   //
   // Rebuilt every tick, the tree reuses its memory (nodes and scratch arrays touch no new
-  // pages) and, when the ids are those of the last build in the same order, its id map.
+  // pages) and, when the ids are those its slots hold, in the same order, its id map and table.
   void build(std::span<const Id> ids, std::span<const Motion<D>> objects) {
     if (ids.size() != objects.size())
       throw InvalidArgument(std::string(kName) + ": ids and reports differ in length");
@@ -199,7 +199,7 @@ class MovingRTree {
         if (k + kAhead < n) {
           const std::uint32_t ahead = cells_[k + kAhead].index;
           __builtin_prefetch(&motion[ahead]);
-          __builtin_prefetch(reinterpret_cast<const char*>(&motion[ahead + 1]) - 1);
+          __builtin_prefetch(reinterpret_cast<const char*>(motion + ahead + 1) - 1);
           __builtin_prefetch(&obj_id_[ahead]);
           __builtin_prefetch(&obj_leaf_[ahead], 1);
         }
