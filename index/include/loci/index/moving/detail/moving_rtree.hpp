@@ -181,8 +181,8 @@ class MovingRTree {
     }
     std::vector<Item>& level = level_;
     level.resize(leaves);
-    // Leaves. Locals carry the count and the magnitudes, which stores through the nodes'
-    // arrays would otherwise force back to memory at every entry.
+    // Leaves. Locals carry the entry index and the magnitudes, which stores through the
+    // nodes' arrays would otherwise force back to memory at every entry.
     constexpr std::size_t kAhead = 32;
     const double epoch = epoch_;
     const Motion<D>* const motion = obj_motion_.data();
