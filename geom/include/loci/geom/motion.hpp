@@ -247,12 +247,14 @@ bool comes_within(const Motion<D>& a, const Motion<D>& b, double s0, double hori
   return detail::closest(a, b, s0, horizon).dcpa <= within;
 }
 
-// The closest approach of a and b over [s0, s0 + horizon] when it is at most `within`;
-// nullopt otherwise. horizon >= 0, within >= 0.
+// The closest approach over [s0, s0 + horizon] of two points at pa and pb at time s0 moving
+// with velocities va and vb, when it is at most `within`; nullopt otherwise. horizon >= 0,
+// within >= 0.
 template <int D>
-std::optional<Approach> closest_approach(const Motion<D>& a, const Motion<D>& b, double s0,
-                                         double horizon, double within) {
-  const detail::Closest<D> c = detail::closest(a, b, s0, horizon);
+std::optional<Approach> closest_approach_at(const Point<D>& pa, const Point<D>& va,
+                                            const Point<D>& pb, const Point<D>& vb, double s0,
+                                            double horizon, double within) {
+  const detail::Closest<D> c = detail::closest_at(pa, va, pb, vb, horizon);
   const double u = c.u, dcpa = c.dcpa;
   if (!(dcpa <= within)) return std::nullopt;
   const Point<D> zero{};
@@ -262,6 +264,14 @@ std::optional<Approach> closest_approach(const Motion<D>& a, const Motion<D>& b,
   const double enter = in.empty() ? u : std::min(in.enter, u);
   const double exit = in.empty() ? u : std::max(in.exit, u);
   return Approach{s0 + u, dcpa, s0 + enter, s0 + exit};
+}
+
+// The closest approach of a and b over [s0, s0 + horizon] when it is at most `within`;
+// nullopt otherwise. horizon >= 0, within >= 0.
+template <int D>
+std::optional<Approach> closest_approach(const Motion<D>& a, const Motion<D>& b, double s0,
+                                         double horizon, double within) {
+  return closest_approach_at(position(a, s0), a.v, position(b, s0), b.v, s0, horizon, within);
 }
 
 }  // namespace loci

@@ -37,6 +37,10 @@
 #include <span>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "loci/geom/motion.hpp"
 #include "loci/index/broadphase/detail/proxy_table.hpp"
 #include "loci/index/broadphase/sweep_prune.hpp"
@@ -147,6 +151,74 @@ bool stays_in_range(const Motion<D>& m, double t0, double t1) {
 [[noreturn]] inline void out_of_range(const std::string& who) {
   throw InvalidArgument("conflicts: " + who + " moves beyond 1e150 in the time searched");
 }
+
+// The quick test of a candidate pair: true when the closest approach over [0, horizon] of q
+// relative to p is clearly beyond reach (reach2 its square), by more than rounding can
+// explain. No division and no branch: with d and w the relative position and velocity, the
+// least squared distance over the horizon is |d|^2 when d.w >= 0 (moving apart), |d + wH|^2
+// when the closest approach is past H, and |d|^2 - (d.w)^2 / |w|^2 otherwise, compared
+// multiplied by |w|^2 and with a slack of 1e-14 |d|^2 |w|^2 that covers its rounding while
+// the products are normal numbers (about 10 ulps of |d|^2 |w|^2 in 3D); an overflow makes it
+// false (not apart), and so do products near the subnormal range, where they lose their
+// relative precision (and a |w|^2 of 0 sends the exact test to u = 0): not decided here.
+template <int D>
+[[gnu::always_inline]] inline bool clearly_apart(const Kinematics<D>& p, const Kinematics<D>& q,
+                                                 double reach2, double horizon) {
+  double dw = 0, ww = 0, dd = 0, ee = 0;
+  for (int k = 0; k < D; ++k) {
+    const double d = q.p[k] - p.p[k], w = q.v[k] - p.v[k];
+    const double e = d + w * horizon;
+    dw += d * w;
+    ww += w * w;
+    dd += d * d;
+    ee += e * e;
+  }
+  const double ddww = dd * ww;
+  const bool apart_now = dd > reach2, apart_end = ee > reach2;
+  const bool apart_mid = ddww - dw * dw - 1e-14 * ddww > reach2 * ww;
+  const bool receding = dw >= 0, past = -dw >= horizon * ww;
+  const bool normal = (ww >= 0x1p-1000) & (dd >= 0x1p-1000) & (ddww >= 0x1p-960);
+  return (receding & apart_now) | (!receding & normal & past & apart_end) |
+         (!receding & normal & !past & apart_mid);
+}
+
+#if defined(__SSE2__)
+// clearly_apart of p with q0 and with q1 at once, the same operations in the same order on
+// two lanes (so the same answers): bit 0 for q0, bit 1 for q1. Inlined into the loop over a
+// run, so that its constants stay in registers.
+template <int D>
+[[gnu::always_inline]] inline int clearly_apart2(const Kinematics<D>& p, const Kinematics<D>& q0,
+                                                 const Kinematics<D>& q1, double reach2,
+                                                 double horizon) {
+  const __m128d h = _mm_set1_pd(horizon);
+  __m128d dw = _mm_setzero_pd(), ww = dw, dd = dw, ee = dw;
+  for (int k = 0; k < D; ++k) {
+    const __m128d d = _mm_sub_pd(_mm_set_pd(q1.p[k], q0.p[k]), _mm_set1_pd(p.p[k]));
+    const __m128d w = _mm_sub_pd(_mm_set_pd(q1.v[k], q0.v[k]), _mm_set1_pd(p.v[k]));
+    const __m128d e = _mm_add_pd(d, _mm_mul_pd(w, h));
+    dw = _mm_add_pd(dw, _mm_mul_pd(d, w));
+    ww = _mm_add_pd(ww, _mm_mul_pd(w, w));
+    dd = _mm_add_pd(dd, _mm_mul_pd(d, d));
+    ee = _mm_add_pd(ee, _mm_mul_pd(e, e));
+  }
+  const __m128d r2 = _mm_set1_pd(reach2);
+  const __m128d ddww = _mm_mul_pd(dd, ww);
+  const __m128d apart_now = _mm_cmpgt_pd(dd, r2), apart_end = _mm_cmpgt_pd(ee, r2);
+  const __m128d apart_mid = _mm_cmpgt_pd(
+      _mm_sub_pd(_mm_sub_pd(ddww, _mm_mul_pd(dw, dw)), _mm_mul_pd(_mm_set1_pd(1e-14), ddww)),
+      _mm_mul_pd(r2, ww));
+  const __m128d receding = _mm_cmpge_pd(dw, _mm_setzero_pd());
+  const __m128d past = _mm_cmpge_pd(_mm_xor_pd(dw, _mm_set1_pd(-0.0)), _mm_mul_pd(h, ww));
+  const __m128d normal = _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(ww, _mm_set1_pd(0x1p-1000)),
+                                               _mm_cmpge_pd(dd, _mm_set1_pd(0x1p-1000))),
+                                    _mm_cmpge_pd(ddww, _mm_set1_pd(0x1p-960)));
+  const __m128d approaching =
+      _mm_or_pd(_mm_and_pd(past, apart_end), _mm_andnot_pd(past, apart_mid));
+  const __m128d apart = _mm_or_pd(_mm_and_pd(receding, apart_now),
+                                  _mm_andnot_pd(receding, _mm_and_pd(normal, approaching)));
+  return _mm_movemask_pd(apart);
+}
+#endif
 }  // namespace detail
 
 // The broad phase and buffers of conflict searches, kept between calls so that a search
@@ -166,37 +238,11 @@ class ConflictFinder {
     const std::size_t n = objects.size();
     broad_.reserve(n);
     // Pairs whose closest approach computed from the positions at `now` is clearly beyond D
-    // (by more than rounding can explain) are dropped before the exact test, which alone
-    // decides the rest. The quick test has no division and no branch: with d and w the
-    // relative position at `now` and velocity, the least squared distance over the horizon
-    // is |d|^2 when d.w >= 0 (moving apart), |d + wH|^2 when the closest approach is past H,
-    // and |d|^2 - (d.w)^2 / |w|^2 otherwise, compared multiplied by |w|^2 and with a slack
-    // of 1e-14 |d|^2 |w|^2 that covers its rounding while the products are normal numbers
-    // (about 10 ulps of |d|^2 |w|^2 in 3D); an overflow makes it false (not apart), and so do
-    // products near the subnormal range. d and w are computed as the exact test computes
-    // them, whose own rounding the margin of `reach` covers.
+    // (detail::clearly_apart) are dropped before the exact test, which alone decides the
+    // rest. d and w are computed as the exact test computes them, whose own rounding the
+    // margin of `reach` covers.
     const double reach = within * (1 + 1e-9) + 1e-9 * scale_;
     const double reach2 = reach * reach;
-    auto clearly_apart = [&](const detail::Kinematics<D>& p, const detail::Kinematics<D>& q) {
-      double dw = 0, ww = 0, dd = 0, ee = 0;
-      for (int k = 0; k < D; ++k) {
-        const double d = q.p[k] - p.p[k], w = q.v[k] - p.v[k];
-        const double e = d + w * horizon;
-        dw += d * w;
-        ww += w * w;
-        dd += d * d;
-        ee += e * e;
-      }
-      const double ddww = dd * ww;
-      const bool apart_now = dd > reach2, apart_end = ee > reach2;
-      const bool apart_mid = ddww - dw * dw - 1e-14 * ddww > reach2 * ww;
-      const bool receding = dw >= 0, past = -dw >= horizon * ww;
-      // Where |w|^2 or |d|^2 |w|^2 nears the subnormal range the products lose their
-      // relative precision (and a |w|^2 of 0 sends the exact test to u = 0): not decided here.
-      const bool normal = (ww >= 0x1p-1000) & (dd >= 0x1p-1000) & (ddww >= 0x1p-960);
-      return (receding & apart_now) | (!receding & normal & past & apart_end) |
-             (!receding & normal & !past & apart_mid);
-    };
     const double step = horizon / double(slices);
     for (std::size_t s = 0; s < slices; ++s) {
       const double t0 = now + step * double(s);
@@ -214,34 +260,49 @@ class ConflictFinder {
       held_ = n;
       bool go = true;
       const Id* proxy = nullptr;
-      // Positions at `now` and velocities copied into the sweep's order, so that the quick
-      // test of a run's candidates reads neighbouring memory.
+      detail::Kinematics<D>* kin = nullptr;
+      std::uint32_t* near = nullptr;
+      // Positions at `now` and velocities copied into the sweep's order, so that the tests
+      // of a run's candidates read neighbouring memory.
       auto lay_out = [&](std::span<const Id> ids) {
         proxy = ids.data();
         kin_.resize(ids.size());
         near_.resize(ids.size());
+        kin = kin_.data();
+        near = near_.data();
         for (std::size_t e = 0; e < ids.size(); ++e) {
           if (ids[e] == SweepPrune<D>::kSeparator) continue;
           const Motion<D>& m = motion_[ids[e]];
-          kin_[e] = {position(m, now), m.v};
+          kin[e] = {position(m, now), m.v};
         }
       };
       auto run = [&](std::size_t e, std::span<const std::uint32_t> partners) {
         st.entries_tested += partners.size();
-        const detail::Kinematics<D> p = kin_[e];
-        // The quick test over the run, its survivors left-packed into near_.
-        std::size_t kept = 0;
-        for (const std::uint32_t f : partners) {
-          near_[kept] = f;
-          kept += !clearly_apart(p, kin_[f]);
+        const detail::Kinematics<D> p = kin[e];
+        // The quick test over the run, its survivors left-packed into near.
+        std::size_t kept = 0, h = 0;
+#if defined(__SSE2__)
+        for (; h + 2 <= partners.size(); h += 2) {
+          const std::uint32_t f0 = partners[h], f1 = partners[h + 1];
+          const int apart = detail::clearly_apart2(p, kin[f0], kin[f1], reach2, horizon);
+          near[kept] = f0;
+          kept += std::size_t(~apart & 1);
+          near[kept] = f1;
+          kept += std::size_t(~apart >> 1 & 1);
+        }
+#endif
+        for (; h < partners.size(); ++h) {
+          near[kept] = partners[h];
+          kept += !detail::clearly_apart(p, kin[partners[h]], reach2, horizon);
         }
         for (std::size_t h = 0; h < kept; ++h) {
-          std::size_t a = e, b = near_[h];
+          std::size_t a = e, b = near[h];
           std::uint32_t i = order_[proxy[a]], j = order_[proxy[b]];
           if (j < i) std::swap(i, j), std::swap(a, b);
-          // The reports of objects[i] and objects[j], copied in proxy order.
+          // objects[i] and objects[j], from their positions at `now` and velocities: what
+          // closest_approach(objects[i], objects[j], now, horizon, within) computes.
           const auto ap =
-              closest_approach(motion_[proxy[a]], motion_[proxy[b]], now, horizon, within);
+              closest_approach_at(kin[a].p, kin[a].v, kin[b].p, kin[b].v, now, horizon, within);
           if (!ap) continue;
           // Reported from the slice holding the entry time only.
           const bool first = s == 0 || ap->t_enter > t0;
