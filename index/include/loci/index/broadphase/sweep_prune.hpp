@@ -33,7 +33,7 @@
 // +inf sentinel, so a run ends on a comparison instead of a bounds check; the test on the
 // other axes is branch-free and writes each candidate into a buffer whose cursor advances by
 // the test's result (left-packed output), so the only unpredictable branch is the end of the
-// run. With SSE2 (every x86-64) a run tests two entries a step.
+// run. With SSE2 (every x86-64) a run tests four entries a step.
 //
 // Callers with data of their own per proxy (find_conflicts keeps each object's motion) use
 // entry_pairs: it gives them the sweep's order once, then each entry with its run's hits by
@@ -384,11 +384,12 @@ class BasicSweepPrune {
     gather_sentinel();
   }
 
-  // Room for `capacity` entries and sentinels, plus one slot past the last sentinel: the
-  // two-lane sweep reads a pair of entries at a time and masks out the one past the end.
+  // Room for `capacity` entries and sentinels, plus three slots past the last sentinel: the
+  // sweep reads four entries a step and masks out those past the end (and writes a step's
+  // hits four at a time).
   void begin_gather(std::size_t capacity) {
     count_ = 0;
-    const std::size_t room = capacity + 2;
+    const std::size_t room = capacity + 4;
     start_.resize(room);
     lo_.resize(room);
     hi_.resize(room);
@@ -444,6 +445,30 @@ class BasicSweepPrune {
     return st;
   }
 
+#if defined(__SSE2__)
+  // For a mask of four lanes: its prefix of set lanes, its count of set lanes, and the
+  // offsets of its set lanes left-packed.
+  struct LaneTables {
+    std::uint8_t prefix[16], count[16];
+    alignas(16) std::int32_t packed[16][4];
+  };
+  static constexpr LaneTables lane_tables() {
+    LaneTables t{};
+    for (int m = 0; m < 16; ++m) {
+      int p = 0;
+      while (p < 4 && (m >> p & 1))
+        ++p;
+      t.prefix[m] = std::uint8_t((1 << p) - 1);
+      int c = 0;
+      for (int l = 0; l < 4; ++l)
+        if (m >> l & 1) t.packed[m][c++] = l;
+      t.count[m] = std::uint8_t(c);
+    }
+    return t;
+  }
+  static constexpr LaneTables kLanes = lane_tables();
+#endif
+
   // The run of entry i: writes the positions of the entries after i whose boxes meet its box
   // into hits (left-packed), returns their count, and sets `tested` to the run's length. The
   // run ends at the first entry whose start is beyond i's max on the sweep axis (a sentinel's
@@ -457,32 +482,39 @@ class BasicSweepPrune {
     std::size_t found = 0;
     std::size_t j = i + 1;
 #if defined(__SSE2__)
-    // Two entries a step. Starts increase within a stripe, so lane j + 1 is in the run only
-    // when lane j is; the lane past a sentinel (the next stripe, or the slot past the last
-    // sentinel) is masked out.
+    // Four entries a step, as two pairs of lanes. Starts increase within a stripe, so the
+    // entries of a step in the run are a prefix of its lanes; the lanes from a sentinel on
+    // (the next stripe, or the slots past the last sentinel) are masked out. The step's hits
+    // are written at once, left-packed by a table indexed by their lane mask.
     const __m128d end = _mm_set1_pd(hi[i]), begin = _mm_set1_pd(lo[i]);
     const __m128d at_home = _mm_castsi128_pd(_mm_set1_epi64x(std::int64_t(home[i])));
     __m128d ilo[kOther], ihi[kOther];
     for (int k = 0; k < kOther; ++k)
       ilo[k] = _mm_set1_pd(olo_[k][i]), ihi[k] = _mm_set1_pd(ohi_[k][i]);
-    for (;; j += 2) {
-      const int in = _mm_movemask_pd(_mm_cmple_pd(_mm_loadu_pd(start + j), end));
-      const int lanes = in & -(in & 1);
+    auto meets = [&](std::size_t at) {
       const __m128d jhome =
-          _mm_castsi128_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(home + j)));
-      __m128d meet = _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(lo + j), end),
-                                _mm_cmple_pd(begin, _mm_loadu_pd(hi + j)));
+          _mm_castsi128_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(home + at)));
+      __m128d meet = _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(lo + at), end),
+                                _mm_cmple_pd(begin, _mm_loadu_pd(hi + at)));
       meet = _mm_and_pd(meet, _mm_or_pd(at_home, jhome));
       for (int k = 0; k < kOther; ++k)
-        meet = _mm_and_pd(meet, _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(olo_[k].data() + j), ihi[k]),
-                                           _mm_cmple_pd(ilo[k], _mm_loadu_pd(ohi_[k].data() + j))));
-      const int m = _mm_movemask_pd(meet) & lanes;
-      hits[found] = std::uint32_t(j);
-      found += std::size_t(m & 1);
-      hits[found] = std::uint32_t(j + 1);
-      found += std::size_t(m >> 1);
-      if (lanes != 3) {
-        j += std::size_t(lanes);  // 0 or 1 lane of this step was in the run
+        meet =
+            _mm_and_pd(meet, _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(olo_[k].data() + at), ihi[k]),
+                                        _mm_cmple_pd(ilo[k], _mm_loadu_pd(ohi_[k].data() + at))));
+      return _mm_movemask_pd(meet);
+    };
+    for (;; j += 4) {
+      const int in = _mm_movemask_pd(_mm_cmple_pd(_mm_loadu_pd(start + j), end)) |
+                     _mm_movemask_pd(_mm_cmple_pd(_mm_loadu_pd(start + j + 2), end)) << 2;
+      const int lanes = kLanes.prefix[in];
+      const int m = (meets(j) | meets(j + 2) << 2) & lanes;
+      _mm_storeu_si128(
+          reinterpret_cast<__m128i*>(hits + found),
+          _mm_add_epi32(_mm_set1_epi32(int(j)),
+                        _mm_load_si128(reinterpret_cast<const __m128i*>(kLanes.packed[m]))));
+      found += kLanes.count[m];
+      if (lanes != 15) {
+        j += kLanes.count[lanes];  // the lanes of this step that were in the run
         break;
       }
     }
