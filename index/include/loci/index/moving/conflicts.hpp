@@ -164,14 +164,14 @@ bool stays_in_range(const Motion<D>& m, double t0, double t1) {
 template <int D>
 [[gnu::always_inline]] inline bool clearly_apart(const Kinematics<D>& p, const Kinematics<D>& q,
                                                  double reach2, double horizon) {
-  double dw = 0, ww = 0, dd = 0, ee = 0;
+  double dw, ww, dd, ee;
   for (int k = 0; k < D; ++k) {
     const double d = q.p[k] - p.p[k], w = q.v[k] - p.v[k];
     const double e = d + w * horizon;
-    dw += d * w;
-    ww += w * w;
-    dd += d * d;
-    ee += e * e;
+    dw = k ? dw + d * w : d * w;
+    ww = k ? ww + w * w : w * w;
+    dd = k ? dd + d * d : d * d;
+    ee = k ? ee + e * e : e * e;
   }
   const double ddww = dd * ww;
   const bool apart_now = dd > reach2, apart_end = ee > reach2;
@@ -191,15 +191,15 @@ template <int D>
                                                  const Kinematics<D>& q1, double reach2,
                                                  double horizon) {
   const __m128d h = _mm_set1_pd(horizon);
-  __m128d dw = _mm_setzero_pd(), ww = dw, dd = dw, ee = dw;
+  __m128d dw, ww, dd, ee;
   for (int k = 0; k < D; ++k) {
     const __m128d d = _mm_sub_pd(_mm_set_pd(q1.p[k], q0.p[k]), _mm_set1_pd(p.p[k]));
     const __m128d w = _mm_sub_pd(_mm_set_pd(q1.v[k], q0.v[k]), _mm_set1_pd(p.v[k]));
     const __m128d e = _mm_add_pd(d, _mm_mul_pd(w, h));
-    dw = _mm_add_pd(dw, _mm_mul_pd(d, w));
-    ww = _mm_add_pd(ww, _mm_mul_pd(w, w));
-    dd = _mm_add_pd(dd, _mm_mul_pd(d, d));
-    ee = _mm_add_pd(ee, _mm_mul_pd(e, e));
+    dw = k ? _mm_add_pd(dw, _mm_mul_pd(d, w)) : _mm_mul_pd(d, w);
+    ww = k ? _mm_add_pd(ww, _mm_mul_pd(w, w)) : _mm_mul_pd(w, w);
+    dd = k ? _mm_add_pd(dd, _mm_mul_pd(d, d)) : _mm_mul_pd(d, d);
+    ee = k ? _mm_add_pd(ee, _mm_mul_pd(e, e)) : _mm_mul_pd(e, e);
   }
   const __m128d r2 = _mm_set1_pd(reach2);
   const __m128d ddww = _mm_mul_pd(dd, ww);
@@ -209,8 +209,9 @@ template <int D>
       _mm_mul_pd(r2, ww));
   const __m128d receding = _mm_cmpge_pd(dw, _mm_setzero_pd());
   const __m128d past = _mm_cmpge_pd(_mm_xor_pd(dw, _mm_set1_pd(-0.0)), _mm_mul_pd(h, ww));
-  const __m128d normal = _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(ww, _mm_set1_pd(0x1p-1000)),
-                                               _mm_cmpge_pd(dd, _mm_set1_pd(0x1p-1000))),
+  // dd and ww are never NaN (sums of squares of finite differences): the least of the two
+  // is at least 2^-1000 exactly when both are.
+  const __m128d normal = _mm_and_pd(_mm_cmpge_pd(_mm_min_pd(ww, dd), _mm_set1_pd(0x1p-1000)),
                                     _mm_cmpge_pd(ddww, _mm_set1_pd(0x1p-960)));
   const __m128d approaching =
       _mm_or_pd(_mm_and_pd(past, apart_end), _mm_andnot_pd(past, apart_mid));
