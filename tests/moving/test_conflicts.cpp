@@ -261,48 +261,72 @@ TEST(Conflicts, GrazingInGeneralPosition) {
 #if defined(__SSE2__)
 // The quick test on two lanes gives, lane by lane, the answer of the one-lane test it stands
 // for, on values of every magnitude the range allows (products that overflow or reach the
-// subnormal range included), equal points and velocities, and both signs of zero.
-TEST(Conflicts, QuickTestOnTwoLanesAgreesWithOneLane) {
-  std::mt19937_64 rng(41);
-  // 1e-151, 3e-148 and 1e-145 put |w|^2 and |d|^2 |w|^2 about the thresholds of normal
-  // products.
-  const double scales[] = {0,    1e-300, 1e-160, 1e-151, 3e-148, 1e-145,
-                           1e-5, 1,      200,    1e5,    1e75,   1e150};
-  std::uniform_int_distribution<int> pick(0, 11), coin(0, 1), sixth(0, 5);
+// subnormal range included), equal points and velocities, and both signs of zero; and on
+// pairs built where one branch of the test decides alone.
+template <int D>
+void expect_two_lanes_agree(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  // 3e-151 brackets |w|^2 and |d|^2 = 2^-1000, 5.6e-73 |d|^2 |w|^2 = 2^-960: the bounds of
+  // the products the test trusts.
+  const double scales[] = {0, 1e-300, 1e-160, 3e-151, 5.6e-73, 1e-5, 1, 200, 1e5, 1e75, 1e150};
+  std::uniform_int_distribution<int> pick(0, 10), coin(0, 1), sixth(0, 5);
   std::uniform_real_distribution<double> unit(0.5, 1);
   auto value = [&] {
     const double v = scales[pick(rng)] * unit(rng);
     return coin(rng) ? -v : v;
   };
   auto kinematics = [&] {
-    detail::Kinematics<2> k;
-    for (int a = 0; a < 2; ++a)
+    detail::Kinematics<D> k;
+    for (int a = 0; a < D; ++a)
       k.p[a] = value(), k.v[a] = value();
     return k;
   };
   const double reaches[] = {0, 1, 4e4, 1e300};
   const double horizons[] = {0, 1, 600, 1e10};
   int apart = 0, kept = 0;
+  auto check = [&](const detail::Kinematics<D>& p, const detail::Kinematics<D>(&q)[2], double r2,
+                   double h) {
+    const int bits = detail::clearly_apart2(p, q[0], q[1], r2, h);
+    for (int l = 0; l < 2; ++l) {
+      const bool one = detail::clearly_apart(p, q[l], r2, h);
+      ASSERT_EQ((bits >> l & 1) != 0, one) << "D " << D << " lane " << l;
+      (one ? apart : kept) += 1;
+    }
+  };
   for (int t = 0; t < 200000; ++t) {
-    const detail::Kinematics<2> p = kinematics();
-    detail::Kinematics<2> q[2] = {kinematics(), kinematics()};
-    for (detail::Kinematics<2>& k : q) {
+    const detail::Kinematics<D> p = kinematics();
+    detail::Kinematics<D> q[2] = {kinematics(), kinematics()};
+    for (detail::Kinematics<D>& k : q) {
       const int c = sixth(rng);
       if (c == 0) k = p;      // the same object
       if (c == 1) k.v = p.v;  // parallel courses
       if (c == 2) k.p = p.p;  // at the same place now
     }
-    const double r2 = reaches[t % 4], h = horizons[t / 4 % 4];
-    const int bits = detail::clearly_apart2(p, q[0], q[1], r2, h);
-    for (int l = 0; l < 2; ++l) {
-      const bool one = detail::clearly_apart(p, q[l], r2, h);
-      ASSERT_EQ((bits >> l & 1) != 0, one) << "case " << t << " lane " << l;
-      (one ? apart : kept) += 1;
-    }
+    check(p, q, reaches[t % 4], horizons[t / 4 % 4]);
   }
   // Both answers are common, so the agreement is not that of a constant.
   EXPECT_GT(apart, 40000);
   EXPECT_GT(kept, 40000);
+  // Closest approach exactly at the horizon (-d.w = H |w|^2, every product exact), passing
+  // a few ulps outside the reach: the end of the horizon decides "apart", where the middle
+  // formula, within its slack, would not.
+  for (const double a : {0.5, 1.0, 3.0})
+    for (const double h : {1.0, 600.0})
+      for (int k = 1; k <= 8; ++k) {
+        detail::Kinematics<D> p{}, q[2] = {};
+        q[0].v[0] = a;
+        q[0].p[0] = -a * h;
+        q[0].p[1] = 200 * (1 + k * 0x1p-52);
+        q[1] = q[0];
+        q[1].p[1] = -q[0].p[1];
+        ASSERT_TRUE(detail::clearly_apart(p, q[0], 40000, h)) << a << " " << h << " " << k;
+        check(p, q, 40000, h);
+      }
+}
+
+TEST(Conflicts, QuickTestOnTwoLanesAgreesWithOneLane) {
+  expect_two_lanes_agree<2>(41);
+  expect_two_lanes_agree<3>(42);
 }
 #endif
 

@@ -236,7 +236,7 @@ class BasicSweepPrune {
   void sort_and_gather() {
     if constexpr (Incremental) {
       sort_incremental();
-      begin_gather(order_.size());
+      begin_gather(order_.size() + 1);  // the entries and one sentinel
       for (const std::uint32_t s : order_)
         gather(s, proxies_.box(s).min[axis_], true);
       gather_sentinel();
@@ -384,12 +384,12 @@ class BasicSweepPrune {
     gather_sentinel();
   }
 
-  // Room for `capacity` entries and sentinels, plus three slots past the last sentinel: the
-  // sweep reads four entries a step and masks out those past the end (and writes a step's
-  // hits four at a time).
+  // Room for `capacity` entries and sentinels (callers count both), plus three slots past the
+  // last sentinel: the sweep reads four entries a step and masks out those past the end (and
+  // writes a step's hits four at a time).
   void begin_gather(std::size_t capacity) {
     count_ = 0;
-    const std::size_t room = capacity + 4;
+    const std::size_t room = capacity + 3;
     start_.resize(room);
     lo_.resize(room);
     hi_.resize(room);
@@ -482,7 +482,7 @@ class BasicSweepPrune {
     std::size_t found = 0;
     std::size_t j = i + 1;
 #if defined(__SSE2__)
-    // Four entries a step, as two pairs of lanes. Starts increase within a stripe, so the
+    // Four entries a step, as two pairs of lanes. Starts never decrease within a stripe, so the
     // entries of a step in the run are a prefix of its lanes; the lanes from a sentinel on
     // (the next stripe, or the slots past the last sentinel) are masked out. The step's hits
     // are written at once, left-packed by a table indexed by their lane mask.

@@ -184,8 +184,10 @@ template <int D>
 
 #if defined(__SSE2__)
 // clearly_apart of p with q0 and with q1 at once, the same operations in the same order on
-// two lanes (so the same answers): bit 0 for q0, bit 1 for q1. Inlined into the loop over a
-// run, so that its constants stay in registers.
+// two lanes (so the same answers, as long as the compiler fuses no multiply and add of the
+// one-lane test: baseline x86-64 has no fused instruction; where a build allows them, the two
+// may round differently, and each stays sound on its own): bit 0 for q0, bit 1 for q1.
+// Inlined into the loop over a run, so that its constants stay in registers.
 template <int D>
 [[gnu::always_inline]] inline int clearly_apart2(const Kinematics<D>& p, const Kinematics<D>& q0,
                                                  const Kinematics<D>& q1, double reach2,
@@ -209,8 +211,9 @@ template <int D>
       _mm_mul_pd(r2, ww));
   const __m128d receding = _mm_cmpge_pd(dw, _mm_setzero_pd());
   const __m128d past = _mm_cmpge_pd(_mm_xor_pd(dw, _mm_set1_pd(-0.0)), _mm_mul_pd(h, ww));
-  // dd and ww are never NaN (sums of squares of finite differences): the least of the two
-  // is at least 2^-1000 exactly when both are.
+  // dd and ww are never NaN (sums of squares, of differences that may overflow to infinity
+  // but never meet infinities of both signs): the least of the two is at least 2^-1000
+  // exactly when both are.
   const __m128d normal = _mm_and_pd(_mm_cmpge_pd(_mm_min_pd(ww, dd), _mm_set1_pd(0x1p-1000)),
                                     _mm_cmpge_pd(ddww, _mm_set1_pd(0x1p-960)));
   const __m128d approaching =
