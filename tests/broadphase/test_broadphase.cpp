@@ -436,5 +436,58 @@ TEST(SweepPrune, TouchingWhereFloatsRound) {
   }
 }
 
+// Boxes whose bounds all come from a few values where floats round (a value, its double
+// neighbours, values a float step apart, beyond the float range, the largest float): on
+// every axis, the sweep's float tests are decided exactly, as brute force decides them.
+template <class BP, int D>
+void expect_pairs_at_float_steps(BP bp, std::uint64_t seed) {
+  const double f = 1.0 + 0x1p-23;  // the float after 1
+  const double hard[] = {1.0,
+                         std::nextafter(1.0, 2.0),
+                         std::nextafter(1.0, 0.0),
+                         f,
+                         std::nextafter(f, 0.0),
+                         0.1,
+                         -0.1,
+                         0.0,
+                         -1e-50,
+                         double(std::numeric_limits<float>::max()),
+                         std::nextafter(double(std::numeric_limits<float>::max()), 1e300),
+                         1e39,
+                         -1e39,
+                         1e300,
+                         -1e300};
+  constexpr int kHard = sizeof(hard) / sizeof(hard[0]);
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> pick(0, kHard - 1);
+  std::vector<Box<D>> boxes;
+  for (int n = 0; n < 300; ++n) {
+    Box<D> b;
+    for (int a = 0; a < D; ++a) {
+      const double x = hard[pick(rng)], y = hard[pick(rng)];
+      b.min[a] = std::min(x, y);
+      b.max[a] = std::max(x, y);
+    }
+    boxes.push_back(b);
+  }
+  std::vector<IdPair> want;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    bp.add(i, boxes[i]);
+    for (std::size_t j = i + 1; j < boxes.size(); ++j)
+      if (intersects(boxes[i], boxes[j])) want.push_back({i, j});
+  }
+  EXPECT_EQ(sorted(bp.pairs()), want);
+}
+
+TEST(SweepPrune, PairsAtFloatStepsOnEveryAxis) {
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    expect_pairs_at_float_steps<SweepPrune<2>, 2>(SweepPrune<2>(), seed);
+    expect_pairs_at_float_steps<SweepPrune<2>, 2>(SweepPrune<2>(4), seed);
+    expect_pairs_at_float_steps<SweepPrune<3>, 3>(SweepPrune<3>(4), seed);
+    expect_pairs_at_float_steps<IncrementalSweepPrune<2>, 2>(IncrementalSweepPrune<2>(), seed);
+    expect_pairs_at_float_steps<IncrementalSweepPrune<3>, 3>(IncrementalSweepPrune<3>(), seed);
+  }
+}
+
 }  // namespace
 }  // namespace loci
