@@ -408,6 +408,18 @@ TEST(SweepPrune, EntryPairsMatchPairs) {
   }
 }
 
+// Adds boxes[i] as proxy i and expects pairs() to be the pairs of boxes that meet.
+template <class BP, int D>
+void expect_pairs_of(BP& bp, const std::vector<Box<D>>& boxes) {
+  std::vector<IdPair> want;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    bp.add(i, boxes[i]);
+    for (std::size_t j = i + 1; j < boxes.size(); ++j)
+      if (intersects(boxes[i], boxes[j])) want.push_back({i, j});
+  }
+  EXPECT_EQ(sorted(bp.pairs()), want);
+}
+
 // The sweep orders runs by mins rounded down to floats: boxes that touch exactly at a value
 // a float rounds up (0.1, 1/3), rounds to -0 (-1e-50) or to infinity (1e39), or where floats
 // are sparse (1e30 plus a few ulps), are still paired, as in brute force.
@@ -425,13 +437,7 @@ TEST(SweepPrune, TouchingWhereFloatsRound) {
         boxes.push_back({{u, y}, {u, y + 2}});      // starts an ulp after x
         boxes.push_back({{std::nextafter(u, u + 1), y}, {u + 1, y}});
       }
-      std::vector<IdPair> want;
-      for (std::size_t i = 0; i < boxes.size(); ++i) {
-        bp.add(i, boxes[i]);
-        for (std::size_t j = i + 1; j < boxes.size(); ++j)
-          if (intersects(boxes[i], boxes[j])) want.push_back({i, j});
-      }
-      EXPECT_EQ(sorted(bp.pairs()), want);
+      expect_pairs_of(bp, boxes);
     }
   }
 }
@@ -470,13 +476,7 @@ void expect_pairs_at_float_steps(BP bp, std::uint64_t seed) {
     }
     boxes.push_back(b);
   }
-  std::vector<IdPair> want;
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    bp.add(i, boxes[i]);
-    for (std::size_t j = i + 1; j < boxes.size(); ++j)
-      if (intersects(boxes[i], boxes[j])) want.push_back({i, j});
-  }
-  EXPECT_EQ(sorted(bp.pairs()), want);
+  expect_pairs_of(bp, boxes);
 }
 
 TEST(SweepPrune, PairsAtFloatStepsOnEveryAxis) {
