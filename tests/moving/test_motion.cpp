@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "loci/geom/motion.hpp"
 
@@ -31,6 +32,43 @@ TEST(Motion, BadReportsAreRefused) {
   EXPECT_NO_THROW(check_motion(Motion2{0, {1e149, 0}, {0, 0}}));
   EXPECT_THROW(check_window(MovingWindow<2>::during({{0, 0}, {1, 1}}, 2, 1)), InvalidGeometry);
   EXPECT_THROW(check_window(MovingWindow<2>::at({{1, 0}, {0, 1}}, 0)), InvalidGeometry);
+}
+
+// The message of check_motion's refusal (empty when it accepts).
+template <int D>
+std::string refusal(const Motion<D>& m, const char* what = "report") {
+  try {
+    check_motion(m, what);
+  } catch (const InvalidGeometry& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Each bad value of a report, on every axis, gets its own message, in the order time, then
+// NaN or infinite coordinates, then magnitudes; the limits themselves are accepted.
+TEST(Motion, RefusalsNameWhatIsWrong) {
+  const double nan = std::nan("");
+  EXPECT_EQ(refusal(Motion2{nan, {0, 0}, {0, 0}}), "report has a NaN or infinite time");
+  EXPECT_EQ(refusal(Motion2{-INFINITY, {nan, 0}, {0, 0}}), "report has a NaN or infinite time");
+  EXPECT_EQ(refusal(Motion2{2e150, {nan, 0}, {0, 0}}), "report has a time beyond 1e150");
+  EXPECT_EQ(refusal(Motion2{0, {0, 0}, {0, 0}}, "row 7"), "");
+  EXPECT_EQ(refusal(Motion2{-1e150, {1e150, -1e150}, {-1e150, 1e150}}), "");
+  for (int a = 0; a < 3; ++a) {
+    SCOPED_TRACE(a);
+    for (const bool velocity : {false, true}) {
+      Motion<3> m{1.7e9, {1, 2, 3}, {0, 0, 0}};
+      (velocity ? m.v : m.p)[a] = nan;
+      EXPECT_EQ(refusal(m, "row 7").rfind("row 7 has a NaN or infinite coordinate: ", 0), 0u)
+          << refusal(m, "row 7");
+      (velocity ? m.v : m.p)[a] = -INFINITY;
+      EXPECT_EQ(refusal(m).rfind("report has a NaN or infinite coordinate: ", 0), 0u);
+      (velocity ? m.v : m.p)[a] = -2e150;
+      EXPECT_EQ(refusal(m), "report has a position or velocity beyond 1e150");
+      (velocity ? m.v : m.p)[a] = std::nextafter(1e150, 2e150);
+      EXPECT_EQ(refusal(m, "row 7"), "row 7 has a position or velocity beyond 1e150");
+    }
+  }
 }
 
 TEST(Motion, WindowHandCases) {
