@@ -233,13 +233,21 @@ void check_cells_tiling(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::vector<CellItem> tmp;
   constexpr int bits = cell_bits<D>();
-  for (std::size_t n : {0, 1, 5, 64, 65, 1000, 20000}) {
-    // random cells, few distinct cells, all equal, and distinct cells on every axis
-    for (int form = 0; form < 4; ++form) {
+  for (std::size_t n : {0, 1, 5, 24, 32, 64, 65, 1000, 20000}) {
+    // random cells, few distinct cells, all equal, distinct cells on every axis, and buckets
+    // of the top bits holding a few items each, tied in the bits below (the sort of a bucket
+    // a boundary cuts)
+    for (int form = 0; form < 5; ++form) {
       if (form == 3 && n > (std::size_t(1) << bits)) continue;
       std::vector<CellItem> v(n);
       for (std::uint32_t i = 0; i < n; ++i)
         v[i] = {form == 0 ? rng() : form == 1 ? rng() & 0x0003000300030003 : 42, i};
+      if (form == 4)
+        for (std::uint32_t i = 0; i < n; ++i) {
+          v[i].cells = 0;
+          for (int a = 0; a < D; ++a)
+            v[i].cells |= ((rng() & 0xff) << (bits - 8) | (rng() & 1)) << (bits * a);
+        }
       if (form == 3)
         for (int a = 0; a < D; ++a) {
           std::vector<std::uint64_t> c(std::size_t(1) << bits);
@@ -249,7 +257,9 @@ void check_cells_tiling(std::uint64_t seed) {
             v[i].cells = (a == 0 ? 0 : v[i].cells) | c[i] << (bits * a);
         }
       std::vector<std::size_t> groups;
-      const std::size_t k = std::max<std::size_t>(1, n / (1 + rng() % 40));
+      // Small inputs in groups of two or three, so that their ties meet slab boundaries.
+      const std::size_t k =
+          std::max<std::size_t>(1, n / (n <= 32 ? 2 + rng() % 2 : 1 + rng() % 40));
       for (std::size_t g = 0; g <= k; ++g)
         groups.push_back(n * g / k);
       auto ref = v;
@@ -269,6 +279,20 @@ void check_cells_tiling(std::uint64_t seed) {
       for (std::uint32_t i = 0; i < n; ++i)
         ASSERT_EQ(sorted[i].cells, orig[i].cells) << where;
       expect_tiled<D>(v.data(), std::span<const std::size_t>(groups));
+      // The first level's slabs hold the items a stable sort gives them, ties included (ties
+      // on the first axis are split at a slab boundary by input order).
+      if (k > 1) {
+        const std::size_t per = groups_per_slab<D>(k, 0);
+        for (std::size_t first = 0; first < k; first += per) {
+          const std::size_t last = std::min(first + per, k);
+          std::vector<std::uint32_t> got, want;
+          for (std::size_t i = groups[first]; i < groups[last]; ++i)
+            got.push_back(v[i].index), want.push_back(ref[i].index);
+          std::sort(got.begin(), got.end());
+          std::sort(want.begin(), want.end());
+          ASSERT_EQ(got, want) << where << " slab at group " << first;
+        }
+      }
       // Without ties the groups are those of full sorts at every level, item for item.
       if (form == 3)
         for (std::size_t g = 0; g < k; ++g) {
