@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <unordered_map>
 #include <vector>
 
@@ -85,6 +86,62 @@ TEST(Conflicts, MatchBruteForceOnEveryFleet) {
           EXPECT_GT(want.size(), 0u);
       }
   }
+}
+
+// One-off searches on a thread reuse its finder (detail::Lease): fleets that shrink and grow,
+// other distances, horizons and slicings, a search run from inside another's visitor, and
+// searches after one whose visitor threw all give brute force's answer.
+TEST(Conflicts, RepeatedSearchesOnOneThread) {
+  auto search = [](const std::vector<Motion2>& fleet, double within, double now, double horizon,
+                   std::size_t slices, auto&& also) {
+    std::vector<Id> ids(fleet.size());
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      ids[i] = i;
+    std::vector<Conflict> got;
+    find_conflicts<2>(
+        fleet, within, now, horizon,
+        [&](std::uint32_t i, std::uint32_t j, const Approach& ap) {
+          got.push_back({i, j, ap});
+          also();
+          return true;
+        },
+        slices);
+    sort_conflicts(got);
+    expect_same(got, brute(ids, fleet, within, now, horizon),
+                std::to_string(fleet.size()) + " objects, D=" + std::to_string(within));
+    return got.size();
+  };
+  auto nothing = [] {};
+  const std::size_t sizes[] = {900, 37, 2, 1500, 0, 400, 1, 900};
+  std::size_t found = 0;
+  for (std::size_t round = 0; round < std::size(sizes); ++round) {
+    const auto f = test::kAllFleets[round % std::size(test::kAllFleets)];
+    const auto fleet = test::make_fleet(f, sizes[round], 30 + round);
+    found += search(fleet, 5.0 + double(round), test::fleet_epoch(f), 20.0 * double(round % 3),
+                    round % 4, nothing);
+  }
+  EXPECT_GT(found, 0u);
+  // A search inside a visitor's call, once.
+  const auto outer = test::make_fleet(test::Fleet::clustered, 300, 50);
+  const auto inner = test::make_fleet(test::Fleet::uniform, 700, 51);
+  bool nested = false;
+  search(outer, 10, 0, 30, 0, [&] {
+    if (nested) return;
+    nested = true;
+    search(inner, 20, 0, 10, 2, nothing);
+  });
+  EXPECT_TRUE(nested);
+  // A visitor that throws halfway, then searches on other fleets.
+  const auto big = test::make_fleet(test::Fleet::head_on, 1200, 52);
+  int calls = 0;
+  EXPECT_THROW(find_conflicts<2>(big, 25, 0, 60,
+                                 [&](std::uint32_t, std::uint32_t, const Approach&) -> bool {
+                                   if (++calls == 5) throw std::runtime_error("visitor");
+                                   return true;
+                                 }),
+               std::runtime_error);
+  search(test::make_fleet(test::Fleet::staggered, 800, 53), 15, 0, 40, 0, nothing);
+  search(big, 25, 0, 60, 3, nothing);
 }
 
 TEST(Conflicts, ByIdsSortedAndChecked) {

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <stdexcept>
 
 #include "loci/index/detail/hilbert.hpp"
 #include "loci/index/detail/radix_sort.hpp"
+#include "loci/index/detail/scratch.hpp"
 #include "loci/index/detail/soa_boxes.hpp"
 #include "loci/index/detail/str_partition.hpp"
 #include "support/random_data.hpp"
@@ -142,6 +144,83 @@ TEST(RadixSort, KeptBufferAndOffsetBits) {
       ASSERT_EQ(v[i].index, ref[i].index) << round;
     }
   }
+}
+
+namespace {
+// A type of its own, so that the pool starts empty and the objects alive can be counted.
+struct Leased {
+  static inline int alive = 0;
+  int mark = 0;
+  Leased() { ++alive; }
+  ~Leased() { --alive; }
+};
+}  // namespace
+
+// A lease hands back the object the thread's previous lease returned, as it was left; nested
+// leases hold different objects; a dropped lease or one ended by an exception destroys its
+// object instead of returning it.
+TEST(Lease, ReturnsNestsDropsAndForgetsOnExceptions) {
+  {
+    Lease<Leased> a;
+    a->mark = 1;
+  }
+  EXPECT_EQ(Leased::alive, 1);
+  {
+    Lease<Leased> b;
+    EXPECT_EQ(b->mark, 1);  // the same object, not a new one
+    Lease<Leased> c;        // nested: the pool is empty, so a new one
+    EXPECT_EQ(c->mark, 0);
+    EXPECT_EQ(Leased::alive, 2);
+    c->mark = 2;
+  }
+  EXPECT_EQ(Leased::alive, 2);  // both back in the pool
+  {
+    Lease<Leased> d, e;
+    EXPECT_EQ(d->mark + e->mark, 3);
+    e.drop();
+  }
+  EXPECT_EQ(Leased::alive, 1);
+  try {
+    Lease<Leased> f;
+    f->mark = 7;
+    throw std::runtime_error("in the middle of a call");
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_EQ(Leased::alive, 0);
+  {
+    Lease<Leased> g;
+    EXPECT_EQ(g->mark, 0);
+  }
+  // A lease taken while an exception is already in flight (in a destructor during unwinding)
+  // still returns its object when it ends normally.
+  struct Unwinding {
+    ~Unwinding() {
+      Lease<Leased> h;
+      h->mark = 9;
+    }
+  };
+  try {
+    Unwinding u;
+    throw std::runtime_error("unwinding");
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_EQ(Leased::alive, 1);
+  Lease<Leased> i;
+  EXPECT_EQ(i->mark, 9);
+}
+
+// Scratch buffers come back empty with their capacity kept.
+TEST(Lease, ScratchComesBackClearedWithItsCapacity) {
+  const double* data = nullptr;
+  {
+    Scratch<double> s;
+    s->assign(1000, 1.0);
+    data = s->data();
+  }
+  Scratch<double> t;
+  EXPECT_TRUE(t->empty());
+  EXPECT_GE(t->capacity(), 1000u);
+  EXPECT_EQ(t->data(), data);
 }
 
 TEST(StrTile, GroupsAreSlabsThenTiles) {

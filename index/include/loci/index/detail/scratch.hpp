@@ -1,41 +1,70 @@
-// Scratch<T>: a reusable buffer leased from a per-thread pool, so that queries allocate
-// nothing once a thread has warmed up. Leases nest (a visitor may run another query on the
-// same thread); each lease returns its buffer, cleared but with its capacity kept.
+// Lease<T>: a T leased from a per-thread pool of idle ones, so that a call repeated on a thread
+// reuses what the previous call built (its buffers above all) instead of allocating and
+// faulting in fresh memory. An empty pool makes a new T. Leases nest (a visitor may run another
+// query on the same thread, which leases a second T). At the end of the lease the T goes back
+// to the pool, unless drop() was called (a holder that would keep too much memory) or the
+// lease ends by an exception, which may have left the T half-changed: then it is destroyed.
+//
+// Scratch<T>: a lease of a std::vector<T>, given back cleared but with its capacity kept.
 #pragma once
 
+#include <exception>
 #include <memory>
 #include <vector>
 
 namespace loci::detail {
 
 template <class T>
-class Scratch {
+class Lease {
  public:
-  Scratch() {
+  Lease() : exceptions_(std::uncaught_exceptions()) {
     auto& p = pool();
     if (p.empty()) {
-      buf_ = std::make_unique<std::vector<T>>();
+      obj_ = std::make_unique<T>();
     } else {
-      buf_ = std::move(p.back());
+      obj_ = std::move(p.back());
       p.pop_back();
     }
   }
-  ~Scratch() {
-    buf_->clear();
-    pool().push_back(std::move(buf_));
+  ~Lease() {
+    if (!keep_ || std::uncaught_exceptions() != exceptions_) return;
+    try {
+      pool().push_back(std::move(obj_));
+    } catch (...) {  // no room in the pool: the T is destroyed instead
+    }
   }
+  Lease(const Lease&) = delete;
+  Lease& operator=(const Lease&) = delete;
+
+  // The T is destroyed at the end of the lease rather than kept.
+  void drop() { keep_ = false; }
+
+  T& operator*() { return *obj_; }
+  T* operator->() { return obj_.get(); }
+
+ private:
+  static std::vector<std::unique_ptr<T>>& pool() {
+    thread_local std::vector<std::unique_ptr<T>> p;
+    return p;
+  }
+  std::unique_ptr<T> obj_;
+  int exceptions_;
+  bool keep_ = true;
+};
+
+template <class T>
+class Scratch {
+ public:
+  Scratch() = default;
+  ~Scratch() { lease_->clear(); }
   Scratch(const Scratch&) = delete;
   Scratch& operator=(const Scratch&) = delete;
 
-  std::vector<T>& operator*() { return *buf_; }
-  std::vector<T>* operator->() { return buf_.get(); }
+  std::vector<T>& operator*() { return *lease_; }
+  std::vector<T>* operator->() { return &*lease_; }
 
  private:
-  static std::vector<std::unique_ptr<std::vector<T>>>& pool() {
-    thread_local std::vector<std::unique_ptr<std::vector<T>>> p;
-    return p;
-  }
-  std::unique_ptr<std::vector<T>> buf_;
+  Lease<std::vector<T>> lease_;
 };
 
 }  // namespace loci::detail
