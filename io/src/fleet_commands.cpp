@@ -702,7 +702,10 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
     std::size_t pairs = 0;
     bool full = true;
     if (o.from_scratch) {
-      pairs = find_conflicts<2>(ids, motions, o.within, t, o.horizon).size();
+      // Counted as the monitor's pairs are below: listed, not collected and sorted.
+      find_conflicts<2>(
+          std::span<const Motion2>(motions), o.within, t, o.horizon,
+          [&](std::uint32_t, std::uint32_t, const Approach&) { return ++pairs, true; });
     } else {
       const std::size_t before = monitor.full_computations();
       monitor.refresh(t);
