@@ -167,6 +167,23 @@ TEST(Conflicts, PositionsBeyondTheRangeAreRefused) {
   EXPECT_EQ(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 0, 1e9).size(), 1u);
   EXPECT_THROW(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 0, 1e11), InvalidArgument);
   EXPECT_THROW(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 1e11, 1), InvalidArgument);
+  // Velocities beyond 1e150 are refused even where the positions stay in range (a horizon of
+  // 0): their differences could overflow. 1e150 itself is taken.
+  for (const double v : {1e150, std::nextafter(1e150, 2e150), -1e300, 1e308}) {
+    const std::vector<Motion2> fast{{0, {0, 0}, {0, 0}}, {0, {1, 0}, {0, v}}};
+    if (std::abs(v) <= 1e150) {
+      EXPECT_EQ(find_conflicts<2>(std::vector<Id>{1, 2}, fast, 2, 0, 0).size(), 1u);
+      continue;
+    }
+    try {
+      find_conflicts<2>(std::vector<Id>{1, 2}, fast, 2, 0, 0);
+      ADD_FAILURE() << "a velocity of " << v << " was taken";
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("object 1 of the input has a velocity beyond 1e150"),
+                std::string::npos)
+          << e.what();
+    }
+  }
   ConflictMonitor<2> monitor(2, 1e9, 1e9);
   monitor.report(1, fleet[0]);
   monitor.report(2, fleet[1]);

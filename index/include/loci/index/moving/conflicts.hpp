@@ -3,7 +3,9 @@
 // find_conflicts(objects, D, now, H, visit) reports each pair (i, j), i < j indices into
 // `objects`, whose distance is at most D at some time of [now, now + H], with its closest
 // approach (tcpa clamped to the horizon, dcpa, and the entry and exit times of the D-circle;
-// geom/motion.hpp closest_approach, which alone decides).
+// geom/motion.hpp closest_approach, which alone decides). It throws InvalidArgument, naming
+// the object, for one whose velocity exceeds 1e150 or whose position leaves +-1e150 during
+// the horizon (the differences of such values could overflow and lose pairs).
 //
 // Broad phase. Two objects within D of each other at time s lie, at s, in boxes of half-side
 // D/2 around their positions that meet (the L-infinity distance is at most the Euclidean
@@ -331,9 +333,15 @@ class ConflictFinder {
   // the broad phase reports (neighbours in space) read neighbouring memory.
   void prepare(std::span<const Motion<D>> objects, double now, double horizon) {
     const std::size_t n = objects.size();
-    for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t i = 0; i < n; ++i) {
       if (!detail::stays_in_range(objects[i], now, now + horizon))
         detail::out_of_range("object " + std::to_string(i) + " of the input");
+      // As check_motion refuses them in a report: beyond 1e150 the relative velocity of two
+      // objects may overflow, even over a horizon of 0.
+      if (!within_coordinate_range(objects[i].v))
+        throw InvalidArgument("conflicts: object " + std::to_string(i) +
+                              " of the input has a velocity beyond 1e150");
+    }
     motion_.resize(n);
     Box<D> extent = Box<D>::empty();
     for (const Motion<D>& m : objects)
