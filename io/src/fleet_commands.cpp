@@ -34,6 +34,36 @@ std::string num(double d) {
   return std::string(buf, r.ptr);
 }
 
+// num(d) and an id appended to `out` without a string of their own: rows of big answers.
+void append_num(std::string& out, double d) {
+  char buf[32];
+  out.append(buf, std::to_chars(buf, buf + sizeof buf, d).ptr);
+}
+void append_id(std::string& out, Id id) {
+  char buf[24];
+  out.append(buf, std::to_chars(buf, buf + sizeof buf, id).ptr);
+}
+
+// Rows gathered into blocks of about 64 KB, each written at once; flush() writes the last.
+class BlockWriter {
+ public:
+  explicit BlockWriter(std::FILE* f) : f_(f) { buf_.reserve(kBlock + 1024); }
+  std::string& buf() { return buf_; }
+  // After each row: writes the block once it is full.
+  void row_done() {
+    if (buf_.size() >= kBlock) flush();
+  }
+  void flush() {
+    std::fwrite(buf_.data(), 1, buf_.size(), f_);
+    buf_.clear();
+  }
+
+ private:
+  static constexpr std::size_t kBlock = std::size_t(1) << 16;
+  std::FILE* f_;
+  std::string buf_;
+};
+
 std::string fixed(double d, int decimals) {
   char buf[48];
   std::snprintf(buf, sizeof buf, "%.*f", decimals, d);
@@ -346,35 +376,54 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   } else {
     std::fprintf(f, "{\"type\":\"FeatureCollection\",\"features\":[");
   }
+  BlockWriter w(f);
+  std::string& row = w.buf();
   for (std::size_t i = 0; i < found.size(); ++i) {
     const Conflict& c = found[i];
     const Approach& ap = c.approach;
     const Point2 a = shown(l, position(motion_of(c.a), ap.tcpa));
     const Point2 b = shown(l, position(motion_of(c.b), ap.tcpa));
-    const std::string ia = std::to_string(c.a), ib = std::to_string(c.b);
-    if (o.format == Format::csv) {
-      std::string row = ia + "," + ib + "," + num(ap.tcpa) + "," + num(ap.dcpa) + "," +
-                        num(ap.t_enter) + "," + num(ap.t_exit);
+    const bool csv = o.format == Format::csv;
+    if (!csv)
+      row += i ? ",\n{\"type\":\"Feature\",\"properties\":{"
+               : "\n{\"type\":\"Feature\",\"properties\":{";
+    row += csv ? "" : "\"id_a\":";
+    append_id(row, c.a);
+    row += csv ? "," : ",\"id_b\":";
+    append_id(row, c.b);
+    const char* const names[] = {",\"tcpa\":", ",\"dcpa\":", ",\"t_enter\":", ",\"t_exit\":"};
+    const double values[] = {ap.tcpa, ap.dcpa, ap.t_enter, ap.t_exit};
+    for (int k = 0; k < 4; ++k) {
+      row += csv ? "," : names[k];
+      append_num(row, values[k]);
+    }
+    if (csv) {
       if (ais)
         row += "," + fixed(ap.dcpa / kNauticalMile, 4) + "," + format_utc(ap.tcpa) + "," +
                fixed((ap.tcpa - l.now) / 60, 2) + "," + format_utc(ap.t_enter) + "," +
                format_utc(ap.t_exit);
-      row += "," + num(a[0]) + "," + num(a[1]) + "," + num(b[0]) + "," + num(b[1]);
-      std::fprintf(f, "%s\n", row.c_str());
-      continue;
-    }
-    std::string props = "\"id_a\":" + ia + ",\"id_b\":" + ib + ",\"tcpa\":" + num(ap.tcpa) +
-                        ",\"dcpa\":" + num(ap.dcpa) + ",\"t_enter\":" + num(ap.t_enter) +
-                        ",\"t_exit\":" + num(ap.t_exit);
-    if (ais)
-      props += ",\"dcpa_nm\":" + fixed(ap.dcpa / kNauticalMile, 4) + ",\"tcpa_utc\":\"" +
+      for (const double v : {a[0], a[1], b[0], b[1]}) {
+        row += ',';
+        append_num(row, v);
+      }
+      row += '\n';
+    } else {
+      if (ais)
+        row += ",\"dcpa_nm\":" + fixed(ap.dcpa / kNauticalMile, 4) + ",\"tcpa_utc\":\"" +
                format_utc(ap.tcpa) + "\",\"tcpa_min\":" + fixed((ap.tcpa - l.now) / 60, 2);
-    std::fprintf(f,
-                 "%s\n{\"type\":\"Feature\",\"properties\":{%s},\"geometry\":{\"type\":"
-                 "\"LineString\",\"coordinates\":[[%s,%s],[%s,%s]]}}",
-                 i ? "," : "", props.c_str(), num(a[0]).c_str(), num(a[1]).c_str(),
-                 num(b[0]).c_str(), num(b[1]).c_str());
+      row += "},\"geometry\":{\"type\":\"LineString\",\"coordinates\":[[";
+      append_num(row, a[0]);
+      row += ',';
+      append_num(row, a[1]);
+      row += "],[";
+      append_num(row, b[0]);
+      row += ',';
+      append_num(row, b[1]);
+      row += "]]}}";
+    }
+    w.row_done();
   }
+  w.flush();
   if (o.format == Format::geojson) std::fprintf(f, "\n]}\n");
   out.commit();
   FleetRun r = run_of(l);

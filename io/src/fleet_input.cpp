@@ -91,10 +91,14 @@ class CsvRecords {
         if (at_ < text_.size() && text_[at_] != ',' && text_[at_] != '\n' && text_[at_] != '\r')
           fail("text after a quoted field's closing quote");
       } else {
-        const std::size_t end = std::min(text_.find_first_of(",\r\n", at_), text_.size());
-        const std::string_view f = text_.substr(at_, end - at_);
-        if (f.find('"') != std::string_view::npos) fail("a quote inside an unquoted field");
-        fields.push_back(f);
+        // One pass to the field's end, looking for a stray quote on the way.
+        std::size_t end = at_;
+        for (; end < text_.size(); ++end) {
+          const char c = text_[end];
+          if (c == ',' || c == '\n' || c == '\r' || c == '"') break;
+        }
+        if (end < text_.size() && text_[end] == '"') fail("a quote inside an unquoted field");
+        fields.push_back(text_.substr(at_, end - at_));
         at_ = end;
       }
       if (at_ < text_.size() && text_[at_] == ',') {
