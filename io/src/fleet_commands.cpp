@@ -290,40 +290,65 @@ Point2 shown(const Loaded& l, const Point2& p) {
 void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, Format format,
                 std::FILE* out) {
   const bool ais = l.ais();
+  BlockWriter w(out);
+  std::string& row = w.buf();
   if (format == Format::ids) {
-    for (const Hit& h : hits)
-      std::fprintf(out, "%llu\n", static_cast<unsigned long long>(h.id));
+    for (const Hit& h : hits) {
+      append_id(row, h.id);
+      row += '\n';
+      w.row_done();
+    }
+    w.flush();
     return;
   }
   if (format == Format::csv) {
-    std::string head = nearest ? "id,distance" : "id";
-    if (nearest && ais) head += ",distance_nm";
-    head += ais ? ",t,time_utc,lon,lat" : ",t,x,y";
-    std::fprintf(out, "%s\n", head.c_str());
+    row += nearest ? "id,distance" : "id";
+    if (nearest && ais) row += ",distance_nm";
+    row += ais ? ",t,time_utc,lon,lat\n" : ",t,x,y\n";
     for (const Hit& h : hits) {
-      std::string row = std::to_string(h.id);
-      if (nearest) row += "," + num(h.distance);
+      append_id(row, h.id);
+      if (nearest) {
+        row += ',';
+        append_num(row, h.distance);
+      }
       if (nearest && ais) row += "," + fixed(h.distance / kNauticalMile, 4);
-      row += "," + num(h.t);
+      row += ',';
+      append_num(row, h.t);
       if (ais) row += "," + format_utc(h.t);
       const Point2 p = shown(l, h.p);
-      row += "," + num(p[0]) + "," + num(p[1]);
-      std::fprintf(out, "%s\n", row.c_str());
+      row += ',';
+      append_num(row, p[0]);
+      row += ',';
+      append_num(row, p[1]);
+      row += '\n';
+      w.row_done();
     }
+    w.flush();
     return;
   }
-  std::fprintf(out, "{\"type\":\"FeatureCollection\",\"features\":[");
+  row += "{\"type\":\"FeatureCollection\",\"features\":[";
   for (std::size_t i = 0; i < hits.size(); ++i) {
     const Hit& h = hits[i];
     const Point2 p = shown(l, h.p);
-    std::fprintf(out, "%s\n{\"type\":\"Feature\",\"properties\":{\"id\":%llu,\"t\":%s",
-                 i ? "," : "", static_cast<unsigned long long>(h.id), num(h.t).c_str());
-    if (ais) std::fprintf(out, ",\"time_utc\":\"%s\"", format_utc(h.t).c_str());
-    if (nearest) std::fprintf(out, ",\"distance\":%s", num(h.distance).c_str());
-    std::fprintf(out, "},\"geometry\":{\"type\":\"Point\",\"coordinates\":[%s,%s]}}",
-                 num(p[0]).c_str(), num(p[1]).c_str());
+    row += i ? ",\n{\"type\":\"Feature\",\"properties\":{\"id\":"
+             : "\n{\"type\":\"Feature\",\"properties\":{\"id\":";
+    append_id(row, h.id);
+    row += ",\"t\":";
+    append_num(row, h.t);
+    if (ais) row += ",\"time_utc\":\"" + format_utc(h.t) + "\"";
+    if (nearest) {
+      row += ",\"distance\":";
+      append_num(row, h.distance);
+    }
+    row += "},\"geometry\":{\"type\":\"Point\",\"coordinates\":[";
+    append_num(row, p[0]);
+    row += ',';
+    append_num(row, p[1]);
+    row += "]}}";
+    w.row_done();
   }
-  std::fprintf(out, "\n]}\n");
+  row += "\n]}\n";
+  w.flush();
 }
 
 }  // namespace
