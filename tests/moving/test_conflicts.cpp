@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <thread>
 #include <unordered_map>
 #include <vector>
 
@@ -142,6 +143,47 @@ TEST(Conflicts, RepeatedSearchesOnOneThread) {
                std::runtime_error);
   search(test::make_fleet(test::Fleet::staggered, 800, 53), 15, 0, 40, 0, nothing);
   search(big, 25, 0, 60, 3, nothing);
+  // A search stopped by its visitor, then a full one.
+  int seen = 0;
+  find_conflicts<2>(big, 25, 0, 60,
+                    [&](std::uint32_t, std::uint32_t, const Approach&) { return ++seen < 3; });
+  EXPECT_EQ(seen, 3);
+  search(big, 25, 0, 60, 0, nothing);
+}
+
+// The pairs a search visits, in the order it visits them.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> visits(const std::vector<Motion2>& fleet,
+                                                            double within, double horizon) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+  find_conflicts<2>(fleet, within, 0, horizon,
+                    [&](std::uint32_t i, std::uint32_t j, const Approach&) {
+                      out.push_back({i, j});
+                      return true;
+                    });
+  return out;
+}
+
+// The order of the visits does not depend on the searches a thread ran before: a fleet
+// searched on a fresh thread and again after larger (striped) and smaller searches on this
+// one, with ties in the sweep (identical and stationary fleets).
+TEST(Conflicts, VisitOrderIgnoresEarlierSearches) {
+  for (const test::Fleet f : {test::Fleet::identical, test::Fleet::stationary,
+                              test::Fleet::parallel, test::Fleet::uniform}) {
+    const auto fleet = test::make_fleet(f, 5000, 60);
+    const double within = f == test::Fleet::identical  ? 0.5
+                          : f == test::Fleet::parallel ? 8.0
+                                                       : 3.0;
+    const double horizon = 5;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> fresh;
+    std::thread([&] { fresh = visits(fleet, within, horizon); }).join();
+    visits(test::make_fleet(test::Fleet::uniform, 7000, 61), 3, 5);  // striped, larger
+    const auto small = test::make_fleet(f, 300, 62);
+    EXPECT_EQ(visits(small, within, horizon).size(),
+              brute(std::vector<Id>(small.size()), small, within, 0, horizon).size())
+        << test::name(f);
+    EXPECT_GT(fresh.size(), 0u) << test::name(f);
+    EXPECT_EQ(visits(fleet, within, horizon), fresh) << test::name(f);
+  }
 }
 
 TEST(Conflicts, ByIdsSortedAndChecked) {
@@ -183,6 +225,9 @@ TEST(Conflicts, PositionsBeyondTheRangeAreRefused) {
                 std::string::npos)
           << e.what();
     }
+    // Alone too, where there is no pair to search.
+    EXPECT_THROW(find_conflicts<2>(std::vector<Id>{2}, std::span(fast).subspan(1), 2, 0, 0),
+                 InvalidArgument);
   }
   ConflictMonitor<2> monitor(2, 1e9, 1e9);
   monitor.report(1, fleet[0]);

@@ -2,10 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numeric>
 #include <random>
 #include <stdexcept>
+#include <thread>
 
 #include "loci/index/detail/hilbert.hpp"
 #include "loci/index/detail/radix_sort.hpp"
@@ -207,6 +209,33 @@ TEST(Lease, ReturnsNestsDropsAndForgetsOnExceptions) {
   EXPECT_EQ(Leased::alive, 1);
   Lease<Leased> i;
   EXPECT_EQ(i->mark, 9);
+}
+
+namespace {
+struct LeasedLate {
+  static inline std::atomic<int> alive = 0, made = 0;
+  LeasedLate() { ++alive, ++made; }
+  ~LeasedLate() { --alive; }
+};
+struct LeasesAtExit {
+  ~LeasesAtExit() {
+    Lease<LeasedLate> late;
+    (void)*late;
+  }
+};
+}  // namespace
+
+// A lease taken at a thread's exit, after the thread's pool is gone (from the destructor of
+// a thread-local made before the pool), gets an object of its own and frees it.
+TEST(Lease, AfterThePoolIsGone) {
+  std::thread([] {
+    thread_local LeasesAtExit made_first;
+    (void)&made_first;
+    Lease<LeasedLate> early;
+    (void)*early;
+  }).join();
+  EXPECT_EQ(LeasedLate::made, 2);  // the late lease did not find the early one's object
+  EXPECT_EQ(LeasedLate::alive, 0);
 }
 
 // Scratch buffers come back empty with their capacity kept.

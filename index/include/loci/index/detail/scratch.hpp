@@ -18,18 +18,19 @@ template <class T>
 class Lease {
  public:
   Lease() : exceptions_(std::uncaught_exceptions()) {
-    auto& p = pool();
-    if (p.empty()) {
+    std::vector<std::unique_ptr<T>>* p = pool();
+    if (!p || p->empty()) {
       obj_ = std::make_unique<T>();
     } else {
-      obj_ = std::move(p.back());
-      p.pop_back();
+      obj_ = std::move(p->back());
+      p->pop_back();
     }
   }
   ~Lease() {
-    if (!keep_ || std::uncaught_exceptions() != exceptions_) return;
+    std::vector<std::unique_ptr<T>>* p = pool();
+    if (!p || !keep_ || std::uncaught_exceptions() != exceptions_) return;
     try {
-      pool().push_back(std::move(obj_));
+      p->push_back(std::move(obj_));
     } catch (...) {  // no room in the pool: the T is destroyed instead
     }
   }
@@ -43,9 +44,21 @@ class Lease {
   T* operator->() { return obj_.get(); }
 
  private:
-  static std::vector<std::unique_ptr<T>>& pool() {
-    thread_local std::vector<std::unique_ptr<T>> p;
-    return p;
+  // The thread's pool; null once the thread's exit has destroyed it (a lease taken from the
+  // destructor of another thread-local or static object then has a T of its own). The flag
+  // is a plain bool, which no destructor ends, so it can be read at any time.
+  struct Pool {
+    std::vector<std::unique_ptr<T>> idle;
+    ~Pool() { gone() = true; }
+  };
+  static bool& gone() {
+    thread_local bool g = false;
+    return g;
+  }
+  static std::vector<std::unique_ptr<T>>* pool() {
+    if (gone()) return nullptr;
+    thread_local Pool p;
+    return &p.idle;
   }
   std::unique_ptr<T> obj_;
   int exceptions_;

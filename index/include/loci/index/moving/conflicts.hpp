@@ -238,12 +238,20 @@ class ConflictFinder {
   QueryStats find(std::span<const Motion<D>> objects, double within, double now, double horizon,
                   F&& visit, std::size_t slices = 0) {
     check_conflict_query(within, now, horizon);
+    check_objects(objects, now, horizon);
     if (slices == 0) slices = detail::auto_slices(objects, within, horizon);
     QueryStats st;
     if (objects.size() < 2) return st;
     if (objects.size() >= kNone) throw InvalidArgument("find_conflicts: too many objects");
     prepare(objects, now, horizon);
     const std::size_t n = objects.size();
+    // Proxy k holds slot k of the broad phase, whatever the searches before: a fleet smaller
+    // than the last is added afresh (the memory kept) rather than leaving freed slots, which
+    // the sweep would walk on every later search and which would reorder its ties.
+    if (n < held_) {
+      broad_.clear();
+      held_ = 0;
+    }
     broad_.reserve(n);
     // Pairs whose closest approach computed from the positions at `now` is clearly beyond D
     // (detail::clearly_apart) are dropped before the exact test, which alone decides the
@@ -263,8 +271,6 @@ class ConflictFinder {
         else
           broad_.add(k, b);
       }
-      for (std::size_t k = n; k < held_; ++k)
-        broad_.remove(k);
       held_ = n;
       bool go = true;
       const Id* proxy = nullptr;
@@ -331,17 +337,21 @@ class ConflictFinder {
  private:
   // Numbers the objects in Hilbert order of their positions at mid-horizon, so that the pairs
   // the broad phase reports (neighbours in space) read neighbouring memory.
-  void prepare(std::span<const Motion<D>> objects, double now, double horizon) {
-    const std::size_t n = objects.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!detail::stays_in_range(objects[i], now, now + horizon))
-        detail::out_of_range("object " + std::to_string(i) + " of the input");
-      // As check_motion refuses them in a report: beyond 1e150 the relative velocity of two
-      // objects may overflow, even over a horizon of 0.
+  // Velocities beyond 1e150 (as check_motion refuses them in a report: the relative velocity
+  // of two objects could overflow, even over a horizon of 0), then positions that leave
+  // +-1e150 over the horizon; every object, however few.
+  static void check_objects(std::span<const Motion<D>> objects, double now, double horizon) {
+    for (std::size_t i = 0; i < objects.size(); ++i) {
       if (!within_coordinate_range(objects[i].v))
         throw InvalidArgument("conflicts: object " + std::to_string(i) +
                               " of the input has a velocity beyond 1e150");
+      if (!detail::stays_in_range(objects[i], now, now + horizon))
+        detail::out_of_range("object " + std::to_string(i) + " of the input");
     }
+  }
+
+  void prepare(std::span<const Motion<D>> objects, double now, double horizon) {
+    const std::size_t n = objects.size();
     motion_.resize(n);
     Box<D> extent = Box<D>::empty();
     for (const Motion<D>& m : objects)
@@ -380,7 +390,9 @@ class ConflictFinder {
 // The one-off search leases its thread's idle ConflictFinder (detail/scratch.hpp), so that
 // calls repeated on a thread reuse its buffers instead of faulting in fresh pages (300 to 350
 // bytes an object in 2D, measured); a finder that served more than kLeasedObjects objects is
-// freed at the end of the call instead, so that what a thread keeps stays under about 60 MB.
+// freed at the end of the call instead, so that what a thread keeps stays under about 60 MB
+// (per level of nesting, when visitors search too). The answer and the order of the visits
+// do not depend on the searches before.
 namespace detail {
 inline constexpr std::size_t kLeasedObjects = std::size_t(1) << 17;
 }
