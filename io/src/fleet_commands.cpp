@@ -5,6 +5,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <numbers>
 #include <random>
 
@@ -38,6 +39,15 @@ std::string num(double d) {
 void append_num(std::string& out, double d) {
   char buf[32];
   out.append(buf, std::to_chars(buf, buf + sizeof buf, d).ptr);
+}
+// The numbers joined by commas.
+void append_nums(std::string& out, std::initializer_list<double> values) {
+  const char* sep = "";
+  for (const double v : values) {
+    out += sep;
+    append_num(out, v);
+    sep = ",";
+  }
 }
 void append_id(std::string& out, Id id) {
   char buf[24];
@@ -317,9 +327,7 @@ void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, For
       if (ais) row += "," + format_utc(h.t);
       const Point2 p = shown(l, h.p);
       row += ',';
-      append_num(row, p[0]);
-      row += ',';
-      append_num(row, p[1]);
+      append_nums(row, {p[0], p[1]});
       row += '\n';
       w.row_done();
     }
@@ -341,9 +349,7 @@ void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, For
       append_num(row, h.distance);
     }
     row += "},\"geometry\":{\"type\":\"Point\",\"coordinates\":[";
-    append_num(row, p[0]);
-    row += ',';
-    append_num(row, p[1]);
+    append_nums(row, {p[0], p[1]});
     row += "]}}";
     w.row_done();
   }
@@ -427,23 +433,17 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
         row += "," + fixed(ap.dcpa / kNauticalMile, 4) + "," + format_utc(ap.tcpa) + "," +
                fixed((ap.tcpa - l.now) / 60, 2) + "," + format_utc(ap.t_enter) + "," +
                format_utc(ap.t_exit);
-      for (const double v : {a[0], a[1], b[0], b[1]}) {
-        row += ',';
-        append_num(row, v);
-      }
+      row += ',';
+      append_nums(row, {a[0], a[1], b[0], b[1]});
       row += '\n';
     } else {
       if (ais)
         row += ",\"dcpa_nm\":" + fixed(ap.dcpa / kNauticalMile, 4) + ",\"tcpa_utc\":\"" +
                format_utc(ap.tcpa) + "\",\"tcpa_min\":" + fixed((ap.tcpa - l.now) / 60, 2);
       row += "},\"geometry\":{\"type\":\"LineString\",\"coordinates\":[[";
-      append_num(row, a[0]);
-      row += ',';
-      append_num(row, a[1]);
+      append_nums(row, {a[0], a[1]});
       row += "],[";
-      append_num(row, b[0]);
-      row += ',';
-      append_num(row, b[1]);
+      append_nums(row, {b[0], b[1]});
       row += "]]}}";
     }
     w.row_done();
