@@ -266,12 +266,13 @@ class ConflictFinder {
       for (std::uint32_t k = 0; k < n; ++k) {
         // The reports in proxy order, read in sequence.
         const Box<D> b = detail::grown_sweep(motion_[k], t0, t1, 0.5 * within);
-        if (k < held_)
+        if (k < held_) {
           broad_.move(k, b);
-        else
+        } else {
           broad_.add(k, b);
+          held_ = k + 1;  // counted as added, should a later add throw
+        }
       }
-      held_ = n;
       bool go = true;
       const Id* proxy = nullptr;
       detail::Kinematics<D>* kin = nullptr;
@@ -335,8 +336,6 @@ class ConflictFinder {
   }
 
  private:
-  // Numbers the objects in Hilbert order of their positions at mid-horizon, so that the pairs
-  // the broad phase reports (neighbours in space) read neighbouring memory.
   // Velocities beyond 1e150 (as check_motion refuses them in a report: the relative velocity
   // of two objects could overflow, even over a horizon of 0), then positions that leave
   // +-1e150 over the horizon; every object, however few.
@@ -350,6 +349,8 @@ class ConflictFinder {
     }
   }
 
+  // Numbers the objects in Hilbert order of their positions at mid-horizon, so that the pairs
+  // the broad phase reports (neighbours in space) read neighbouring memory.
   void prepare(std::span<const Motion<D>> objects, double now, double horizon) {
     const std::size_t n = objects.size();
     motion_.resize(n);
