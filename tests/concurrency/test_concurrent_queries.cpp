@@ -14,11 +14,13 @@
 
 #include "loci/index/interval_tree.hpp"
 #include "loci/index/kd_tree.hpp"
+#include "loci/index/moving/conflicts.hpp"
 #include "loci/index/packed_rtree.hpp"
 #include "loci/index/pr_quadtree.hpp"
 #include "loci/index/rstar_tree.hpp"
 #include "loci/index/segment_tree.hpp"
 #include "loci/index/segment_window_tree.hpp"
+#include "support/fleet_data.hpp"
 #include "support/random_data.hpp"
 
 #ifdef LOCI_HAVE_IO
@@ -96,6 +98,38 @@ TEST(ConcurrentQueries, PackedRTreeAndRStarTree) {
   EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return box_query_is_exact(packed, boxes, rng); }),
             0u);
   EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return box_query_is_exact(rstar, boxes, rng); }),
+            0u);
+}
+
+// One-off conflict searches on many threads at once, each thread reusing its own leased
+// finder over fleets of other sizes: every search visits the pairs a search on the main
+// thread visited, in the same order.
+TEST(ConcurrentQueries, ConflictSearchesLeasePerThread) {
+  struct Case {
+    std::vector<Motion2> fleet;
+    double within;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> visits;
+  };
+  auto visits = [](const Case& c) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+    find_conflicts<2>(c.fleet, c.within, 0, 10,
+                      [&](std::uint32_t i, std::uint32_t j, const Approach&) {
+                        out.push_back({i, j});
+                        return true;
+                      });
+    return out;
+  };
+  std::vector<Case> cases;
+  const Fleet kinds[] = {Fleet::uniform, Fleet::clustered, Fleet::identical, Fleet::head_on};
+  for (std::size_t k = 0; k < 4; ++k) {
+    cases.push_back({make_fleet(kinds[k], 300 + 150 * k, 70 + k), k == 2 ? 0.5 : 15.0, {}});
+    cases.back().visits = visits(cases.back());
+    EXPECT_GT(cases.back().visits.size(), 0u) << name(kinds[k]);
+  }
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) {
+              const Case& c = cases[rng() % cases.size()];
+              return visits(c) == c.visits;
+            }),
             0u);
 }
 
