@@ -5,10 +5,10 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
-#include <initializer_list>
 #include <numbers>
 #include <random>
 
+#include "block_writer.hpp"
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/index/moving/conflicts.hpp"
@@ -30,49 +30,10 @@ constexpr double kKnot = kNauticalMile / 3600.0;
 
 // The shortest text that reads back as the same double.
 std::string num(double d) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, d);
-  return std::string(buf, r.ptr);
+  std::string s;
+  detail::append_num(s, d);
+  return s;
 }
-
-// num(d) and an id appended to `out` without a string of their own: rows of big answers.
-void append_num(std::string& out, double d) {
-  char buf[32];
-  out.append(buf, std::to_chars(buf, buf + sizeof buf, d).ptr);
-}
-// The numbers joined by commas.
-void append_nums(std::string& out, std::initializer_list<double> values) {
-  const char* sep = "";
-  for (const double v : values) {
-    out += sep;
-    append_num(out, v);
-    sep = ",";
-  }
-}
-void append_id(std::string& out, Id id) {
-  char buf[24];
-  out.append(buf, std::to_chars(buf, buf + sizeof buf, id).ptr);
-}
-
-// Rows gathered into blocks of about 64 KB, each written at once; flush() writes the last.
-class BlockWriter {
- public:
-  explicit BlockWriter(std::FILE* f) : f_(f) { buf_.reserve(kBlock + 1024); }
-  std::string& buf() { return buf_; }
-  // After each row: writes the block once it is full.
-  void row_done() {
-    if (buf_.size() >= kBlock) flush();
-  }
-  void flush() {
-    std::fwrite(buf_.data(), 1, buf_.size(), f_);
-    buf_.clear();
-  }
-
- private:
-  static constexpr std::size_t kBlock = std::size_t(1) << 16;
-  std::FILE* f_;
-  std::string buf_;
-};
 
 std::string fixed(double d, int decimals) {
   char buf[48];
@@ -300,11 +261,11 @@ Point2 shown(const Loaded& l, const Point2& p) {
 void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, Format format,
                 std::FILE* out) {
   const bool ais = l.ais();
-  BlockWriter w(out);
+  detail::BlockWriter w(out);
   std::string& row = w.buf();
   if (format == Format::ids) {
     for (const Hit& h : hits) {
-      append_id(row, h.id);
+      detail::append_int(row, h.id);
       row += '\n';
       w.row_done();
     }
@@ -316,18 +277,18 @@ void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, For
     if (nearest && ais) row += ",distance_nm";
     row += ais ? ",t,time_utc,lon,lat\n" : ",t,x,y\n";
     for (const Hit& h : hits) {
-      append_id(row, h.id);
+      detail::append_int(row, h.id);
       if (nearest) {
         row += ',';
-        append_num(row, h.distance);
+        detail::append_num(row, h.distance);
       }
       if (nearest && ais) row += "," + fixed(h.distance / kNauticalMile, 4);
       row += ',';
-      append_num(row, h.t);
+      detail::append_num(row, h.t);
       if (ais) row += "," + format_utc(h.t);
       const Point2 p = shown(l, h.p);
       row += ',';
-      append_nums(row, {p[0], p[1]});
+      detail::append_nums(row, {p[0], p[1]});
       row += '\n';
       w.row_done();
     }
@@ -340,16 +301,16 @@ void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, For
     const Point2 p = shown(l, h.p);
     row += i ? ",\n{\"type\":\"Feature\",\"properties\":{\"id\":"
              : "\n{\"type\":\"Feature\",\"properties\":{\"id\":";
-    append_id(row, h.id);
+    detail::append_int(row, h.id);
     row += ",\"t\":";
-    append_num(row, h.t);
+    detail::append_num(row, h.t);
     if (ais) row += ",\"time_utc\":\"" + format_utc(h.t) + "\"";
     if (nearest) {
       row += ",\"distance\":";
-      append_num(row, h.distance);
+      detail::append_num(row, h.distance);
     }
     row += "},\"geometry\":{\"type\":\"Point\",\"coordinates\":[";
-    append_nums(row, {p[0], p[1]});
+    detail::append_nums(row, {p[0], p[1]});
     row += "]}}";
     w.row_done();
   }
@@ -400,33 +361,32 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   const bool ais = l.ais();
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
-  if (o.format == Format::csv) {
-    std::fprintf(f, "id_a,id_b,tcpa,dcpa,t_enter,t_exit%s\n",
-                 ais ? ",dcpa_nm,tcpa_utc,tcpa_min,t_enter_utc,t_exit_utc,lon_a,lat_a,lon_b,lat_b"
-                     : ",x_a,y_a,x_b,y_b");
-  } else {
-    std::fprintf(f, "{\"type\":\"FeatureCollection\",\"features\":[");
-  }
-  BlockWriter w(f);
+  const bool csv = o.format == Format::csv;
+  detail::BlockWriter w(f);
   std::string& row = w.buf();
+  if (csv)
+    row += ais ? "id_a,id_b,tcpa,dcpa,t_enter,t_exit,dcpa_nm,tcpa_utc,tcpa_min,t_enter_utc,"
+                 "t_exit_utc,lon_a,lat_a,lon_b,lat_b\n"
+               : "id_a,id_b,tcpa,dcpa,t_enter,t_exit,x_a,y_a,x_b,y_b\n";
+  else
+    row += "{\"type\":\"FeatureCollection\",\"features\":[";
   for (std::size_t i = 0; i < found.size(); ++i) {
     const Conflict& c = found[i];
     const Approach& ap = c.approach;
     const Point2 a = shown(l, position(motion_of(c.a), ap.tcpa));
     const Point2 b = shown(l, position(motion_of(c.b), ap.tcpa));
-    const bool csv = o.format == Format::csv;
     if (!csv)
       row += i ? ",\n{\"type\":\"Feature\",\"properties\":{"
                : "\n{\"type\":\"Feature\",\"properties\":{";
     row += csv ? "" : "\"id_a\":";
-    append_id(row, c.a);
+    detail::append_int(row, c.a);
     row += csv ? "," : ",\"id_b\":";
-    append_id(row, c.b);
+    detail::append_int(row, c.b);
     const char* const names[] = {",\"tcpa\":", ",\"dcpa\":", ",\"t_enter\":", ",\"t_exit\":"};
     const double values[] = {ap.tcpa, ap.dcpa, ap.t_enter, ap.t_exit};
     for (int k = 0; k < 4; ++k) {
       row += csv ? "," : names[k];
-      append_num(row, values[k]);
+      detail::append_num(row, values[k]);
     }
     if (csv) {
       if (ais)
@@ -434,22 +394,22 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
                fixed((ap.tcpa - l.now) / 60, 2) + "," + format_utc(ap.t_enter) + "," +
                format_utc(ap.t_exit);
       row += ',';
-      append_nums(row, {a[0], a[1], b[0], b[1]});
+      detail::append_nums(row, {a[0], a[1], b[0], b[1]});
       row += '\n';
     } else {
       if (ais)
         row += ",\"dcpa_nm\":" + fixed(ap.dcpa / kNauticalMile, 4) + ",\"tcpa_utc\":\"" +
                format_utc(ap.tcpa) + "\",\"tcpa_min\":" + fixed((ap.tcpa - l.now) / 60, 2);
       row += "},\"geometry\":{\"type\":\"LineString\",\"coordinates\":[[";
-      append_nums(row, {a[0], a[1]});
+      detail::append_nums(row, {a[0], a[1]});
       row += "],[";
-      append_nums(row, {b[0], b[1]});
+      detail::append_nums(row, {b[0], b[1]});
       row += "]]}}";
     }
     w.row_done();
   }
+  if (!csv) row += "\n]}\n";
   w.flush();
-  if (o.format == Format::geojson) std::fprintf(f, "\n]}\n");
   out.commit();
   FleetRun r = run_of(l);
   r.answers = found.size();

@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "block_writer.hpp"
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "shapefile_polygons.hpp"
@@ -82,25 +83,18 @@ class AnswerFeatures {
 
 // The rows formatted into a buffer written in blocks (a batch has millions of rows).
 void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
-  constexpr std::size_t kBlock = 1 << 16;
-  std::string buf;
-  buf.reserve(kBlock + 64);
+  detail::BlockWriter w(out);
+  std::string& row = w.buf();
   for (const auto& a : answers) {
-    char row[64];  // two 20-digit numbers, a space and a newline
-    char* at = row;
     if (numbered) {
-      at = std::to_chars(at, row + 21, a.query).ptr;
-      *at++ = ' ';
+      detail::append_int(row, a.query);
+      row += ' ';
     }
-    at = std::to_chars(at, at + 21, a.fid).ptr;
-    *at++ = '\n';
-    buf.append(row, at);
-    if (buf.size() >= kBlock) {
-      std::fwrite(buf.data(), 1, buf.size(), out);
-      buf.clear();
-    }
+    detail::append_int(row, a.fid);
+    row += '\n';
+    w.row_done();
   }
-  std::fwrite(buf.data(), 1, buf.size(), out);
+  w.flush();
 }
 
 void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
