@@ -435,6 +435,10 @@ std::vector<Conflict> find_conflicts(std::span<const Id> ids, std::span<const Mo
 // searched. Objects that reported since b have stale boxes in the packed tree, which queries
 // skip; their current boxes are packed afresh into a small tree at each refresh, which
 // queries look at too. Once now passes b + slack, refresh computes everything again from now.
+// Each tree entry carries the object's position at b and velocity, the entries in Hilbert
+// order of their boxes, so that a query reads its candidates' motions from the leaf's
+// neighbourhood rather than from wherever their slots lie; a candidate gets the quick test
+// of find_conflicts (clearly_apart) before the exact one.
 //
 // conflicts(visit) then reports, from the kept pairs, those within D during [now, now + H]
 // without computing them again: the distance of two linear motions is convex in time, so
@@ -525,7 +529,11 @@ class ConflictMonitor {
       forgotten_ += degree_[s];
       degree_[s] = 0;
       dirty_[s] = 0;
-      if (!moved_[s]) moved_[s] = 1, recent_.push_back(s);
+      if (!moved_[s]) {
+        moved_[s] = 1;
+        recent_.push_back(s);
+        if (s < entry_of_.size() && entry_of_[s] != kNone) packed_entry_[entry_of_[s]].stale = 1;
+      }
       if (!alive_[s]) {
         free_.push_back(s);
         continue;
@@ -535,33 +543,35 @@ class ConflictMonitor {
     }
     if (forgotten_ > kept_.size() / 4) sweep();
     // The objects that reported since the base, in a small packed tree made afresh.
-    recent_live_.clear();
+    recent_entry_.clear();
     std::vector<Box<D>> boxes;
     for (std::uint32_t s : recent_)
       if (alive_[s]) {
-        recent_live_.push_back(s);
+        recent_entry_.push_back({at_base_[s], s});
         boxes.push_back(detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_));
       }
     recent_tree_ = PackedRTree<D>::build(boxes);
+    const double span = t1 - base_, keep2 = keep_ * keep_;
     for (std::uint32_t s : dirty_list_) {
       if (!alive_[s]) continue;
+      const detail::Kinematics<D>& x = at_base_[s];
       const Box<D> b = detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_);
-      auto candidate = [&](std::uint32_t t) {
+      auto candidate = [&](const Entry& e) {
         // A pair of two reporting objects is taken from the first of them looked at.
-        if (t == s || dirty_seen_[t]) return true;
-        // comes_within(motion_[s], motion_[t], base_, t1 - base_, keep_), from the positions
-        // at the base kept for every object
-        const detail::Kinematics<D>& x = at_base_[s];
-        const detail::Kinematics<D>& y = at_base_[t];
-        if (detail::closest_at(x.p, x.v, y.p, y.v, t1 - base_).dcpa <= keep_) keep(s, t);
+        if (e.slot == s || dirty_seen_[e.slot]) return true;
+        // comes_within(motion_[s], motion_[t], base_, span, keep_), from the positions at the
+        // base; the quick test first drops the pairs clearly beyond.
+        if (detail::clearly_apart(x, e.at, keep2, span)) return true;
+        if (detail::closest_at(x.p, x.v, e.at.p, e.at.v, span).dcpa <= keep_)
+          keep(s, e.slot, x, e.at);
         return true;
       };
       st += packed_.query(b, [&](Id k, const Box<D>&) {
-        // Boxes of objects that reported since the base are stale here.
-        const std::uint32_t other = packed_slot_[k];
-        return moved_[other] ? true : candidate(other);
+        // Entries of objects that reported since the base are stale.
+        const Entry& e = packed_entry_[k];
+        return e.stale ? true : candidate(e);
       });
-      st += recent_tree_.query(b, [&](Id e, const Box<D>&) { return candidate(recent_live_[e]); });
+      st += recent_tree_.query(b, [&](Id k, const Box<D>&) { return candidate(recent_entry_[k]); });
       dirty_seen_[s] = 1;
     }
     for (std::uint32_t s : dirty_list_)
@@ -618,6 +628,12 @@ class ConflictMonitor {
     std::uint32_t s, t, vs, vt;
     double tcpa, dcpa, t_enter, t_exit;
   };
+  // An object in a packed tree: its kinematics at the base, its slot, and whether it has
+  // reported since (its box stale).
+  struct Entry {
+    detail::Kinematics<D> at;
+    std::uint32_t slot, stale;
+  };
 
   void mark(std::uint32_t s) {
     ++version_[s];
@@ -635,9 +651,12 @@ class ConflictMonitor {
     keep_ = within_ * (1 + 1e-9) + 1e-9 * scale_;
     margin_ = 0.5 * (keep_ - within_);
   }
-  void keep(std::uint32_t s, std::uint32_t t) {
+  // Keeps the pair of slots s and t, x and y their kinematics at the base (at_base_).
+  void keep(std::uint32_t s, std::uint32_t t, const detail::Kinematics<D>& x,
+            const detail::Kinematics<D>& y) {
     Kept k{s, t, version_[s], version_[t], 0, std::numeric_limits<double>::infinity(), 0, 0};
-    if (auto ap = closest_approach(motion_[s], motion_[t], base_, horizon_ + slack_, within_))
+    // closest_approach(motion_[s], motion_[t], base_, horizon_ + slack_, within_)
+    if (auto ap = closest_approach_at(x.p, x.v, y.p, y.v, base_, horizon_ + slack_, within_))
       k.tcpa = ap->tcpa, k.dcpa = ap->dcpa, k.t_enter = ap->t_enter, k.t_exit = ap->t_exit;
     kept_.push_back(k);
     ++degree_[s];
@@ -685,18 +704,37 @@ class ConflictMonitor {
       at_base_[s] = {position(motion_[s], now), motion_[s].v};
       widen(motion_[s], span);
     }
-    // The packed tree names entries by their index in `boxes`, packed_slot_ maps it back.
-    std::vector<Box<D>> boxes;
-    boxes.reserve(live.size());
-    for (std::uint32_t s : live)
-      boxes.push_back(detail::grown_sweep(motion_[s], now, now + span, 0.5 * keep_));
-    packed_ = PackedRTree<D>::build(boxes);
-    packed_slot_ = live;
-    const QueryStats st = finder_.find(std::span<const Motion<D>>(dense), keep_, now, span,
-                                       [&](std::uint32_t i, std::uint32_t j, const Approach&) {
-                                         keep(live[i], live[j]);
-                                         return true;
-                                       });
+    // The packed tree's entries in Hilbert order of their boxes' centres (the order it packs
+    // them in), so that the entries of a leaf, and the records of the candidates a query
+    // reads, lie side by side.
+    {
+      std::vector<Box<D>> grown(live.size()), boxes(live.size());
+      Box<D> centres = Box<D>::empty();
+      for (std::size_t e = 0; e < live.size(); ++e) {
+        grown[e] = detail::grown_sweep(motion_[live[e]], now, now + span, 0.5 * keep_);
+        centres.expand(grown[e].center());
+      }
+      const detail::HilbertGrid<D> hilbert(centres);
+      std::vector<detail::KeyedIndex> keyed(live.size());
+      for (std::size_t e = 0; e < live.size(); ++e)
+        keyed[e] = {hilbert.key(grown[e].center()), std::uint32_t(e)};
+      detail::radix_sort(keyed, D * detail::hilbert_bits<D>());
+      packed_entry_.resize(live.size());
+      entry_of_.assign(ids_.size(), kNone);
+      for (std::size_t k = 0; k < keyed.size(); ++k) {
+        const std::uint32_t s = live[keyed[k].index];
+        boxes[k] = grown[keyed[k].index];
+        packed_entry_[k] = {at_base_[s], s, 0};
+        entry_of_[s] = std::uint32_t(k);
+      }
+      packed_ = PackedRTree<D>::build(boxes);
+    }
+    const QueryStats st =
+        finder_.find(std::span<const Motion<D>>(dense), keep_, now, span,
+                     [&](std::uint32_t i, std::uint32_t j, const Approach&) {
+                       keep(live[i], live[j], at_base_[live[i]], at_base_[live[j]]);
+                       return true;
+                     });
     // Room for the pairs refreshes add before the next sweep, so that the table is not moved
     // (and its pages faulted in again) in the middle of a stream.
     kept_.reserve(kept_.size() + kept_.size() / 2 + 1024);
@@ -718,11 +756,12 @@ class ConflictMonitor {
   std::size_t forgotten_ = 0;  // kept pairs whose versions no longer match, at most
   detail::IdMap slots_;
   std::size_t count_ = 0;
-  PackedRTree<D> packed_;                   // grown swept boxes at the base
-  std::vector<std::uint32_t> packed_slot_;  // slot of each entry of packed_
-  std::vector<std::uint32_t> recent_;       // objects that reported since the base, by slot
-  std::vector<std::uint32_t> recent_live_;  // those alive, by entry of recent_tree_
-  PackedRTree<D> recent_tree_;              // their grown swept boxes
+  PackedRTree<D> packed_;                    // grown swept boxes at the base
+  detail::LargeVector<Entry> packed_entry_;  // by entry of packed_
+  std::vector<std::uint32_t> entry_of_;      // by slot: its entry of packed_, or kNone
+  std::vector<std::uint32_t> recent_;        // objects that reported since the base, by slot
+  std::vector<Entry> recent_entry_;          // those alive, by entry of recent_tree_
+  PackedRTree<D> recent_tree_;               // their grown swept boxes
   ConflictFinder<D> finder_;
 };
 
