@@ -587,19 +587,18 @@ class ConflictMonitor {
     const double lo = within_ - margin_, hi = within_ + margin_;
     for (const Kept& k : kept_) {
       if (version_[k.s] != k.vs || version_[k.t] != k.vt) continue;  // forgotten
-      const bool st = ids_[k.s] < ids_[k.t];
-      const Motion<D>& a = motion_[st ? k.s : k.t];
-      const Motion<D>& b = motion_[st ? k.t : k.s];
       std::optional<Approach> ap;
       if (k.dcpa <= within_) {
         // Least distance over the window: at the span's closest approach clamped to it.
         const double tc = std::clamp(k.tcpa, now_, end);
         double d = k.dcpa;
         if (tc != k.tcpa) {
-          const Point<D> pa = position(a, tc), pb = position(b, tc);
+          // From the pair's relative motion, kept with it (the reports are not looked up).
           double dd = 0;
-          for (int i = 0; i < D; ++i)
-            dd += (pb[i] - pa[i]) * (pb[i] - pa[i]);
+          for (int a = 0; a < D; ++a) {
+            const double c = k.d[a] + k.w[a] * (tc - base_);
+            dd += c * c;
+          }
           d = std::sqrt(dd);
         }
         if (d > hi) continue;
@@ -608,10 +607,12 @@ class ConflictMonitor {
                         std::max(std::min(k.t_exit, end), tc)};
       }
       if (!ap) {  // within rounding of D (or kept within keep_ only): decided as from scratch
-        ap = closest_approach(a, b, now_, horizon_, within_);
+        const bool st = ids_[k.s] < ids_[k.t];
+        ap = closest_approach(motion_[st ? k.s : k.t], motion_[st ? k.t : k.s], now_, horizon_,
+                              within_);
         if (!ap) continue;
       }
-      if (!visit(ids_[st ? k.s : k.t], ids_[st ? k.t : k.s], *ap)) return;
+      if (!visit(k.a, k.b, *ap)) return;
     }
   }
   std::vector<Conflict> conflicts() const {
@@ -622,11 +623,15 @@ class ConflictMonitor {
   }
 
  private:
-  // A kept pair, by slots, with the versions of their reports when it was found and its
-  // closest approach within D over the span (dcpa = infinity when it comes within keep_ only).
+  // A kept pair, by slots, with the versions of their reports when it was found, its ids, its
+  // closest approach within D over the span (dcpa = infinity when it comes within keep_ only)
+  // and its relative motion: conflicts() reads the pairs in sequence and looks nothing up but
+  // the versions (and the reports of a pair within rounding of D).
   struct Kept {
     std::uint32_t s, t, vs, vt;
+    Id a, b;  // the ids of s and t, a < b
     double tcpa, dcpa, t_enter, t_exit;
+    Point<D> d, w;  // t's position at the base and velocity less s's
   };
   // An object in a packed tree: its kinematics at the base, its slot, and whether it has
   // reported since (its box stale).
@@ -654,10 +659,15 @@ class ConflictMonitor {
   // Keeps the pair of slots s and t, x and y their kinematics at the base (at_base_).
   void keep(std::uint32_t s, std::uint32_t t, const detail::Kinematics<D>& x,
             const detail::Kinematics<D>& y) {
-    Kept k{s, t, version_[s], version_[t], 0, std::numeric_limits<double>::infinity(), 0, 0};
+    Kept k{};
+    k.s = s, k.t = t, k.vs = version_[s], k.vt = version_[t];
+    k.a = std::min(ids_[s], ids_[t]), k.b = std::max(ids_[s], ids_[t]);
+    k.dcpa = std::numeric_limits<double>::infinity();
     // closest_approach(motion_[s], motion_[t], base_, horizon_ + slack_, within_)
     if (auto ap = closest_approach_at(x.p, x.v, y.p, y.v, base_, horizon_ + slack_, within_))
       k.tcpa = ap->tcpa, k.dcpa = ap->dcpa, k.t_enter = ap->t_enter, k.t_exit = ap->t_exit;
+    for (int a = 0; a < D; ++a)
+      k.d[a] = y.p[a] - x.p[a], k.w[a] = y.v[a] - x.v[a];
     kept_.push_back(k);
     ++degree_[s];
     ++degree_[t];
