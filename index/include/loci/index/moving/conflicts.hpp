@@ -556,22 +556,37 @@ class ConflictMonitor {
       if (!alive_[s]) continue;
       const detail::Kinematics<D>& x = at_base_[s];
       const Box<D> b = detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_);
-      auto candidate = [&](const Entry& e) {
-        // A pair of two reporting objects is taken from the first of them looked at.
-        if (e.slot == s || dirty_seen_[e.slot]) return true;
-        // comes_within(motion_[s], motion_[t], base_, span, keep_), from the positions at the
-        // base; the quick test first drops the pairs clearly beyond.
-        if (detail::clearly_apart(x, e.at, keep2, span)) return true;
-        if (detail::closest_at(x.p, x.v, e.at.p, e.at.v, span).dcpa <= keep_)
-          keep(s, e.slot, x, e.at);
-        return true;
-      };
+      // The candidates of both trees are gathered, then given the quick test two at a time.
+      near_.clear();
       st += packed_.query(b, [&](Id k, const Box<D>&) {
         // Entries of objects that reported since the base are stale.
         const Entry& e = packed_entry_[k];
-        return e.stale ? true : candidate(e);
+        if (!e.stale && e.slot != s) near_.push_back(&e);
+        return true;
       });
-      st += recent_tree_.query(b, [&](Id k, const Box<D>&) { return candidate(recent_entry_[k]); });
+      st += recent_tree_.query(b, [&](Id k, const Box<D>&) {
+        const Entry& e = recent_entry_[k];
+        if (e.slot != s) near_.push_back(&e);
+        return true;
+      });
+      // comes_within(motion_[s], motion_[t], base_, span, keep_), from the positions at the
+      // base; the quick test first drops the pairs clearly beyond.
+      auto exact = [&](const Entry& e) {
+        // A pair of two reporting objects is taken from the first of them looked at.
+        if (dirty_seen_[e.slot]) return;
+        if (detail::closest_at(x.p, x.v, e.at.p, e.at.v, span).dcpa <= keep_)
+          keep(s, e.slot, x, e.at);
+      };
+      std::size_t h = 0;
+#if defined(__SSE2__)
+      for (; h + 2 <= near_.size(); h += 2) {
+        const int apart = detail::clearly_apart2(x, near_[h]->at, near_[h + 1]->at, keep2, span);
+        if (!(apart & 1)) exact(*near_[h]);
+        if (!(apart & 2)) exact(*near_[h + 1]);
+      }
+#endif
+      for (; h < near_.size(); ++h)
+        if (!detail::clearly_apart(x, near_[h]->at, keep2, span)) exact(*near_[h]);
       dirty_seen_[s] = 1;
     }
     for (std::uint32_t s : dirty_list_)
@@ -771,6 +786,7 @@ class ConflictMonitor {
   std::vector<std::uint32_t> entry_of_;      // by slot: its entry of packed_, or kNone
   std::vector<std::uint32_t> recent_;        // objects that reported since the base, by slot
   std::vector<Entry> recent_entry_;          // those alive, by entry of recent_tree_
+  std::vector<const Entry*> near_;           // a query's candidates
   PackedRTree<D> recent_tree_;               // their grown swept boxes
   ConflictFinder<D> finder_;
 };
