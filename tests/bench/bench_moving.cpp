@@ -455,12 +455,14 @@ void run_conflicts(const Options& o) {
              {now, loci::position(fleet[i], now), {v[0] * c - v[1] * sn, v[0] * sn + v[1] * c}}});
       }
     inc.clear();
+    const std::size_t full_before = monitor.full_computations();
+    double tr = 0;
     const double ti = [&] {
       const auto t0 = Clock::now();
       for (const auto& [i, m] : batch)
         monitor.report(i, m);
       monitor.refresh(now);
-      refresh_s.push_back(seconds_since(t0));
+      tr = seconds_since(t0);
       inc.reserve(answer + answer / 8);
       monitor.conflicts([&](Id a, Id b, const loci::Approach& ap) {
         inc.push_back({a, b, ap});
@@ -507,7 +509,8 @@ void run_conflicts(const Options& o) {
       std::exit(1);
     }
     answer = full.size();
-    if (tick % 6 != 0) inc_s.push_back(ti);  // ticks that refresh incrementally
+    // The ticks that refresh incrementally (not the first, nor those past the slack).
+    if (monitor.full_computations() == full_before) inc_s.push_back(ti), refresh_s.push_back(tr);
     full_s.push_back(tf);
   }
   std::printf(

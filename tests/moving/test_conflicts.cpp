@@ -508,5 +508,45 @@ TEST(ConflictMonitor, MatchesComputationFromScratch) {
   }
 }
 
+// At epoch-second times now + H rounds to a step of 2^-22 s; a pair that comes within D in the
+// last instants of the window is still found, by the search and by the monitor, as
+// closest_approach (which measures the window from now) decides it. One vessel lies still,
+// the other closes on it at 20 units a second and reaches D within a few steps of the
+// window's end, on either side of it.
+TEST(ConflictMonitor, WindowEndsAtEpochSecondsAsClosestApproachDecides) {
+  const double within = 12, slack = 5;
+  int found = 0, tried = 0;
+  for (double horizon : {30.1, 0.3}) {
+    for (int f = 0; f < 6; ++f) {
+      const double base = 1.7e9 + 0.0371 * f;
+      for (double step : {1.0, 0.7, 3.3}) {
+        const double now = base + step;
+        for (int k = -30; k <= 30; ++k) {
+          const double x = within + 20 * (step + horizon) + k * 1e-7;
+          const Motion2 a{base, {0, 0}, {0, 0}}, b{base, {x, 0}, {-20, 0}};
+          const bool want = closest_approach(a, b, now, horizon, within).has_value();
+          ConflictMonitor<2> monitor(within, horizon, slack);
+          monitor.report(1, a);
+          monitor.report(2, b);
+          monitor.refresh(base);
+          monitor.refresh(now);
+          const std::vector<Id> ids{1, 2};
+          const std::vector<Motion2> objects{a, b};
+          const std::string at = "horizon " + std::to_string(horizon) + " step " +
+                                 std::to_string(step) + " offset " + std::to_string(k);
+          EXPECT_EQ(find_conflicts<2>(ids, objects, within, now, horizon).size(), want ? 1u : 0u)
+              << at;
+          EXPECT_EQ(monitor.conflicts().size(), want ? 1u : 0u) << at;
+          found += want;
+          ++tried;
+        }
+      }
+    }
+  }
+  // Both sides of the window's end were tried.
+  EXPECT_GT(found, 0);
+  EXPECT_LT(found, tried);
+}
+
 }  // namespace
 }  // namespace loci

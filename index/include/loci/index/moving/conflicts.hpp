@@ -19,7 +19,8 @@
 // that holds its entry time t_enter only, so pairs found in several slices are reported once
 // without a set of seen pairs; at its entry time the pair is within D, so that slice's boxes
 // meet and the pair is not missed. Boxes are grown by a hair more than D/2 so that rounding in
-// the positions cannot lose a pair that touches the D-circle.
+// the positions cannot lose a pair that touches the D-circle, and the last slice ends at
+// now + H rounded up (window_end), so that rounding in the time cannot either.
 //
 // More slices mean smaller boxes (fewer candidates) but one more sort per slice; slices = 0
 // picks the count from a cost model of the two (auto_slices), at most 16.
@@ -91,6 +92,14 @@ Box<D> grown_sweep(const Motion<D>& m, double t0, double t1, double grow) {
     box.max[i] += pad;
   }
   return box;
+}
+
+// start + length rounded up, never below the exact sum: at epoch-second times the sum rounds
+// to a step of 2^-22 s, and a box swept to a rounded-down end would leave out the last
+// instants of the window that closest_approach, measuring time from start, still searches.
+inline double window_end(double start, double length) {
+  const double t = start + length;
+  return t - start < length ? std::nextafter(t, std::numeric_limits<double>::infinity()) : t;
 }
 
 // The slice count that minimizes a cost model of the broad phase: each slice sorts every
@@ -262,7 +271,8 @@ class ConflictFinder {
     const double step = horizon / double(slices);
     for (std::size_t s = 0; s < slices; ++s) {
       const double t0 = now + step * double(s);
-      const double t1 = s + 1 == slices ? now + horizon : now + step * double(s + 1);
+      const double t1 =
+          s + 1 == slices ? detail::window_end(now, horizon) : now + step * double(s + 1);
       for (std::uint32_t k = 0; k < n; ++k) {
         // The reports in proxy order, read in sequence.
         const Box<D> b = detail::grown_sweep(motion_[k], t0, t1, 0.5 * within);
@@ -435,10 +445,12 @@ std::vector<Conflict> find_conflicts(std::span<const Id> ids, std::span<const Mo
 // searched. Objects that reported since b have stale boxes in the packed tree, which queries
 // skip; their current boxes are packed afresh into a small tree at each refresh, which
 // queries look at too. Once now passes b + slack, refresh computes everything again from now.
-// Each tree entry carries the object's position at b and velocity, the entries in Hilbert
-// order of their boxes, so that a query reads its candidates' motions from the leaf's
-// neighbourhood rather than from wherever their slots lie; a candidate gets the quick test
-// of find_conflicts (clearly_apart) before the exact one.
+// Each tree entry carries the object's position at b and velocity (the packed tree's entries
+// in Hilbert order of their boxes), so that a query reads its candidates' motions from the
+// leaf's neighbourhood rather than from wherever their slots lie; a candidate gets the quick
+// test of find_conflicts (clearly_apart) before the exact one. Times within the span are
+// kept from b, so that at epoch-second times the window's end is not rounded to the clock's
+// step (2^-22 s near 1.7e9) where closest_approach, measuring from now, does not round it.
 //
 // conflicts(visit) then reports, from the kept pairs, those within D during [now, now + H]
 // without computing them again: the distance of two linear motions is convex in time, so
@@ -514,7 +526,7 @@ class ConflictMonitor {
   QueryStats refresh(double now) {
     if (!std::isfinite(now)) throw InvalidArgument("conflict time is NaN or infinite");
     if (!computed_ || now < base_ || now > base_ + slack_) return recompute(now);
-    const double t1 = base_ + horizon_ + slack_;
+    const double t1 = detail::window_end(base_, horizon_ + slack_);
     // Every new report is checked before anything changes.
     for (std::uint32_t s : dirty_list_)
       if (alive_[s] && !detail::stays_in_range(motion_[s], base_, t1))
@@ -599,19 +611,23 @@ class ConflictMonitor {
   template <class F>
   void conflicts(F&& visit) const {
     const double end = now_ + horizon_;
+    // The window in time from the base, where its end is not rounded to the step of
+    // epoch-second times (2^-22 s near 1.7e9), as closest_approach measures it from now.
+    const double from = now_ - base_, to = from + horizon_;
     const double lo = within_ - margin_, hi = within_ + margin_;
     for (const Kept& k : kept_) {
       if (version_[k.s] != k.vs || version_[k.t] != k.vt) continue;  // forgotten
       std::optional<Approach> ap;
       if (k.dcpa <= within_) {
         // Least distance over the window: at the span's closest approach clamped to it.
-        const double tc = std::clamp(k.tcpa, now_, end);
+        const double u = std::clamp(k.u, from, to);
+        const double tc = base_ + u;
         double d = k.dcpa;
-        if (tc != k.tcpa) {
+        if (u != k.u) {
           // From the pair's relative motion, kept with it (the reports are not looked up).
           double dd = 0;
           for (int a = 0; a < D; ++a) {
-            const double c = k.d[a] + k.w[a] * (tc - base_);
+            const double c = k.d[a] + k.w[a] * u;
             dd += c * c;
           }
           d = std::sqrt(dd);
@@ -644,8 +660,9 @@ class ConflictMonitor {
   // the versions (and the reports of a pair within rounding of D).
   struct Kept {
     std::uint32_t s, t, vs, vt;
-    Id a, b;  // the ids of s and t, a < b
-    double tcpa, dcpa, t_enter, t_exit;
+    Id a, b;   // the ids of s and t, a < b
+    double u;  // the time of closest approach over the span, from the base
+    double dcpa, t_enter, t_exit;
     Point<D> d, w;  // t's position at the base and velocity less s's
   };
   // An object in a packed tree: its kinematics at the base, its slot, and whether it has
@@ -678,9 +695,11 @@ class ConflictMonitor {
     k.s = s, k.t = t, k.vs = version_[s], k.vt = version_[t];
     k.a = std::min(ids_[s], ids_[t]), k.b = std::max(ids_[s], ids_[t]);
     k.dcpa = std::numeric_limits<double>::infinity();
-    // closest_approach(motion_[s], motion_[t], base_, horizon_ + slack_, within_)
-    if (auto ap = closest_approach_at(x.p, x.v, y.p, y.v, base_, horizon_ + slack_, within_))
-      k.tcpa = ap->tcpa, k.dcpa = ap->dcpa, k.t_enter = ap->t_enter, k.t_exit = ap->t_exit;
+    // closest_approach(motion_[s], motion_[t], base_, horizon_ + slack_, within_), its times
+    // from the base
+    if (auto ap = closest_approach_at(x.p, x.v, y.p, y.v, 0.0, horizon_ + slack_, within_))
+      k.u = ap->tcpa, k.dcpa = ap->dcpa, k.t_enter = base_ + ap->t_enter,
+      k.t_exit = base_ + ap->t_exit;
     for (int a = 0; a < D; ++a)
       k.d[a] = y.p[a] - x.p[a], k.w[a] = y.v[a] - x.v[a];
     kept_.push_back(k);
@@ -736,7 +755,8 @@ class ConflictMonitor {
       std::vector<Box<D>> grown(live.size()), boxes(live.size());
       Box<D> centres = Box<D>::empty();
       for (std::size_t e = 0; e < live.size(); ++e) {
-        grown[e] = detail::grown_sweep(motion_[live[e]], now, now + span, 0.5 * keep_);
+        grown[e] =
+            detail::grown_sweep(motion_[live[e]], now, detail::window_end(now, span), 0.5 * keep_);
         centres.expand(grown[e].center());
       }
       const detail::HilbertGrid<D> hilbert(centres);
@@ -774,9 +794,9 @@ class ConflictMonitor {
   std::vector<Motion<D>> motion_;
   std::vector<std::uint8_t> alive_, dirty_, dirty_seen_, moved_;
   std::vector<std::uint32_t> dirty_list_, free_;
-  std::vector<std::uint32_t> version_;          // reports and removals of each slot, counted
-  std::vector<std::uint32_t> degree_;           // kept pairs of each slot since the last sweep
-  detail::LargeVector<Kept> kept_;              // on huge pages: tens of megabytes in a dense fleet
+  std::vector<std::uint32_t> version_;  // reports and removals of each slot, counted
+  std::vector<std::uint32_t> degree_;   // kept pairs of each slot since the last sweep
+  detail::LargeVector<Kept> kept_;      // on huge pages: 96 bytes a pair in 2D, tens of megabytes
   std::vector<detail::Kinematics<D>> at_base_;  // by slot
   std::size_t forgotten_ = 0;  // kept pairs whose versions no longer match, at most
   detail::IdMap slots_;
