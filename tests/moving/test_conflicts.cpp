@@ -548,5 +548,50 @@ TEST(ConflictMonitor, WindowEndsAtEpochSecondsAsClosestApproachDecides) {
   EXPECT_LT(found, tried);
 }
 
+// The times the monitor reports lie in [now, now + H] and equal the window's ends where they
+// are clamped, as a computation from scratch gives them, also where the span's times, kept
+// from an earlier base, do not add back to now exactly (a clock of tenths of a second, a
+// base below 0 and now above it).
+TEST(ConflictMonitor, ClampedTimesAreTheWindowsEnds) {
+  struct Case {
+    double base, now, slack;
+    Motion2 a, b;
+  };
+  const double base1 = 147 * 0.1, now1 = base1 + 22 * 0.1;
+  const double base2 = -0x1.1c7ec10e745e1p+2, now2 = 0x1.dc02a09dd4a7bp+1;
+  const Case cases[] = {
+      // Closest approach long after the window: tcpa and t_exit are now + H.
+      {base1, now1, 5, {base1, {0, 0}, {0, 0}}, {base1, {11.5, 0}, {-1e-3, 0}}},
+      // At rest within D: tcpa and t_enter are now.
+      {base2, now2, 10, {-4, {0, 0}, {0, 0}}, {-4, {5, 0}, {0, 0}}},
+      {-3.3, 0.5000002, 5, {-3.3, {0, 0}, {0, 0}}, {-3.3, {5, 0}, {0, 0}}},
+  };
+  const double within = 12, horizon = 30.1;
+  for (const Case& c : cases) {
+    ConflictMonitor<2> monitor(within, horizon, c.slack);
+    monitor.report(1, c.a);
+    monitor.report(2, c.b);
+    monitor.refresh(c.base);
+    monitor.refresh(c.now);
+    ASSERT_EQ(monitor.incremental_refreshes(), 1u);
+    const std::vector<Id> ids{1, 2};
+    const std::vector<Motion2> objects{c.a, c.b};
+    const auto want = find_conflicts<2>(ids, objects, within, c.now, horizon);
+    const auto got = monitor.conflicts();
+    ASSERT_EQ(got.size(), 1u);
+    ASSERT_EQ(want.size(), 1u);
+    const Approach &g = got[0].approach, &w = want[0].approach;
+    const double end = c.now + horizon;
+    for (double t : {g.tcpa, g.t_enter, g.t_exit}) {
+      EXPECT_GE(t, c.now);
+      EXPECT_LE(t, end);
+    }
+    // Where scratch reports an end of the window, the monitor reports the same double.
+    for (auto [x, y] : {std::pair{g.tcpa, w.tcpa}, std::pair{g.t_enter, w.t_enter},
+                        std::pair{g.t_exit, w.t_exit}})
+      if (y == c.now || y == end) EXPECT_EQ(x, y);
+  }
+}
+
 }  // namespace
 }  // namespace loci

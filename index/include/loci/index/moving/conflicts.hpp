@@ -621,7 +621,9 @@ class ConflictMonitor {
       if (k.dcpa <= within_) {
         // Least distance over the window: at the span's closest approach clamped to it.
         const double u = std::clamp(k.u, from, to);
-        const double tc = base_ + u;
+        // Back in absolute time: the window's own ends where clamped (as a computation from
+        // scratch reports them), never a rounding outside the window.
+        const double tc = u == from ? now_ : u == to ? end : std::clamp(base_ + u, now_, end);
         double d = k.dcpa;
         if (u != k.u) {
           // From the pair's relative motion, kept with it (the reports are not looked up).
