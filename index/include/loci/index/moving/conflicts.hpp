@@ -446,8 +446,8 @@ std::vector<Conflict> find_conflicts(std::span<const Id> ids, std::span<const Mo
 // skip; their current boxes are packed afresh into a small tree at each refresh, which
 // queries look at too. Once now passes b + slack, refresh computes everything again from now.
 // Each tree entry carries the object's position at b and velocity (the packed tree's entries
-// in Hilbert order of their boxes), so that a query reads its candidates' motions from the
-// leaf's neighbourhood rather than from wherever their slots lie; a candidate gets the quick
+// in its packed order, read by packed position), so that a query reads its candidates' motions from
+// the leaf's neighbourhood rather than from wherever their slots lie; a candidate gets the quick
 // test of find_conflicts (clearly_apart) before the exact one. Times within the span are
 // kept from b, so that at epoch-second times the window's end is not rounded to the clock's
 // step (2^-22 s near 1.7e9) where closest_approach, measuring from now, does not round it.
@@ -570,12 +570,15 @@ class ConflictMonitor {
       const Box<D> b = detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_);
       // The candidates of both trees are gathered, then given the quick test two at a time.
       near_.clear();
-      st += packed_.query(b, [&](Id k, const Box<D>&) {
-        // Entries of objects that reported since the base are stale.
-        const Entry& e = packed_entry_[k];
-        if (!e.stale && e.slot != s) near_.push_back(&e);
-        return true;
-      });
+      st += packed_.query_packed(
+          b,
+          [&](std::size_t pos, const Box<D>&) {
+            // Entries of objects that reported since the base are stale.
+            const Entry& e = packed_entry_[pos];
+            if (!e.stale && e.slot != s) near_.push_back(&e);
+            return true;
+          },
+          [&](std::size_t pos) { __builtin_prefetch(packed_entry_.data() + pos); });
       st += recent_tree_.query(b, [&](Id k, const Box<D>&) {
         const Entry& e = recent_entry_[k];
         if (e.slot != s) near_.push_back(&e);
@@ -750,31 +753,22 @@ class ConflictMonitor {
       at_base_[s] = {position(motion_[s], now), motion_[s].v};
       widen(motion_[s], span);
     }
-    // The packed tree's entries in Hilbert order of their boxes' centres (the order it packs
-    // them in), so that the entries of a leaf, and the records of the candidates a query
-    // reads, lie side by side.
+    // The packed tree's entries laid out in its packed order, so that the entries of a leaf,
+    // and the motions of the candidates a query reads, lie side by side.
     {
-      std::vector<Box<D>> grown(live.size()), boxes(live.size());
-      Box<D> centres = Box<D>::empty();
-      for (std::size_t e = 0; e < live.size(); ++e) {
-        grown[e] =
-            detail::grown_sweep(motion_[live[e]], now, detail::window_end(now, span), 0.5 * keep_);
-        centres.expand(grown[e].center());
-      }
-      const detail::HilbertGrid<D> hilbert(centres);
-      std::vector<detail::KeyedIndex> keyed(live.size());
-      for (std::size_t e = 0; e < live.size(); ++e)
-        keyed[e] = {hilbert.key(grown[e].center()), std::uint32_t(e)};
-      detail::radix_sort(keyed, D * detail::hilbert_bits<D>());
+      std::vector<Box<D>> boxes;
+      boxes.reserve(live.size());
+      const double end = detail::window_end(now, span);
+      for (std::uint32_t s : live)
+        boxes.push_back(detail::grown_sweep(motion_[s], now, end, 0.5 * keep_));
+      packed_ = PackedRTree<D>::build(boxes);
       packed_entry_.resize(live.size());
       entry_of_.assign(ids_.size(), kNone);
-      for (std::size_t k = 0; k < keyed.size(); ++k) {
-        const std::uint32_t s = live[keyed[k].index];
-        boxes[k] = grown[keyed[k].index];
-        packed_entry_[k] = {at_base_[s], s, 0};
-        entry_of_[s] = std::uint32_t(k);
+      for (std::size_t pos = 0; pos < live.size(); ++pos) {
+        const std::uint32_t s = live[packed_.item_at(pos)];
+        packed_entry_[pos] = {at_base_[s], s, 0};
+        entry_of_[s] = std::uint32_t(pos);
       }
-      packed_ = PackedRTree<D>::build(boxes);
     }
     const QueryStats st =
         finder_.find(std::span<const Motion<D>>(dense), keep_, now, span,
@@ -804,12 +798,12 @@ class ConflictMonitor {
   detail::IdMap slots_;
   std::size_t count_ = 0;
   PackedRTree<D> packed_;                    // grown swept boxes at the base
-  detail::LargeVector<Entry> packed_entry_;  // by entry of packed_
-  std::vector<std::uint32_t> entry_of_;      // by slot: its entry of packed_, or kNone
+  detail::LargeVector<Entry> packed_entry_;  // by packed position of packed_
+  std::vector<std::uint32_t> entry_of_;      // by slot: its packed position, or kNone
   std::vector<std::uint32_t> recent_;        // objects that reported since the base, by slot
   std::vector<Entry> recent_entry_;          // those alive, by entry of recent_tree_
-  std::vector<const Entry*> near_;           // a query's candidates
   PackedRTree<D> recent_tree_;               // their grown swept boxes
+  std::vector<const Entry*> near_;           // a query's candidates
   ConflictFinder<D> finder_;
 };
 
