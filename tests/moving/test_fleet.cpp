@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "loci/index/moving/fleet.hpp"
+#include "loci/index/moving/moving_grid.hpp"
 #include "loci/index/moving/moving_scan.hpp"
 #include "loci/index/moving/tpr_tree.hpp"
 
@@ -24,7 +25,7 @@ const Motion2* at(const std::map<double, Motion2>& h, double s) {
 
 template <class T>
 class FleetTest : public ::testing::Test {};
-using Indexes = ::testing::Types<MovingScan<2>, TprTree<2>>;
+using Indexes = ::testing::Types<MovingScan<2>, TprTree<2>, MovingGrid<2>>;
 TYPED_TEST_SUITE(FleetTest, Indexes);
 
 TYPED_TEST(FleetTest, AnswersFromTheReportsInForce) {

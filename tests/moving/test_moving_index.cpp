@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "loci/index/moving/moving_grid.hpp"
 #include "loci/index/moving/moving_scan.hpp"
 #include "loci/index/moving/star_tree.hpp"
 #include "loci/index/moving/tpr_tree.hpp"
@@ -151,8 +152,17 @@ struct EagerStar : StarTree<2, 6> {
   EagerStar() : StarTree<2, 6>(StarParams<2>{1.05, 30, true}) {}
 };
 
+// The grid with one velocity band, cells of one object and no horizon (laid out at the
+// clock, so queries ahead look far from its reference time), and with many bands.
+struct FineGrid : MovingGrid<2> {
+  FineGrid() : MovingGrid<2>(MovingGridParams<2>{0, 1, 1}) {}
+};
+struct BandedGrid : MovingGrid<2> {
+  BandedGrid() : MovingGrid<2>(MovingGridParams<2>{30, 7, 4}) {}
+};
+
 using Structures = ::testing::Types<MovingScan<2>, TprTree<2>, TprTree<2, 6>, TprEraseInsert,
-                                    StarTree<2>, EagerStar>;
+                                    StarTree<2>, EagerStar, MovingGrid<2>, FineGrid, BandedGrid>;
 TYPED_TEST_SUITE(MovingIndexTest, Structures);
 
 MovingWindow<2> random_window(std::mt19937_64& rng, double now, int kind) {
@@ -583,6 +593,153 @@ TEST(TprTree, CostsOverflowingInThreeDimensions) {
 }
 TEST(StarTree, CostsOverflowingInThreeDimensions) {
   check_overflowing_costs<StarTree<3>>();
+}
+
+// The grid laid out again and again as its clock moves (each layout with its own reference
+// time, cells and bands), with velocities ten times beyond the bands of the last layout,
+// objects far outside its cells, erasures and new ids, in 2D and 3D: windows of every kind
+// and nearest-n (from within the fleet and from far outside it, ahead of the clock and before
+// it) answer as brute force.
+template <int D>
+void check_grid_layouts() {
+  std::mt19937_64 rng(40 + D);
+  std::uniform_real_distribution<double> pos(0, 1000), vel(-3, 3), len(0, 200), ahead(0, 20);
+  MovingGridParams<D> params;
+  params.horizon = 10;
+  params.per_cell = 4;
+  MovingGrid<D> grid(params);
+  std::unordered_map<Id, Motion<D>> objs;
+  auto random_motion = [&](double t) {
+    Motion<D> m{};
+    m.t = t;
+    for (int a = 0; a < D; ++a)
+      m.p[a] = pos(rng), m.v[a] = vel(rng);
+    return m;
+  };
+  for (Id i = 0; i < 2000; ++i) {
+    objs[i] = random_motion(0);
+    grid.insert(i, objs[i]);
+  }
+  const std::size_t loaded = grid.layouts();
+  auto check = [&](double now, const std::string& what) {
+    grid.validate();
+    ASSERT_EQ(grid.size(), objs.size()) << what;
+    for (int q = 0; q < 45; ++q) {
+      Box<D> b, to;
+      for (int a = 0; a < D; ++a) {
+        b.min[a] = pos(rng) - 100, b.max[a] = b.min[a] + len(rng);
+        const double shift = 3 * vel(rng);
+        to.min[a] = b.min[a] + shift, to.max[a] = b.max[a] + shift;
+      }
+      const double t1 = now + ahead(rng) - 5, t2 = t1 + ahead(rng) / 2;
+      const MovingWindow<D> w = q % 3 == 0   ? MovingWindow<D>::at(b, t1)
+                                : q % 3 == 1 ? MovingWindow<D>::during(b, t1, t2)
+                                             : MovingWindow<D>{b, to, t1, t2};
+      std::vector<Id> got = grid.query(w), want;
+      for (const auto& [id, m] : objs)
+        if (inside(m, w)) want.push_back(id);
+      std::sort(got.begin(), got.end());
+      std::sort(want.begin(), want.end());
+      ASSERT_EQ(got, want) << what << " window " << q;
+    }
+    for (int q = 0; q < 24; ++q) {
+      Point<D> p;
+      for (int a = 0; a < D; ++a)
+        p[a] = q % 6 == 5 ? 1e7 * vel(rng) : pos(rng);
+      const double s = q % 4 == 3 ? now - 15 : now + ahead(rng);
+      const std::size_t k = q % 8 == 7 ? 5000 : 1 + q % 13;
+      std::vector<double> want;
+      for (const auto& [id, m] : objs)
+        want.push_back(std::sqrt(squared_distance(position(m, s), p)));
+      std::sort(want.begin(), want.end());
+      want.resize(std::min(k, want.size()));
+      const auto got = grid.nearest(p, s, k);
+      ASSERT_EQ(got.size(), want.size()) << what << " nearest " << q;
+      for (std::size_t i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(got[i].distance, want[i]) << what << " nearest " << q << " rank " << i;
+        ASSERT_EQ(std::sqrt(squared_distance(position(objs.at(got[i].id), s), p)), got[i].distance);
+      }
+    }
+  };
+  check(0, "loaded");
+  std::uniform_int_distribution<Id> pick(0, 2400);
+  for (int tick = 1; tick <= 24; ++tick) {
+    const double now = 2.0 * tick;
+    for (int u = 0; u < 300; ++u) {
+      const Id id = pick(rng);
+      if (u % 13 == 0) {
+        EXPECT_EQ(grid.erase(id), objs.erase(id) == 1);
+        continue;
+      }
+      Motion<D> m = random_motion(now);
+      if (auto it = objs.find(id); it != objs.end()) m.p = position(it->second, now);
+      if (u % 7 == 0)  // ten times faster than any velocity laid out
+        for (int a = 0; a < D; ++a)
+          m.v[a] *= 10;
+      if (u % 29 == 0)  // far outside the grid's cells
+        for (int a = 0; a < D; ++a)
+          m.p[a] = 1e6 * vel(rng);
+      grid.update(id, m);
+      objs[id] = m;
+    }
+    if (tick % 4 == 0) check(now, "tick " + std::to_string(tick));
+  }
+  EXPECT_GE(grid.layouts(), loaded + 3);  // the clock passed several reference times
+  EXPECT_EQ(grid.clock(), 48.0);
+  // One object at 1e100 among the others: every query looks at most cells, still exact.
+  Motion<D> far{};
+  far.t = 48;
+  for (int a = 0; a < D; ++a)
+    far.p[a] = 1e100, far.v[a] = 1;
+  grid.insert(99999, far);
+  objs[99999] = far;
+  check(48, "one object at 1e100");
+  for (const auto& [id, m] : objs)
+    ASSERT_TRUE(grid.erase(id));
+  EXPECT_TRUE(grid.empty());
+  grid.validate();
+  EXPECT_TRUE(grid.query(MovingWindow<D>::at(Box<D>{}, 0)).empty());
+  EXPECT_TRUE(grid.nearest(Point<D>{}, 0, 3).empty());
+}
+
+TEST(MovingGrid, RelayoutsFastVelocitiesAndFarObjectsMatchBruteForce) {
+  check_grid_layouts<2>();
+}
+TEST(MovingGrid, RelayoutsInThreeDimensions) {
+  check_grid_layouts<3>();
+}
+
+// One class of opposite velocities, asked about long after the reference time: an object's
+// cell lies far (in cells) from where it is at the time asked, toward either side, and a query
+// at the grid's edge has rings on one side only. Nearest-n must still find the nearest.
+TEST(MovingGrid, NearestRingsReachAsFarAsVelocitiesSpread) {
+  MovingGrid<2> grid(MovingGridParams<2>{0, 1, 1});
+  std::unordered_map<Id, Motion2> objs;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> pos(0, 1000);
+  for (Id i = 0; i < 400; ++i) {
+    objs[i] = Motion2{0, {pos(rng), pos(rng)}, {i % 2 ? 10.0 : -10.0, 0}};
+    grid.insert(i, objs[i]);
+  }
+  for (const double s : {50.0, -50.0})
+    for (const Point2 q : {Point2{1000, 500}, Point2{0, 500}, Point2{1200, 700}}) {
+      double want = INFINITY;
+      for (const auto& [id, m] : objs)
+        want = std::min(want, std::sqrt(squared_distance(position(m, s), q)));
+      const auto got = grid.nearest(q, s, 1);
+      ASSERT_EQ(got.size(), 1u);
+      EXPECT_EQ(got[0].distance, want) << "at " << s << " from " << q[0];
+    }
+}
+
+TEST(MovingGrid, RefusesBadParameters) {
+  EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{-1, 3, 32}), InvalidArgument);
+  EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{NAN, 3, 32}), InvalidArgument);
+  EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{60, 0, 32}), InvalidArgument);
+  EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{60, 17, 32}), InvalidArgument);
+  EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{60, 3, 0.5}), InvalidArgument);
+  EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{60, 3, INFINITY}), InvalidArgument);
+  EXPECT_NO_THROW(MovingGrid<3>(MovingGridParams<3>{0, 16, 1}));
 }
 
 }  // namespace
