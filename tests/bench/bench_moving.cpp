@@ -347,10 +347,11 @@ void run_objects(const Options& o) {
     const Rates sx = row("libspatialindex TPR-tree", t_sidx);
     std::printf(
         "  vs libspatialindex: updates %.0fx (TPR*), %.0fx (in place), %.0fx (packed), %.0fx "
-        "(STAR), %.0fx (scan); queries %.1fx (TPR*), %.1fx (in place), %.1fx (packed), %.1fx "
-        "(STAR), %.1fx (scan)\n",
+        "(STAR), %.0fx (scan), %.0fx (grid); queries %.1fx (TPR*), %.1fx (in place), %.1fx "
+        "(packed), %.1fx (STAR), %.1fx (scan), %.1fx (grid)\n",
         tp.ups / sx.ups, ip.ups / sx.ups, pk.ups / sx.ups, st.ups / sx.ups, sc.ups / sx.ups,
-        tp.qps / sx.qps, ip.qps / sx.qps, pk.qps / sx.qps, st.qps / sx.qps, sc.qps / sx.qps);
+        gr.ups / sx.ups, tp.qps / sx.qps, ip.qps / sx.qps, pk.qps / sx.qps, st.qps / sx.qps,
+        sc.qps / sx.qps, gr.qps / sx.qps);
     std::printf(
         "  libspatialindex: %zu of %zu windows answered differently from brute force (%zu ids "
         "missing, %zu extra); %zu of %zu deletes failed\n",
