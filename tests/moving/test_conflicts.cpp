@@ -449,6 +449,42 @@ TEST(Conflicts, QuickTestOnTwoLanesAgreesWithOneLane) {
 }
 #endif
 
+// Pairs that touch (D = 0) exactly when measured from `now`, reported long before it: the
+// position at a slice's start, computed from the report, rounds differently from the position
+// at now carried forward by the exact test, by an amount that grows with the time since the
+// report. Every touching pair is found whichever slice its touch falls in.
+TEST(Conflicts, TouchingPairsReportedLongBeforeNowInEverySlice) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const double now = 0, horizon = 10;
+  for (const double ago : {1e6, 1e9}) {
+    std::size_t touching = 0, found = 0;
+    std::vector<Motion2> fleet;
+    for (int i = 0; i < 6000; ++i) {
+      // a moves along +x; b is placed 2 tau ahead of it at now (as far as rounding lets the
+      // report say so), moving 2 slower: they meet at now + tau, exactly or not at all.
+      const double tau = std::ldexp(std::floor(u01(rng) * 1280), -7);  // k / 128 in [0, 10)
+      Motion2 a{-ago * u01(rng), {0, 0}, {1 + u01(rng), 0.5 * u01(rng)}};
+      a.p = {10 * u01(rng) - a.v[0] * (now - a.t), 10 * u01(rng) - a.v[1] * (now - a.t)};
+      const Point2 pa = position(a, now);
+      Motion2 b{-ago * u01(rng), {0, 0}, {a.v[0] - 2, a.v[1]}};
+      b.p = {pa[0] + 2 * tau - b.v[0] * (now - b.t), pa[1] - b.v[1] * (now - b.t)};
+      if (!closest_approach(a, b, now, horizon, 0.0)) continue;
+      ++touching;
+      const std::vector<Motion2> pair{a, b};
+      for (std::size_t slices : {4, 16}) {
+        bool seen = false;
+        find_conflicts<2>(
+            pair, 0.0, now, horizon,
+            [&](std::uint32_t, std::uint32_t, const Approach&) { return seen = true; }, slices);
+        found += seen;
+      }
+    }
+    EXPECT_GE(touching, 3000u);
+    EXPECT_EQ(found, 2 * touching) << "reports up to " << ago << " s before now";
+  }
+}
+
 TEST(Conflicts, VisitorStops) {
   const auto fleet = test::make_fleet(test::Fleet::identical, 300, 2);
   int seen = 0;

@@ -19,7 +19,9 @@
 // that holds its entry time t_enter only, so pairs found in several slices are reported once
 // without a set of seen pairs; at its entry time the pair is within D, so that slice's boxes
 // meet and the pair is not missed. Boxes are grown by a hair more than D/2 so that rounding in
-// the positions cannot lose a pair that touches the D-circle, and the last slice ends at
+// the positions (relative to the coordinates and to the distance moved since the report,
+// since a slice's boxes start from the report and the exact test from the positions at now)
+// cannot lose a pair that touches the D-circle, and the last slice ends at
 // now + H rounded up (window_end), so that rounding in the time cannot either.
 //
 // More slices mean smaller boxes (fewer candidates) but one more sort per slice; slices = 0
@@ -77,21 +79,33 @@ concept ConflictVisitor = Visitor<F, std::uint32_t, std::uint32_t, const Approac
 
 namespace detail {
 
-// The box a point sweeps over [t0, t1], grown by `grow` on every side.
+// The box a point sweeps over [t0, t1], grown by `grow` on every side. `from` is the time
+// whose positions the exact test measures from (t0 by default): the box is padded for the
+// rounding of the positions at t0 and t1 and of those at `from` carried forward, which differ
+// from each other by rounding that grows with the times elapsed since the report (a report
+// long before `from` moved over many steps), not only with the coordinates.
 template <int D>
-Box<D> grown_sweep(const Motion<D>& m, double t0, double t1, double grow) {
+Box<D> grown_sweep(const Motion<D>& m, double t0, double t1, double grow, double from) {
   const Point<D> a = position(m, t0), b = position(m, t1);
   Box<D> box = Box<D>::of_point(a);
   box.expand(b);
+  const double elapsed =
+      std::abs(from - m.t) + std::abs(t0 - m.t) + std::abs(t1 - m.t) + std::abs(t1 - from);
   for (int i = 0; i < D; ++i) {
-    // A hair over `grow`, relative to the coordinates, so that rounding never shrinks it.
+    // A hair over `grow`, relative to the coordinates and the distances moved, so that
+    // rounding never shrinks it.
     const double pad =
         grow * (1 + 1e-12) + 4 * std::numeric_limits<double>::epsilon() *
-                                 std::max(std::abs(box.min[i]), std::abs(box.max[i]));
+                                 (std::max(std::abs(box.min[i]), std::abs(box.max[i])) +
+                                  std::abs(m.v[i]) * elapsed + std::abs(m.p[i]));
     box.min[i] -= pad;
     box.max[i] += pad;
   }
   return box;
+}
+template <int D>
+Box<D> grown_sweep(const Motion<D>& m, double t0, double t1, double grow) {
+  return grown_sweep(m, t0, t1, grow, t0);
 }
 
 // start + length rounded up, never below the exact sum: at epoch-second times the sum rounds
@@ -275,7 +289,7 @@ class ConflictFinder {
           s + 1 == slices ? detail::window_end(now, horizon) : now + step * double(s + 1);
       for (std::uint32_t k = 0; k < n; ++k) {
         // The reports in proxy order, read in sequence.
-        const Box<D> b = detail::grown_sweep(motion_[k], t0, t1, 0.5 * within);
+        const Box<D> b = detail::grown_sweep(motion_[k], t0, t1, 0.5 * within, now);
         if (k < held_) {
           broad_.move(k, b);
         } else {
