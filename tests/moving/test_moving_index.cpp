@@ -732,6 +732,130 @@ TEST(MovingGrid, NearestRingsReachAsFarAsVelocitiesSpread) {
     }
 }
 
+// An axis whose extent is tiny next to the others (objects on a line, drones over a plain
+// with one far outlier) gets one cell, not thousands: the cells stay about size / per_cell.
+TEST(MovingGrid, ThinAxesAndOutliersKeepTheCellsFew) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(0, 1000), h(0, 10), v(-1, 1);
+  MovingGrid<2> line;
+  std::unordered_map<Id, Motion2> on_line;
+  for (Id i = 0; i < 3000; ++i) {
+    on_line[i] = Motion2{0, {u(rng), 100 + 1e-9 * double(i)}, {v(rng), 0}};
+    line.insert(i, on_line[i]);
+  }
+  EXPECT_LE(line.cells(), 4 * 3000 / 32 + 64u);
+  MovingGrid<3> drones;
+  std::vector<Motion<3>> fleet;
+  for (Id i = 0; i < 5000; ++i) {
+    fleet.push_back(Motion<3>{0, {u(rng), u(rng), h(rng)}, {v(rng), v(rng), v(rng) / 10}});
+    drones.insert(i, fleet.back());
+  }
+  fleet.push_back(Motion<3>{0, {1e9, 1e9, 5}, {0, 0, 0}});
+  drones.insert(5000, fleet.back());
+  for (Id i = 0; i < 1000; ++i) {  // enough changes for a layout that sees the outlier
+    fleet[i].t = 100;
+    drones.update(i, fleet[i]);
+  }
+  EXPECT_GE(drones.layouts(), 2u);
+  EXPECT_LE(drones.cells(), 8 * 5001 / 32 + 27 * 8u);
+  for (int q = 0; q < 20; ++q) {
+    const Box2 b{{u(rng), 99}, {0, 101}};
+    const Box2 w{{b.min[0] - 50, b.min[1]}, {b.min[0] + 50, b.max[1]}};
+    std::vector<Id> got = line.query(MovingWindow<2>::at(w, 10)), want;
+    for (const auto& [id, m] : on_line)
+      if (inside(m, MovingWindow<2>::at(w, 10))) want.push_back(id);
+    std::sort(got.begin(), got.end());
+    std::sort(want.begin(), want.end());
+    ASSERT_EQ(got, want);
+    const Box<3> c{{u(rng), u(rng), 0}, {0, 0, 10}};
+    const Box<3> box{c.min, {c.min[0] + 100, c.min[1] + 100, 10}};
+    std::vector<Id> got3 = drones.query(MovingWindow<3>::during(box, 100, 110)), want3;
+    for (Id i = 0; i < fleet.size(); ++i)
+      if (inside(fleet[i], MovingWindow<3>::during(box, 100, 110))) want3.push_back(i);
+    std::sort(got3.begin(), got3.end());
+    ASSERT_EQ(got3, want3);
+  }
+}
+
+// A fleet that moves far away while the clock stands still (every report at the same time)
+// is laid out again once an eighth of it has left the cells' extent.
+TEST(MovingGrid, FleetLeavingTheCellsIsLaidOutAgain) {
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0, 1000), v(-1, 1);
+  MovingGrid<2> grid;
+  std::unordered_map<Id, Motion2> objs;
+  for (Id i = 0; i < 4000; ++i) {
+    objs[i] = Motion2{0, {u(rng), u(rng)}, {v(rng), v(rng)}};
+    grid.insert(i, objs[i]);
+  }
+  const std::size_t before = grid.layouts();
+  for (Id i = 0; i < 4000; ++i) {
+    objs[i] = Motion2{0, {1e5 + u(rng), 1e5 + u(rng)}, {v(rng), v(rng)}};
+    grid.update(i, objs[i]);
+  }
+  EXPECT_EQ(grid.clock(), 0.0);
+  EXPECT_GE(grid.layouts(), before + 1);
+  grid.validate();
+  for (int q = 0; q < 20; ++q) {
+    const double x = 1e5 + u(rng), y = 1e5 + u(rng);
+    const auto w = MovingWindow<2>::at({{x, y}, {x + 50, y + 50}}, 5);
+    std::vector<Id> got = grid.query(w), want;
+    for (const auto& [id, m] : objs)
+      if (inside(m, w)) want.push_back(id);
+    std::sort(got.begin(), got.end());
+    std::sort(want.begin(), want.end());
+    ASSERT_EQ(got, want);
+  }
+}
+
+// Nearest-n from far outside the fleet on one axis: every object is at least that far on it,
+// so the rings stop soon instead of visiting every cell.
+TEST(MovingGrid, NearestFromFarOutsideVisitsFewCells) {
+  std::mt19937_64 rng(10);
+  std::uniform_real_distribution<double> u(0, 1000), v(-1, 1);
+  MovingGrid<2> grid;
+  std::vector<Motion2> fleet;
+  for (Id i = 0; i < 20000; ++i) {
+    fleet.push_back(Motion2{0, {u(rng), u(rng)}, {v(rng), v(rng)}});
+    grid.insert(i, fleet.back());
+  }
+  for (const Point2 p : {Point2{1e6, 500}, Point2{500, -1e7}, Point2{3000, 3000}}) {
+    double want = INFINITY;
+    for (const Motion2& m : fleet)
+      want = std::min(want, std::sqrt(squared_distance(position(m, 20), p)));
+    std::vector<double> got;
+    const QueryStats st = grid.nearest(p, 20, 1, [&](Id, const Motion2&, double d) {
+      got.push_back(d);
+      return true;
+    });
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_EQ(got[0], want);
+    EXPECT_LT(st.nodes_visited, grid.cells() / 3) << p[0] << " " << p[1];
+  }
+}
+
+// At epoch-second times inside() solves for times in absolute time (a step of 2^-22 s, a
+// position step of |v| 2^-22): a window over an interval that an object reaches by less than
+// that is still answered as inside() decides.
+TEST(MovingGrid, IntervalWindowsAtEpochSeconds) {
+  for (const double t0 : {0.0, 1.7e9}) {
+    MovingGrid<2> grid(MovingGridParams<2>{0, 1, 17.0 / 16});
+    std::vector<Motion2> fleet;
+    for (Id i = 0; i <= 16; ++i) {
+      fleet.push_back(Motion2{t0, {double(i), 0}, {1000, 0}});
+      grid.insert(i, fleet.back());
+    }
+    for (const double edge : {1008 - 5e-5, 1008 - 1e-6, 1008.0, 1008 + 1e-6}) {
+      const auto w = MovingWindow<2>::during({{0, -1}, {edge, 1}}, t0 + 1, t0 + 2);
+      std::vector<Id> got = grid.query(w), want;
+      for (Id i = 0; i < fleet.size(); ++i)
+        if (inside(fleet[i], w)) want.push_back(i);
+      std::sort(got.begin(), got.end());
+      EXPECT_EQ(got, want) << "at " << t0 << " edge " << edge;
+    }
+  }
+}
+
 TEST(MovingGrid, RefusesBadParameters) {
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{-1, 3, 32}), InvalidArgument);
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{NAN, 3, 32}), InvalidArgument);

@@ -16,19 +16,26 @@
 // (`inside`, geom/motion.hpp). Windows over an interval and moving windows take the hull of
 // that region at the window's two ends (each side is a minimum or maximum of functions linear
 // in s). Nearest-n visits each class's cells in rings around the query point shifted the same
-// way, nearest ring first across the classes, and stops when no ring can hold a nearer object.
+// way, nearest ring first across the classes, and stops when no ring can hold a nearer object;
+// each class also keeps the extent of its objects' positions at t_ref, which bounds the edge
+// cells and every ring from a query point far outside the fleet.
 //
 // The reference time is clock + horizon / 2 when the grid is laid out, so that queries over
-// [clock, clock + horizon] look at most horizon / 2 away from it; once the clock passes
-// t_ref the grid is laid out again (cells sized for the count, bands for the velocities seen,
-// t_ref moved on), but only after at least an eighth as many updates as objects since the
-// last layout (and when the count doubles), so that the O(n) layout costs O(1) a update
-// however the clock moves. Between layouts the bounds stay exact at every time, before the
-// clock too: only the widening grows with |s - t_ref|, and an object whose velocity falls
-// beyond the bands of the last layout widens its edge band. Positions are extrapolated to
-// t_ref in floating point, so the regions looked at are padded by 1e-12 of the magnitudes the
-// grid holds (an object at 1e100 among objects near 0 makes every query look at most cells:
-// still exact, as slow as a scan).
+// [clock, clock + horizon] look at most horizon / 2 away from it. A layout (cells sized for
+// the count, an axis thinner than a cell's side given one cell, bands for the velocities
+// seen, t_ref moved on) costs O(n), so one comes only after at least an eighth as many
+// changes as objects since the last, which makes it O(1) a change amortized however the
+// clock moves: when the clock has passed t_ref, when that many changes placed objects beyond
+// the positions or velocities laid out (a fleet that moves elsewhere or speeds up while the
+// clock stands still), and when the count doubles. A fleet that gathers somewhere new while
+// the clock stands still can be caught half moved (a layout over both places, few cells in
+// each) until the clock passes t_ref. Between layouts the bounds stay exact at every time,
+// before the clock too: only the widening grows with |s - t_ref|, and an object whose
+// velocity falls beyond the bands of the last layout widens its edge band. Positions are
+// extrapolated to t_ref in floating point, and inside() solves for times in absolute time,
+// so the regions looked at are padded by 1e-12 of the magnitudes involved (an object at
+// 1e100 among objects near 0 makes every query look at most cells: still exact, as slow as
+// a scan).
 //
 // Layout: per cell of each class, a vector of records (report, id, slot); per slot, its cell
 // and its index there; an IdMap from ids to slots. Cells are clamped at the grid's edges (an
@@ -144,6 +151,8 @@ class MovingGrid {
   // The reference time of the present layout, and the layouts made so far.
   double reference_time() const { return t_ref_; }
   std::size_t layouts() const { return layouts_; }
+  // The cells of the present layout, over every class.
+  std::size_t cells() const { return cells_.size(); }
 
   // The report held for id; throws InvalidArgument when there is none.
   Motion<D> at(Id id) const {
@@ -171,9 +180,13 @@ class MovingGrid {
         const double u1 = w.from.max[a] - std::min(b.vlo[a] * d1, b.vhi[a] * d1);
         const double l2 = w2lo - std::max(b.vlo[a] * d2, b.vhi[a] * d2);
         const double u2 = w2hi - std::min(b.vlo[a] * d2, b.vhi[a] * d2);
-        const double pad =
-            kPad * (mag_ + vabs_ * std::max(std::abs(d1), std::abs(d2)) + std::abs(w.from.min[a]) +
-                    std::abs(w.from.max[a]) + std::abs(w2lo) + std::abs(w2hi));
+        // Rounding: of the positions at t_ref, of the window's bounds, and of the times
+        // inside() solves for in absolute time (at epoch seconds a step of 2^-22 s).
+        const double pad = kPad * (mag_ +
+                                   vabs_ * (std::abs(d1) + std::abs(d2) + std::abs(w.t1) +
+                                            std::abs(w.t2) + std::abs(t_ref_)) +
+                                   std::abs(w.from.min[a]) + std::abs(w.from.max[a]) +
+                                   std::abs(w2lo) + std::abs(w2hi));
         lo[a] = axis_cell(std::min(l1, l2) - pad, a);
         hi[a] = axis_cell(std::max(u1, u2) + pad, a);
       }
@@ -236,10 +249,13 @@ class MovingGrid {
         const double mid = 0.5 * b.vlo[a] + 0.5 * b.vhi[a];
         r.q[a] = q[a] - mid * delta;
         r.reach[a] = (0.5 * b.vhi[a] - 0.5 * b.vlo[a]) * std::abs(delta) +
-                     kPad * (mag_ + std::abs(q[a]) + std::abs(r.q[a]) + vabs_ * std::abs(delta) +
+                     kPad * (mag_ + std::abs(q[a]) + std::abs(r.q[a]) +
+                             vabs_ * (std::abs(delta) + std::abs(s) + std::abs(t_ref_)) +
                              std::abs(origin_[a])) +
                      1e-9 * width_[a];
         r.center[a] = axis_cell(r.q[a], a);
+        // How far every object of the class lies from q on this axis, at least.
+        r.gap[a] = std::max({0.0, b.lo[a] - r.q[a] - r.reach[a], r.q[a] - b.hi[a] - r.reach[a]});
       }
       rings.push_back({0.0, c, 0});
       std::push_heap(rings.begin(), rings.end(), farther);
@@ -269,17 +285,24 @@ class MovingGrid {
           }
         }
       });
-      // The next ring's objects lie beyond this ring's block on some axis.
+      // The next ring's objects lie beyond this ring's block on some axis, and on every axis
+      // at least the class's gap away.
+      double others = 0;
+      for (int a = 0; a < D; ++a)
+        others += r.gap[a] * r.gap[a];
       double next = std::numeric_limits<double>::infinity();
       for (int a = 0; a < D; ++a) {
+        auto beyond = [&](double side) {
+          const double g = std::max(side, r.gap[a]);
+          next = std::min(next, others - r.gap[a] * r.gap[a] + g * g);
+        };
         if (r.center[a] - ring.r - 1 >= 0)
-          next = std::min(next, r.q[a] - edge(a, r.center[a] - ring.r) - r.reach[a]);
+          beyond(r.q[a] - edge(a, r.center[a] - ring.r) - r.reach[a]);
         if (r.center[a] + ring.r + 1 < int(cells_axis_[a]))
-          next = std::min(next, edge(a, r.center[a] + ring.r + 1) - r.q[a] - r.reach[a]);
+          beyond(edge(a, r.center[a] + ring.r + 1) - r.q[a] - r.reach[a]);
       }
       if (next < std::numeric_limits<double>::infinity()) {
-        const double g = std::max(0.0, next);
-        rings.push_back({g * g, ring.cls, ring.r + 1});
+        rings.push_back({next, ring.cls, ring.r + 1});
         std::push_heap(rings.begin(), rings.end(), farther);
       }
     }
@@ -317,9 +340,12 @@ class MovingGrid {
           throw Error(std::string(kName) + ": id " + std::to_string(r.id) +
                       " is in the wrong cell");
         const Band& b = band_[c / cells_per_class_];
-        for (int a = 0; a < D; ++a)
+        for (int a = 0; a < D; ++a) {
           if (!(b.vlo[a] <= r.m.v[a] && r.m.v[a] <= b.vhi[a]) || std::abs(r.m.v[a]) > vabs_)
             throw Error(std::string(kName) + ": a velocity lies outside its class's bounds");
+          if (!(b.lo[a] <= reference(r.m, a) && reference(r.m, a) <= b.hi[a]))
+            throw Error(std::string(kName) + ": a position lies outside its class's bounds");
+        }
         if (magnitude(r.m) > mag_)
           throw Error(std::string(kName) + ": a record's magnitude exceeds the grid's");
       }
@@ -339,15 +365,17 @@ class MovingGrid {
   struct Slot {
     std::uint32_t cell = kNone, index = 0;
   };
-  // The velocities met in a class since the last layout, per axis (vlo > vhi: none).
+  // The velocities met in a class since the last layout, per axis (vlo > vhi: none), and
+  // the reference positions (lo, hi): the edge cells' contents, bounded.
   struct Band {
-    Point<D> vlo, vhi;
+    Point<D> vlo, vhi, lo, hi;
   };
 
   // What a nearest-n query works with, per class and overall.
   struct Around {
     Point<D> q;       // the query point shifted back to t_ref
     double reach[D];  // how far an object of the class lies from its shifted position
+    double gap[D];    // how far every object of the class lies from q, at least
     int center[D];    // the cell of q
   };
   struct Ring {
@@ -447,7 +475,7 @@ class MovingGrid {
   double cell_bound(const Around& r, const int* at) const {
     double g2 = 0;
     for (int a = 0; a < D; ++a) {
-      double gap = 0;
+      double gap = r.gap[a];
       if (at[a] > 0) gap = std::max(gap, edge(a, at[a]) - r.q[a] - r.reach[a]);
       if (at[a] + 1 < int(cells_axis_[a]))
         gap = std::max(gap, r.q[a] - edge(a, at[a] + 1) - r.reach[a]);
@@ -460,11 +488,18 @@ class MovingGrid {
   // The bounds cell c's class and the grid keep, widened for m.
   void widen(std::uint32_t c, const Motion<D>& m) {
     Band& b = band_[c / cells_per_class_];
+    bool outside = false;
     for (int a = 0; a < D; ++a) {
+      const double x = reference(m, a);
       b.vlo[a] = std::min(b.vlo[a], m.v[a]);
       b.vhi[a] = std::max(b.vhi[a], m.v[a]);
+      b.lo[a] = std::min(b.lo[a], x);
+      b.hi[a] = std::max(b.hi[a], x);
       vabs_ = std::max(vabs_, std::abs(m.v[a]));
+      outside |= !(laid_lo_[a] <= x && x <= laid_hi_[a]) ||
+                 !(laid_vlo_[a] <= m.v[a] && m.v[a] <= laid_vhi_[a]);
     }
+    drift_ += outside;
     mag_ = std::max(mag_, magnitude(m));
   }
   void place(std::uint32_t s, Id id, const Motion<D>& m, std::uint32_t c) {
@@ -484,10 +519,15 @@ class MovingGrid {
     slots_[s] = {};
   }
 
+  // A layout costs O(n), so one follows at least count / 8 changes (and O(1) a change
+  // amortized): when the count doubled, when the clock passed t_ref, or when that many
+  // changes placed objects beyond the positions or velocities laid out (a fleet that moved
+  // elsewhere, or sped up, while the clock stood still).
   void maybe_layout() {
+    const std::size_t enough = count_ / 8 + 16;
     const bool grew = count_ > 2 * laid_out_ + 16;
-    const bool aged = clock_ > t_ref_ && changes_ >= count_ / 8 + 16;
-    if (grew || aged) layout();
+    const bool aged = clock_ > t_ref_ && changes_ >= enough;
+    if (grew || aged || drift_ >= enough) layout();
   }
 
   // Lays the grid out afresh for the objects held: t_ref, cells and bands.
@@ -513,18 +553,30 @@ class MovingGrid {
       }
     const double total = std::max(
         1.0, std::min(double(all.size()) / (params_.per_cell * double(classes_)), double(1 << 22)));
-    // Cells of equal sides over the axes that have an extent (logarithms: the product of
-    // extents near 1e300 would overflow).
-    double log_sum = 0;
-    int spread = 0;
+    // Cells of equal sides over the axes whose extent is at least a side (logarithms: the
+    // product of extents near 1e300 would overflow); an axis thinner than a side has one
+    // cell, and the side is worked out again over the others, so that the cells number about
+    // `total` however thin an axis is.
+    bool split[D];
     for (int a = 0; a < D; ++a)
-      if (hi[a] > lo[a]) log_sum += std::log(hi[a] - lo[a]), ++spread;
-    const double side = spread ? std::exp((log_sum - std::log(total)) / spread) : 1.0;
+      split[a] = hi[a] > lo[a];
+    double side = 1.0;
+    for (bool again = true; again;) {
+      double log_sum = 0;
+      int spread = 0;
+      for (int a = 0; a < D; ++a)
+        if (split[a]) log_sum += std::log(hi[a] - lo[a]), ++spread;
+      if (!spread) break;
+      side = std::exp((log_sum - std::log(total)) / spread);
+      again = false;
+      for (int a = 0; a < D; ++a)
+        if (split[a] && hi[a] - lo[a] < side) split[a] = false, again = true;
+    }
     cells_per_class_ = 1;
     for (int a = 0; a < D; ++a) {
-      origin_[a] = hi[a] > lo[a] ? lo[a] : 0.0;
+      origin_[a] = split[a] ? lo[a] : 0.0;
       int n = 1;
-      if (hi[a] > lo[a]) {
+      if (split[a]) {
         const double want = std::ceil((hi[a] - lo[a]) / side);
         n = !(want >= 1) ? 1 : want >= kMaxCellsAxis ? kMaxCellsAxis : int(want);
       }
@@ -539,14 +591,17 @@ class MovingGrid {
     band_.assign(classes_, Band{});
     for (Band& b : band_)
       for (int a = 0; a < D; ++a)
-        b.vlo[a] = std::numeric_limits<double>::infinity(),
-        b.vhi[a] = -std::numeric_limits<double>::infinity();
+        b.vlo[a] = b.lo[a] = std::numeric_limits<double>::infinity(),
+        b.vhi[a] = b.hi[a] = -std::numeric_limits<double>::infinity();
+    for (int a = 0; a < D; ++a)
+      laid_lo_[a] = lo[a], laid_hi_[a] = hi[a], laid_vlo_[a] = vlo[a], laid_vhi_[a] = vhi[a];
     mag_ = 0;
     vabs_ = 0;
     for (const Record& r : all)
       put(r.slot, r.id, r.m);
     laid_out_ = all.size();
     changes_ = 0;
+    drift_ = 0;
   }
 
   MovingGridParams<D> params_;
@@ -559,7 +614,9 @@ class MovingGrid {
   std::vector<Slot> slots_;
   std::vector<std::uint32_t> free_;
   detail::IdMap map_;
-  std::size_t count_ = 0, laid_out_ = 0, changes_ = 0, layouts_ = 0;
+  std::size_t count_ = 0, laid_out_ = 0, changes_ = 0, layouts_ = 0, drift_ = 0;
+  // The extent of the reference positions and velocities at the last layout.
+  double laid_lo_[D] = {}, laid_hi_[D] = {}, laid_vlo_[D] = {}, laid_vhi_[D] = {};
   double t_ref_ = 0, mag_ = 0, vabs_ = 0;
   double clock_ = -std::numeric_limits<double>::infinity();
 };
