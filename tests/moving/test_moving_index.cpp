@@ -789,23 +789,34 @@ TEST(MovingGrid, FleetLeavingTheCellsIsLaidOutAgain) {
     grid.insert(i, objs[i]);
   }
   const std::size_t before = grid.layouts();
-  for (Id i = 0; i < 4000; ++i) {
-    objs[i] = Motion2{0, {1e5 + u(rng), 1e5 + u(rng)}, {v(rng), v(rng)}};
-    grid.update(i, objs[i]);
-  }
+  // Two rounds of reports there: the first layout comes an eighth of the way through the
+  // first (over both places), another once the fleet has moved on.
+  for (int round = 0; round < 2; ++round)
+    for (Id i = 0; i < 4000; ++i) {
+      objs[i] = Motion2{0, {1e5 + u(rng), 1e5 + u(rng)}, {v(rng), v(rng)}};
+      grid.update(i, objs[i]);
+    }
   EXPECT_EQ(grid.clock(), 0.0);
-  EXPECT_GE(grid.layouts(), before + 1);
+  EXPECT_GE(grid.layouts(), before + 2);
   grid.validate();
+  std::size_t tested = 0;
   for (int q = 0; q < 20; ++q) {
     const double x = 1e5 + u(rng), y = 1e5 + u(rng);
     const auto w = MovingWindow<2>::at({{x, y}, {x + 50, y + 50}}, 5);
-    std::vector<Id> got = grid.query(w), want;
+    std::vector<Id> got, want;
+    tested += grid.query(w,
+                         [&](Id id, const Motion2&) {
+                           got.push_back(id);
+                           return true;
+                         })
+                  .entries_tested;
     for (const auto& [id, m] : objs)
       if (inside(m, w)) want.push_back(id);
     std::sort(got.begin(), got.end());
     std::sort(want.begin(), want.end());
     ASSERT_EQ(got, want);
   }
+  EXPECT_LT(tested / 20, 4000u / 10);  // a window looks at few cells, not the whole fleet
 }
 
 // Nearest-n from far outside the fleet on one axis: every object is at least that far on it,
@@ -854,11 +865,53 @@ TEST(MovingGrid, IntervalWindowsAtEpochSeconds) {
       EXPECT_EQ(got, want) << "at " << t0 << " edge " << edge;
     }
   }
+  // The same through the window's own speed: still objects, a window moving at 1000/s.
+  for (const double t0 : {0.0, 1.7e9}) {
+    MovingGrid<2> grid(MovingGridParams<2>{0, 1, 17.0 / 16});
+    std::vector<Motion2> fleet;
+    for (Id i = 0; i <= 16; ++i) {
+      fleet.push_back(Motion2{t0, {1092.0 + double(i), 0}, {0, 0}});
+      grid.insert(i, fleet.back());
+    }
+    fleet.push_back(Motion2{t0, {1100 + 5e-5, 0}, {0, 0}});
+    grid.insert(17, fleet.back());
+    const MovingWindow<2> w{Box2{{0, -1}, {100 - 1e-6, 1}}, Box2{{1000, -1}, {1100 - 1e-6, 1}},
+                            t0 + 1, t0 + 2};
+    std::vector<Id> got = grid.query(w), want;
+    for (Id i = 0; i < fleet.size(); ++i)
+      if (inside(fleet[i], w)) want.push_back(i);
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, want) << "moving window at " << t0;
+  }
+}
+
+// A class whose objects' squared distances overflow at the time asked: nearest-n goes on past
+// the first ring and refuses the answer, as the scan does, rather than answering fewer.
+TEST(MovingGrid, NearestBeyondOverflowingDistancesIsRefused) {
+  MovingGrid<2> grid(MovingGridParams<2>{60, 2, 1});
+  MovingScan<2> scan;
+  for (Id i = 0; i < 3; ++i) {  // still, near the query point
+    grid.insert(100 + i, Motion2{0, {double(i), 800}, {0, 0}});
+    scan.insert(100 + i, Motion2{0, {double(i), 800}, {0, 0}});
+  }
+  for (Id i = 0; i < 14; ++i) {  // fast: about 1e160 away at 1e60
+    const Motion2 m{
+        0, {100.0 * double(i), i < 7 ? 10.0 * double(i) : 1600 - 10.0 * double(i - 7)}, {1e100, 0}};
+    grid.insert(i, m);
+    scan.insert(i, m);
+  }
+  EXPECT_EQ(grid.nearest(Point2{0, 800}, 1e60, 3).size(), 3u);
+  for (const std::size_t k : {4, 17}) {
+    EXPECT_THROW(scan.nearest(Point2{0, 800}, 1e60, k), InvalidArgument);
+    EXPECT_THROW(grid.nearest(Point2{0, 800}, 1e60, k), InvalidArgument) << k;
+  }
 }
 
 TEST(MovingGrid, RefusesBadParameters) {
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{-1, 3, 32}), InvalidArgument);
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{NAN, 3, 32}), InvalidArgument);
+  EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{1e300, 3, 32}), InvalidArgument);
+  EXPECT_NO_THROW(MovingGrid<2>(MovingGridParams<2>{1e150, 3, 32}));
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{60, 0, 32}), InvalidArgument);
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{60, 17, 32}), InvalidArgument);
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{60, 3, 0.5}), InvalidArgument);

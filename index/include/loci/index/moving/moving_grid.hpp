@@ -27,11 +27,12 @@
 // changes as objects since the last, which makes it O(1) a change amortized however the
 // clock moves: when the clock has passed t_ref, when that many changes placed objects beyond
 // the positions or velocities laid out (a fleet that moves elsewhere or speeds up while the
-// clock stands still), and when the count doubles. A fleet that gathers somewhere new while
-// the clock stands still can be caught half moved (a layout over both places, few cells in
-// each) until the clock passes t_ref. Between layouts the bounds stay exact at every time,
-// before the clock too: only the widening grows with |s - t_ref|, and an object whose
-// velocity falls beyond the bands of the last layout widens its edge band. Positions are
+// clock stands still), when the count doubles or falls to a quarter, and after as many
+// changes as objects whatever the clock (so a fleet caught half moved by a layout, spread
+// over two places with few cells in each, is laid out again once it has moved on). Between
+// layouts the bounds stay exact at every time, before the clock too: only the widening
+// grows with |s - t_ref|, and an object whose velocity falls beyond the bands of the last
+// layout widens its edge band. Positions are
 // extrapolated to t_ref in floating point, and inside() solves for times in absolute time,
 // so the regions looked at are padded by 1e-12 of the magnitudes involved (an object at
 // 1e100 among objects near 0 makes every query look at most cells: still exact, as slow as
@@ -78,8 +79,8 @@ class MovingGrid {
   static constexpr const char* kName = "MovingGrid";
 
   explicit MovingGrid(const MovingGridParams<D>& p = {}) : params_(p) {
-    if (!(p.horizon >= 0) || !std::isfinite(p.horizon))
-      throw InvalidArgument("MovingGrid: the horizon must be a finite number >= 0");
+    if (!(p.horizon >= 0) || !(p.horizon <= kMaxCoordinate))
+      throw InvalidArgument("MovingGrid: the horizon must be a number from 0 to 1e150");
     if (p.bands < 1 || p.bands > 16)
       throw InvalidArgument("MovingGrid: velocity bands must be between 1 and 16");
     if (!(p.per_cell >= 1) || !std::isfinite(p.per_cell))
@@ -138,6 +139,7 @@ class MovingGrid {
     free_.push_back(s);
     --count_;
     ++changes_;
+    maybe_layout();
     return true;
   }
 
@@ -182,9 +184,11 @@ class MovingGrid {
         const double u2 = w2hi - std::min(b.vlo[a] * d2, b.vhi[a] * d2);
         // Rounding: of the positions at t_ref, of the window's bounds, and of the times
         // inside() solves for in absolute time (at epoch seconds a step of 2^-22 s).
+        // (The window's own bounds move too, and are extended to each object's report time.)
         const double pad = kPad * (mag_ +
-                                   vabs_ * (std::abs(d1) + std::abs(d2) + std::abs(w.t1) +
-                                            std::abs(w.t2) + std::abs(t_ref_)) +
+                                   (vabs_ + std::abs(w.vmin()[a]) + std::abs(w.vmax()[a])) *
+                                       (std::abs(d1) + std::abs(d2) + std::abs(w.t1) +
+                                        std::abs(w.t2) + std::abs(t_ref_) + tabs_) +
                                    std::abs(w.from.min[a]) + std::abs(w.from.max[a]) +
                                    std::abs(w2lo) + std::abs(w2hi));
         lo[a] = axis_cell(std::min(l1, l2) - pad, a);
@@ -250,7 +254,7 @@ class MovingGrid {
         r.q[a] = q[a] - mid * delta;
         r.reach[a] = (0.5 * b.vhi[a] - 0.5 * b.vlo[a]) * std::abs(delta) +
                      kPad * (mag_ + std::abs(q[a]) + std::abs(r.q[a]) +
-                             vabs_ * (std::abs(delta) + std::abs(s) + std::abs(t_ref_)) +
+                             vabs_ * (std::abs(delta) + std::abs(s) + std::abs(t_ref_) + tabs_) +
                              std::abs(origin_[a])) +
                      1e-9 * width_[a];
         r.center[a] = axis_cell(r.q[a], a);
@@ -286,22 +290,25 @@ class MovingGrid {
         }
       });
       // The next ring's objects lie beyond this ring's block on some axis, and on every axis
-      // at least the class's gap away.
-      double others = 0;
-      for (int a = 0; a < D; ++a)
-        others += r.gap[a] * r.gap[a];
+      // at least the class's gap away. (Sums only: a bound that overflows stays infinite,
+      // and the ring is still visited while fewer than k objects are found.)
       double next = std::numeric_limits<double>::infinity();
+      bool more = false;
       for (int a = 0; a < D; ++a) {
         auto beyond = [&](double side) {
+          more = true;
           const double g = std::max(side, r.gap[a]);
-          next = std::min(next, others - r.gap[a] * r.gap[a] + g * g);
+          double b2 = g * g;
+          for (int o = 0; o < D; ++o)
+            if (o != a) b2 += r.gap[o] * r.gap[o];
+          next = std::min(next, b2);
         };
         if (r.center[a] - ring.r - 1 >= 0)
           beyond(r.q[a] - edge(a, r.center[a] - ring.r) - r.reach[a]);
         if (r.center[a] + ring.r + 1 < int(cells_axis_[a]))
           beyond(edge(a, r.center[a] + ring.r + 1) - r.q[a] - r.reach[a]);
       }
-      if (next < std::numeric_limits<double>::infinity()) {
+      if (more) {
         rings.push_back({next, ring.cls, ring.r + 1});
         std::push_heap(rings.begin(), rings.end(), farther);
       }
@@ -496,6 +503,7 @@ class MovingGrid {
       b.lo[a] = std::min(b.lo[a], x);
       b.hi[a] = std::max(b.hi[a], x);
       vabs_ = std::max(vabs_, std::abs(m.v[a]));
+      tabs_ = std::max(tabs_, std::abs(m.t));
       outside |= !(laid_lo_[a] <= x && x <= laid_hi_[a]) ||
                  !(laid_vlo_[a] <= m.v[a] && m.v[a] <= laid_vhi_[a]);
     }
@@ -520,14 +528,17 @@ class MovingGrid {
   }
 
   // A layout costs O(n), so one follows at least count / 8 changes (and O(1) a change
-  // amortized): when the count doubled, when the clock passed t_ref, or when that many
-  // changes placed objects beyond the positions or velocities laid out (a fleet that moved
-  // elsewhere, or sped up, while the clock stood still).
+  // amortized): when the count doubled or fell to a quarter, when the clock passed t_ref,
+  // when that many changes placed objects beyond the positions or velocities laid out (a
+  // fleet that moved elsewhere, or sped up, while the clock stood still), and after as many
+  // changes as objects whatever the clock.
   void maybe_layout() {
     const std::size_t enough = count_ / 8 + 16;
     const bool grew = count_ > 2 * laid_out_ + 16;
+    const bool shrank = 4 * count_ + 16 < laid_out_;
     const bool aged = clock_ > t_ref_ && changes_ >= enough;
-    if (grew || aged || drift_ >= enough) layout();
+    const bool turned = changes_ >= count_ + 16;
+    if (grew || shrank || aged || turned || drift_ >= enough) layout();
   }
 
   // Lays the grid out afresh for the objects held: t_ref, cells and bands.
@@ -597,6 +608,7 @@ class MovingGrid {
       laid_lo_[a] = lo[a], laid_hi_[a] = hi[a], laid_vlo_[a] = vlo[a], laid_vhi_[a] = vhi[a];
     mag_ = 0;
     vabs_ = 0;
+    tabs_ = 0;
     for (const Record& r : all)
       put(r.slot, r.id, r.m);
     laid_out_ = all.size();
@@ -617,7 +629,7 @@ class MovingGrid {
   std::size_t count_ = 0, laid_out_ = 0, changes_ = 0, layouts_ = 0, drift_ = 0;
   // The extent of the reference positions and velocities at the last layout.
   double laid_lo_[D] = {}, laid_hi_[D] = {}, laid_vlo_[D] = {}, laid_vhi_[D] = {};
-  double t_ref_ = 0, mag_ = 0, vabs_ = 0;
+  double t_ref_ = 0, mag_ = 0, vabs_ = 0, tabs_ = 0;
   double clock_ = -std::numeric_limits<double>::infinity();
 };
 
