@@ -194,10 +194,7 @@ class MovingGrid {
         lo[a] = axis_cell(std::min(l1, l2) - pad, a);
         hi[a] = axis_cell(std::max(u1, u2) + pad, a);
       }
-      int at[D];
-      for (int a = 0; a < D; ++a)
-        at[a] = lo[a];
-      for (;;) {
+      const bool go = for_box(lo, hi, [&](const int* at) {
         const std::vector<Record>& cell = cells_[k * cells_per_class_ + linear(at)];
         ++st.nodes_visited;
         st.entries_tested += cell.size();
@@ -205,19 +202,12 @@ class MovingGrid {
           const bool in = slice ? intersects(w.from, position(r.m, w.t1)) : inside(r.m, w);
           if (in) {
             ++st.results;
-            if (!visit(r.id, r.m)) return st;
+            if (!visit(r.id, r.m)) return false;
           }
         }
-        int a = 0;
-        for (; a < D; ++a) {
-          if (at[a] < hi[a]) {
-            ++at[a];
-            break;
-          }
-          at[a] = lo[a];
-        }
-        if (a == D) break;
-      }
+        return true;
+      });
+      if (!go) break;
     }
     return st;
   }
@@ -401,6 +391,26 @@ class MovingGrid {
   }
   static bool farther(const Ring& x, const Ring& y) { return x.bound > y.bound; }
 
+  // Calls f(cell) for each cell of the box of cell indices [lo, hi] (axis 0 fastest) until f
+  // returns false; false when it did.
+  template <class F>
+  static bool for_box(const int* lo, const int* hi, F&& f) {
+    int at[D];
+    for (int a = 0; a < D; ++a)
+      at[a] = lo[a];
+    for (;;) {
+      if (!f(static_cast<const int*>(at))) return false;
+      int a = 0;
+      for (; a < D; ++a) {
+        if (at[a] < hi[a]) {
+          ++at[a];
+          break;
+        }
+        at[a] = lo[a];
+      }
+      if (a == D) return true;
+    }
+  }
   // Calls f(cell) for each cell of the grid at Chebyshev distance r from `center`, once: the
   // first axis at distance r is pinned to one of its two sides, the axes before it range
   // strictly inside, those after it over the whole block.
@@ -410,28 +420,19 @@ class MovingGrid {
       for (int side = 0; side < (r == 0 ? 1 : 2); ++side) {
         const int at_pin = side ? center[pin] + r : center[pin] - r;
         if (at_pin < 0 || at_pin >= int(cells_axis_[pin])) continue;
-        int lo[D], hi[D], at[D];
+        int lo[D], hi[D];
         bool none = false;
         for (int a = 0; a < D; ++a) {
           const int inner = a < pin ? r - 1 : r;
           lo[a] = a == pin ? at_pin : std::max(0, center[a] - inner);
           hi[a] = a == pin ? at_pin : std::min(int(cells_axis_[a]) - 1, center[a] + inner);
           none |= lo[a] > hi[a];
-          at[a] = lo[a];
         }
         if (none) continue;
-        for (;;) {
-          f(static_cast<const int*>(at));
-          int a = 0;
-          for (; a < D; ++a) {
-            if (at[a] < hi[a]) {
-              ++at[a];
-              break;
-            }
-            at[a] = lo[a];
-          }
-          if (a == D) break;
-        }
+        for_box(lo, hi, [&](const int* at) {
+          f(at);
+          return true;
+        });
       }
       if (r == 0) return;  // the center cell alone
     }
