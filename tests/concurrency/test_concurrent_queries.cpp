@@ -15,6 +15,7 @@
 #include "loci/index/interval_tree.hpp"
 #include "loci/index/kd_tree.hpp"
 #include "loci/index/moving/conflicts.hpp"
+#include "loci/index/moving/moving_grid.hpp"
 #include "loci/index/packed_rtree.hpp"
 #include "loci/index/pr_quadtree.hpp"
 #include "loci/index/rstar_tree.hpp"
@@ -98,6 +99,34 @@ TEST(ConcurrentQueries, PackedRTreeAndRStarTree) {
   EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return box_query_is_exact(packed, boxes, rng); }),
             0u);
   EXPECT_EQ(hammer([&](std::mt19937_64& rng) { return box_query_is_exact(rstar, boxes, rng); }),
+            0u);
+}
+
+// The moving grid's windows and nearest-n from many threads at once (nearest-n leases its
+// scratch per thread).
+TEST(ConcurrentQueries, MovingGrid) {
+  const auto fleet = make_fleet(Fleet::clustered, 3000, 12);
+  MovingGrid<2> grid;
+  for (std::size_t i = 0; i < fleet.size(); ++i)
+    grid.insert(Id(i), fleet[i]);
+  EXPECT_EQ(hammer([&](std::mt19937_64& rng) {
+              std::uniform_real_distribution<double> u(0, 1000), ahead(0, 60);
+              const double x = u(rng), y = u(rng), t = ahead(rng);
+              const auto w = rng() % 2
+                                 ? MovingWindow<2>::at({{x, y}, {x + 80, y + 80}}, t)
+                                 : MovingWindow<2>::during({{x, y}, {x + 80, y + 80}}, t, t + 5);
+              std::vector<Id> want;
+              std::vector<double> d;
+              const Point2 p{u(rng), u(rng)};
+              for (std::size_t i = 0; i < fleet.size(); ++i) {
+                if (inside(fleet[i], w)) want.push_back(Id(i));
+                d.push_back(std::sqrt(squared_distance(position(fleet[i], t), p)));
+              }
+              std::nth_element(d.begin(), d.begin() + 4, d.end());
+              const auto near = grid.nearest(p, t, 5);
+              return sorted_ids(grid.query(w)) == want && near.size() == 5 &&
+                     near.back().distance == d[4];
+            }),
             0u);
 }
 
