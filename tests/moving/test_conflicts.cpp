@@ -485,6 +485,44 @@ TEST(Conflicts, TouchingPairsReportedLongBeforeNowInEverySlice) {
   }
 }
 
+// At epoch-second times a pair's entry time, now plus its time from now, rounds to the
+// clock's step there (2^-22 s near 1.7e9): a head-on pair entering less than half a step
+// after a slice's end is given that slice, whose boxes must still meet. Far out (1e17,
+// 1e150) a slice is shorter than the step and the first slices are a single instant.
+TEST(Conflicts, EntryTimesRoundingOntoASliceBoundary) {
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const double horizon = 60, within = 10, speed = 24;
+  for (const std::size_t slices : {2, 7}) {
+    const double now = 1.7e9, step = horizon / double(slices);
+    std::size_t want = 0, found = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+      const double t1 = now + step * double(1 + trial % (slices - 1));  // an inner slice end
+      const double u = (t1 - now) + u01(rng) * 0.5 * (std::nextafter(t1, INFINITY) - t1);
+      const std::vector<Motion2> pair{{now, {0, 0}, {0, 0}},
+                                      {now, {within + speed * u, 0}, {-speed, 0}}};
+      if (!closest_approach(pair[0], pair[1], now, horizon, within)) continue;
+      ++want;
+      find_conflicts<2>(
+          pair, within, now, horizon,
+          [&](std::uint32_t, std::uint32_t, const Approach&) { return ++found, true; }, slices);
+    }
+    EXPECT_GE(want, 300u);
+    EXPECT_EQ(found, want) << slices << " slices";
+  }
+  for (const double now : {1e17, 1e150})
+    for (const std::size_t slices : {1, 2, 16}) {
+      const std::vector<Motion2> pair{{now, {0, 0}, {0, 0}},
+                                      {now, {within + speed * 5, 0}, {-speed, 0}}};
+      ASSERT_TRUE(closest_approach(pair[0], pair[1], now, 10, within));
+      int found = 0;
+      find_conflicts<2>(
+          pair, within, now, 10,
+          [&](std::uint32_t, std::uint32_t, const Approach&) { return ++found, true; }, slices);
+      EXPECT_EQ(found, 1) << "now " << now << ", " << slices << " slices";
+    }
+}
+
 TEST(Conflicts, VisitorStops) {
   const auto fleet = test::make_fleet(test::Fleet::identical, 300, 2);
   int seen = 0;

@@ -83,14 +83,18 @@ namespace detail {
 // whose positions the exact test measures from (t0 by default): the box is padded for the
 // rounding of the positions at t0 and t1 and of those at `from` carried forward, which differ
 // from each other by rounding that grows with the times elapsed since the report (a report
-// long before `from` moved over many steps), not only with the coordinates.
+// long before `from` moved over many steps), not only with the coordinates, and for the
+// rounding of the absolute times themselves.
 template <int D>
 Box<D> grown_sweep(const Motion<D>& m, double t0, double t1, double grow, double from) {
   const Point<D> a = position(m, t0), b = position(m, t1);
   Box<D> box = Box<D>::of_point(a);
   box.expand(b);
-  const double elapsed =
-      std::abs(from - m.t) + std::abs(t0 - m.t) + std::abs(t1 - m.t) + std::abs(t1 - from);
+  // Times elapsed since the report and since `from`, and the times themselves: the exact
+  // test's entry time, now + a time from now, rounds to a step of the clock there (2^-22 s
+  // near 1.7e9), so a pair entering just after t1 can be given the slice ending at t1.
+  const double elapsed = std::abs(from - m.t) + std::abs(t0 - m.t) + std::abs(t1 - m.t) +
+                         std::abs(t1 - from) + std::abs(t0) + std::abs(t1);
   for (int i = 0; i < D; ++i) {
     // A hair over `grow`, relative to the coordinates and the distances moved, so that
     // rounding never shrinks it.
