@@ -907,6 +907,21 @@ TEST(MovingGrid, NearestBeyondOverflowingDistancesIsRefused) {
   }
 }
 
+// A layout costs O(cells) as well as O(objects): a few objects among many classes (3D, 16
+// bands a axis: 4,096 classes) are not laid out again every few updates.
+TEST(MovingGrid, FewObjectsAmongManyClassesAreNotLaidOutOften) {
+  MovingGrid<3> grid(MovingGridParams<3>{0, 16, 1});
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(0, 100), v(-5, 5);
+  for (int step = 1; step <= 2000; ++step)
+    grid.update(Id(step % 3),
+                Motion<3>{double(step), {u(rng), u(rng), u(rng)}, {v(rng), v(rng), v(rng)}});
+  EXPECT_EQ(grid.size(), 3u);
+  EXPECT_LE(grid.layouts(), 8u);  // the growth to 3 objects, then about one per 512 updates
+  grid.validate();
+  EXPECT_EQ(grid.nearest(Point<3>{50, 50, 50}, 2000, 5).size(), 3u);
+}
+
 TEST(MovingGrid, RefusesBadParameters) {
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{-1, 3, 32}), InvalidArgument);
   EXPECT_THROW(MovingGrid<2>(MovingGridParams<2>{NAN, 3, 32}), InvalidArgument);

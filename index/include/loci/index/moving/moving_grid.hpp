@@ -343,7 +343,7 @@ class MovingGrid {
           if (!(b.lo[a] <= reference(r.m, a) && reference(r.m, a) <= b.hi[a]))
             throw Error(std::string(kName) + ": a position lies outside its class's bounds");
         }
-        if (magnitude(r.m) > mag_)
+        if (magnitude(r.m) > mag_ || std::abs(r.m.t) > tabs_)
           throw Error(std::string(kName) + ": a record's magnitude exceeds the grid's");
       }
     }
@@ -528,17 +528,18 @@ class MovingGrid {
     slots_[s] = {};
   }
 
-  // A layout costs O(n), so one follows at least count / 8 changes (and O(1) a change
-  // amortized): when the count doubled or fell to a quarter, when the clock passed t_ref,
+  // A layout costs O(n + cells), so one follows at least (count + cells) / 8 changes (and
+  // O(1) a change amortized, however many classes a few objects have): when the count
+  // doubled or fell to a quarter, when the clock passed t_ref,
   // when that many changes placed objects beyond the positions or velocities laid out (a
   // fleet that moved elsewhere, or sped up, while the clock stood still), and after as many
   // changes as objects whatever the clock.
   void maybe_layout() {
-    const std::size_t enough = count_ / 8 + 16;
+    const std::size_t enough = (count_ + cells_.size()) / 8 + 16;
     const bool grew = count_ > 2 * laid_out_ + 16;
     const bool shrank = 4 * count_ + 16 < laid_out_;
     const bool aged = clock_ > t_ref_ && changes_ >= enough;
-    const bool turned = changes_ >= count_ + 16;
+    const bool turned = changes_ >= count_ + cells_.size() + 16;
     if (grew || shrank || aged || turned || drift_ >= enough) layout();
   }
 
