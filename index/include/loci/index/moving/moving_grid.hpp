@@ -118,14 +118,15 @@ class MovingGrid {
     if (s == kNone) return insert(id, m);
     check_motion(m);
     clock_ = std::max(clock_, m.t);
-    const std::uint32_t c = cell_of(m);
+    const Point<D> x = reference(m);
+    const std::uint32_t c = cell_of(m, x);
     Slot& slot = slots_[s];
     if (c == slot.cell) {
-      widen(c, m);
+      widen(c, m, x);
       cells_[c][slot.index].m = m;
     } else {
       take(s);
-      place(s, id, m, c);
+      place(s, id, m, c, x);
     }
     ++changes_;
     maybe_layout();
@@ -440,14 +441,21 @@ class MovingGrid {
 
   // The object's position at t_ref, on axis a.
   double reference(const Motion<D>& m, int a) const { return m.p[a] + m.v[a] * (t_ref_ - m.t); }
-  // A bound on the magnitudes of the arithmetic of m's reference position.
-  double magnitude(const Motion<D>& m) const {
+  Point<D> reference(const Motion<D>& m) const {
+    Point<D> x;
+    for (int a = 0; a < D; ++a)
+      x[a] = reference(m, a);
+    return x;
+  }
+  // A bound on the magnitudes of the arithmetic of m's reference position x.
+  double magnitude(const Motion<D>& m, const Point<D>& x) const {
     double g = 0;
     for (int a = 0; a < D; ++a)
-      g = std::max(g, std::abs(m.p[a]) + std::abs(m.v[a]) * std::abs(t_ref_ - m.t) +
-                          std::abs(reference(m, a)));
+      g = std::max(g,
+                   std::abs(m.p[a]) + std::abs(m.v[a]) * std::abs(t_ref_ - m.t) + std::abs(x[a]));
     return g;
   }
+  double magnitude(const Motion<D>& m) const { return magnitude(m, reference(m)); }
   // The cell of coordinate x on axis a, clamped to the grid: monotone in x.
   int axis_cell(double x, int a) const {
     const double f = std::floor((x - origin_[a]) * inverse_[a]);
@@ -472,12 +480,14 @@ class MovingGrid {
     }
     return k;
   }
-  std::uint32_t cell_of(const Motion<D>& m) const {
+  // The cell of m, x its reference position.
+  std::uint32_t cell_of(const Motion<D>& m, const Point<D>& x) const {
     int at[D];
     for (int a = 0; a < D; ++a)
-      at[a] = axis_cell(reference(m, a), a);
+      at[a] = axis_cell(x[a], a);
     return class_of(m) * cells_per_class_ + linear(at);
   }
+  std::uint32_t cell_of(const Motion<D>& m) const { return cell_of(m, reference(m)); }
   // A lower bound on the squared distance at the query's time of any object of cell `at` in
   // the class of r.
   double cell_bound(const Around& r, const int* at) const {
@@ -492,13 +502,16 @@ class MovingGrid {
     return g2;
   }
 
-  void put(std::uint32_t s, Id id, const Motion<D>& m) { place(s, id, m, cell_of(m)); }
-  // The bounds cell c's class and the grid keep, widened for m.
-  void widen(std::uint32_t c, const Motion<D>& m) {
+  void put(std::uint32_t s, Id id, const Motion<D>& m) {
+    const Point<D> x = reference(m);
+    place(s, id, m, cell_of(m, x), x);
+  }
+  // The bounds cell c's class and the grid keep, widened for m (reference position ref).
+  void widen(std::uint32_t c, const Motion<D>& m, const Point<D>& ref) {
     Band& b = band_[c / cells_per_class_];
     bool outside = false;
     for (int a = 0; a < D; ++a) {
-      const double x = reference(m, a);
+      const double x = ref[a];
       b.vlo[a] = std::min(b.vlo[a], m.v[a]);
       b.vhi[a] = std::max(b.vhi[a], m.v[a]);
       b.lo[a] = std::min(b.lo[a], x);
@@ -509,10 +522,10 @@ class MovingGrid {
                  !(laid_vlo_[a] <= m.v[a] && m.v[a] <= laid_vhi_[a]);
     }
     drift_ += outside;
-    mag_ = std::max(mag_, magnitude(m));
+    mag_ = std::max(mag_, magnitude(m, ref));
   }
-  void place(std::uint32_t s, Id id, const Motion<D>& m, std::uint32_t c) {
-    widen(c, m);
+  void place(std::uint32_t s, Id id, const Motion<D>& m, std::uint32_t c, const Point<D>& x) {
+    widen(c, m, x);
     slots_[s] = {c, std::uint32_t(cells_[c].size())};
     cells_[c].push_back({m, id, s});
   }
@@ -545,11 +558,9 @@ class MovingGrid {
 
   // Lays the grid out afresh for the objects held: t_ref, cells and bands.
   void layout() {
-    std::vector<Record> all;
-    all.reserve(count_);
-    for (std::vector<Record>& cell : cells_)
-      for (const Record& r : cell)
-        all.push_back(r);
+    // The records are read from the old cells, moved out (not copied into one list first).
+    const std::vector<std::vector<Record>> old = std::move(cells_);
+    cells_.clear();
     ++layouts_;
     t_ref_ = std::isfinite(clock_) ? clock_ + 0.5 * params_.horizon : 0.0;
     // Velocity bands over the velocities held, positions' extent at t_ref.
@@ -558,14 +569,15 @@ class MovingGrid {
       lo[a] = vlo[a] = std::numeric_limits<double>::infinity();
       hi[a] = vhi[a] = -std::numeric_limits<double>::infinity();
     }
-    for (const Record& r : all)
-      for (int a = 0; a < D; ++a) {
-        const double x = reference(r.m, a);
-        lo[a] = std::min(lo[a], x), hi[a] = std::max(hi[a], x);
-        vlo[a] = std::min(vlo[a], r.m.v[a]), vhi[a] = std::max(vhi[a], r.m.v[a]);
-      }
+    for (const std::vector<Record>& cell : old)
+      for (const Record& r : cell)
+        for (int a = 0; a < D; ++a) {
+          const double x = reference(r.m, a);
+          lo[a] = std::min(lo[a], x), hi[a] = std::max(hi[a], x);
+          vlo[a] = std::min(vlo[a], r.m.v[a]), vhi[a] = std::max(vhi[a], r.m.v[a]);
+        }
     const double total = std::max(
-        1.0, std::min(double(all.size()) / (params_.per_cell * double(classes_)), double(1 << 22)));
+        1.0, std::min(double(count_) / (params_.per_cell * double(classes_)), double(1 << 22)));
     // Cells of equal sides over the axes whose extent is at least a side (logarithms: the
     // product of extents near 1e300 would overflow); an axis thinner than a side has one
     // cell, and the side is worked out again over the others, so that the cells number about
@@ -611,9 +623,10 @@ class MovingGrid {
     mag_ = 0;
     vabs_ = 0;
     tabs_ = 0;
-    for (const Record& r : all)
-      put(r.slot, r.id, r.m);
-    laid_out_ = all.size();
+    for (const std::vector<Record>& cell : old)
+      for (const Record& r : cell)
+        put(r.slot, r.id, r.m);
+    laid_out_ = count_;
     changes_ = 0;
     drift_ = 0;
   }
