@@ -696,7 +696,9 @@ class ConflictMonitor {
   };
 
   void mark(std::uint32_t s) {
-    ++version_[s];
+    // After 2^32 reports and removals the slot's count comes round to the versions its kept
+    // pairs were found with, which would make them look current again: they go first.
+    if (++version_[s] == 0) drop_pairs_of(s);
     if (!dirty_[s]) {
       dirty_[s] = 1;
       dirty_list_.push_back(s);
@@ -728,6 +730,11 @@ class ConflictMonitor {
     kept_.push_back(k);
     ++degree_[s];
     ++degree_[t];
+  }
+  // Drops every kept pair of slot s, and the forgotten pairs.
+  void drop_pairs_of(std::uint32_t s) {
+    std::erase_if(kept_, [&](const Kept& k) { return k.s == s || k.t == s; });
+    sweep();
   }
   // Drops the forgotten pairs.
   void sweep() {
