@@ -353,11 +353,21 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
     ids.push_back(r.id);
     motions.push_back(r.m);
   }
-  const std::vector<Conflict> found = find_conflicts<2>(ids, motions, o.within, l.now, o.horizon);
-  auto motion_of = [&](Id id) {
-    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
-    return motions[std::size_t(it - ids.begin())];
+  // By index into the reports (sorted by id, one per id), so that a pair's reports are at
+  // hand for its positions, not looked up by id; in the order of (id_a, id_b).
+  struct Found {
+    std::uint64_t key;  // the indices of a and b, a's high
+    Approach approach;
   };
+  std::vector<Found> found;
+  find_conflicts<2>(std::span<const Motion2>(motions), o.within, l.now, o.horizon,
+                    [&](std::uint32_t i, std::uint32_t j, const Approach& ap) {
+                      if (j < i) std::swap(i, j);
+                      found.push_back({std::uint64_t(i) << 32 | j, ap});
+                      return true;
+                    });
+  std::sort(found.begin(), found.end(),
+            [](const Found& x, const Found& y) { return x.key < y.key; });
   const bool ais = l.ais();
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
@@ -371,10 +381,11 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   else
     row += "{\"type\":\"FeatureCollection\",\"features\":[";
   for (std::size_t i = 0; i < found.size(); ++i) {
-    const Conflict& c = found[i];
+    const std::size_t ia = std::size_t(found[i].key >> 32), ib = std::uint32_t(found[i].key);
+    const Conflict c{ids[ia], ids[ib], found[i].approach};
     const Approach& ap = c.approach;
-    const Point2 a = shown(l, position(motion_of(c.a), ap.tcpa));
-    const Point2 b = shown(l, position(motion_of(c.b), ap.tcpa));
+    const Point2 a = shown(l, position(motions[ia], ap.tcpa));
+    const Point2 b = shown(l, position(motions[ib], ap.tcpa));
     if (!csv)
       row += i ? ",\n{\"type\":\"Feature\",\"properties\":{"
                : "\n{\"type\":\"Feature\",\"properties\":{";
