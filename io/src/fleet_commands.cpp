@@ -360,6 +360,8 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
     Approach approach;
   };
   std::vector<Found> found;
+  check_conflict_objects<2>(std::span<const Motion2>(motions), l.now, o.horizon,
+                            [&](std::size_t i) { return "id " + std::to_string(ids[i]); });
   find_conflicts<2>(std::span<const Motion2>(motions), o.within, l.now, o.horizon,
                     [&](std::uint32_t i, std::uint32_t j, const Approach& ap) {
                       if (j < i) std::swap(i, j);
@@ -705,12 +707,17 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
   // The simulated reports turn but keep their speed: every object must stay within +-1e150
   // until the last tick's horizon whichever way it turns.
   const double span = o.tick * double(o.ticks) + o.horizon;
-  for (const Motion2& m : motions) {
+  if (!(std::abs(l.now + span) <= kMaxCoordinate))
+    throw InvalidArgument("--ticks x --tick + --horizon carry the simulation's clock beyond 1e150");
+  for (std::size_t i = 0; i < motions.size(); ++i) {
+    const Motion2& m = motions[i];
     const Point2 p = position(m, l.now);
     const double reach = std::hypot(m.v[0], m.v[1]) * span;
-    if (!(std::abs(l.now + span) <= kMaxCoordinate) ||
-        !(std::max(std::abs(p[0]), std::abs(p[1])) + reach <= kMaxCoordinate))
-      throw InvalidArgument("--tick and --ticks carry the simulation beyond 1e150");
+    if (!(std::max(std::abs(p[0]), std::abs(p[1])) + reach <= kMaxCoordinate))
+      throw InvalidArgument("id " + std::to_string(ids[i]) +
+                            " would move beyond 1e150 during the simulation (--ticks x --tick "
+                            "+ --horizon = " +
+                            num(span) + ")");
   }
   FleetIndex ix = index_of(start);
   FleetSimulateReport rep;

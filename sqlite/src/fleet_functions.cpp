@@ -119,6 +119,10 @@ void conflicts(sqlite3* db, const Registry& registry, std::span<sqlite3_value* c
     ids.push_back(ordered_key(id));
     motions.push_back(m);
   }
+  // Named by their SQL ids (the keys passed below are not).
+  check_conflict_objects<2>(std::span<const Motion2>(motions), now, horizon, [&](std::size_t i) {
+    return "id " + std::to_string(reports[i].first);
+  });
   for (const Conflict& c : find_conflicts<2>(ids, motions, within, now, horizon)) {
     rows.add(sqlite3_int64(id_of_ordered(c.a)));
     rows.add(sqlite3_int64(id_of_ordered(c.b)));

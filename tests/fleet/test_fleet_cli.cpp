@@ -516,8 +516,20 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   expect_one_line_error(
       run_loci("fleet simulate " + shell_quote(good) +
                " --ticks 3 --within 1 --horizon 1 --tick 1e300 -o " + shell_quote(path("sim.csv"))),
-      "--tick and --ticks");
+      "--ticks x --tick + --horizon carry the simulation's clock beyond 1e150");
   EXPECT_FALSE(fs::exists(path("sim.csv")));
+  // An object that would leave the range is named by its id (not its place in the input), and
+  // the options that carry it there are named, --horizon among them.
+  const std::string mover = write("mover.csv",
+                                  "id,t,x,y,vx,vy\n5,0,0,0,0,0\n6,0,1,1,0,0\n"
+                                  "42,0,3,3,1e10,0\n");
+  expect_one_line_error(
+      run_loci("fleet simulate " + shell_quote(mover) + " --ticks 3 --within 2 --horizon 1e141 -q"),
+      "id 42 would move beyond 1e150 during the simulation (--ticks x --tick + "
+      "--horizon = ");
+  expect_one_line_error(
+      run_loci("fleet conflicts " + shell_quote(mover) + " --within 1 --horizon 1e141 -q"),
+      "conflicts: id 42 moves beyond 1e150");
   expect_one_line_error(run_loci(g + " --within 1 --horizon 5 --bogus"), "unknown option");
   expect_one_line_error(run_loci("fleet query " + shell_quote(good) + " --bbox 1,2,3"), "--bbox");
   expect_one_line_error(run_loci("fleet query " + shell_quote(good)), "--bbox");

@@ -209,6 +209,12 @@ TEST(Conflicts, PositionsBeyondTheRangeAreRefused) {
   EXPECT_EQ(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 0, 1e9).size(), 1u);
   EXPECT_THROW(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 0, 1e11), InvalidArgument);
   EXPECT_THROW(find_conflicts<2>(std::vector<Id>{1, 2}, fleet, 2, 1e11, 1), InvalidArgument);
+  try {
+    find_conflicts<2>(std::vector<Id>{8, 9}, fleet, 2, 0, 1e11);
+    ADD_FAILURE() << "a position beyond 1e150 was taken";
+  } catch (const InvalidArgument& e) {
+    EXPECT_EQ(std::string(e.what()), "conflicts: id 8 moves beyond 1e150 in the time searched");
+  }
   // Velocities beyond 1e150 are refused even where the positions stay in range (a horizon of
   // 0): their differences could overflow. 1e150 itself is taken.
   for (const double v : {1e150, std::nextafter(1e150, 2e150), -1e300, 1e308}) {
@@ -217,11 +223,21 @@ TEST(Conflicts, PositionsBeyondTheRangeAreRefused) {
       EXPECT_EQ(find_conflicts<2>(std::vector<Id>{1, 2}, fast, 2, 0, 0).size(), 1u);
       continue;
     }
-    try {
-      find_conflicts<2>(std::vector<Id>{1, 2}, fast, 2, 0, 0);
+    try {  // by index into the input
+      find_conflicts<2>(std::span<const Motion2>(fast), 2, 0, 0,
+                        [](std::uint32_t, std::uint32_t, const Approach&) { return true; });
       ADD_FAILURE() << "a velocity of " << v << " was taken";
     } catch (const InvalidArgument& e) {
       EXPECT_NE(std::string(e.what()).find("object 1 of the input has a velocity beyond 1e150"),
+                std::string::npos)
+          << e.what();
+    }
+    // Named by id where the search is given ids.
+    try {
+      find_conflicts<2>(std::vector<Id>{7, 42}, fast, 2, 0, 0);
+      ADD_FAILURE() << "a velocity of " << v << " was taken";
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("conflicts: id 42 has a velocity beyond 1e150"),
                 std::string::npos)
           << e.what();
     }

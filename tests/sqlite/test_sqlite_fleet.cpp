@@ -442,6 +442,11 @@ TEST(SqliteFleetSql, BadInputIsAnSqlErrorWithAClearMessage) {
   EXPECT_EQ(db.value("SELECT id FROM loci_fleet_nearest('f', 0, 0, 1, 1e11)"), "1");
   EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_conflicts('f', 1, 1e160)"), "beyond 1e150"));
   db.exec("DELETE FROM f WHERE id IN (2, 3, 4)");
+  // The object that would leave the range is named by its SQL id, negative ones too.
+  db.exec("INSERT INTO f VALUES (-5, 0, 0, 0, 1e10, 0)");
+  EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_conflicts('f', 1, 1e141)"),
+                  "conflicts: id -5 moves beyond 1e150"));
+  db.exec("DELETE FROM f WHERE id = -5");
   EXPECT_TRUE(has(db.error_of("SELECT loci_check('plain')"), "not a loci_rtree or loci_fleet"));
 }
 

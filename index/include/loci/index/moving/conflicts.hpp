@@ -256,6 +256,20 @@ template <int D>
 #endif
 }  // namespace detail
 
+// Throws InvalidArgument, naming the object as who(i) does, for the first object a conflict
+// search refuses: a velocity beyond 1e150 (as check_motion refuses it in a report: the relative
+// velocity of two objects could overflow, even over a horizon of 0), or a position leaving
+// +-1e150 during [now, now + horizon]. Every object is checked, however few.
+template <int D, class Name>
+void check_conflict_objects(std::span<const Motion<D>> objects, double now, double horizon,
+                            Name&& who) {
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    if (!within_coordinate_range(objects[i].v))
+      throw InvalidArgument("conflicts: " + who(i) + " has a velocity beyond 1e150");
+    if (!detail::stays_in_range(objects[i], now, now + horizon)) detail::out_of_range(who(i));
+  }
+}
+
 // The broad phase and buffers of conflict searches, kept between calls so that a search
 // repeated every tick reuses its memory (and the broad phase its proxies).
 template <int D>
@@ -364,17 +378,10 @@ class ConflictFinder {
   }
 
  private:
-  // Velocities beyond 1e150 (as check_motion refuses them in a report: the relative velocity
-  // of two objects could overflow, even over a horizon of 0), then positions that leave
-  // +-1e150 over the horizon; every object, however few.
   static void check_objects(std::span<const Motion<D>> objects, double now, double horizon) {
-    for (std::size_t i = 0; i < objects.size(); ++i) {
-      if (!within_coordinate_range(objects[i].v))
-        throw InvalidArgument("conflicts: object " + std::to_string(i) +
-                              " of the input has a velocity beyond 1e150");
-      if (!detail::stays_in_range(objects[i], now, now + horizon))
-        detail::out_of_range("object " + std::to_string(i) + " of the input");
-    }
+    check_conflict_objects<D>(objects, now, horizon, [](std::size_t i) {
+      return "object " + std::to_string(i) + " of the input";
+    });
   }
 
   // Numbers the objects in Hilbert order of their positions at mid-horizon, so that the pairs
@@ -440,6 +447,9 @@ std::vector<Conflict> find_conflicts(std::span<const Id> ids, std::span<const Mo
                                      double within, double now, double horizon) {
   if (ids.size() != objects.size())
     throw InvalidArgument("find_conflicts: ids and objects differ in length");
+  check_conflict_query(within, now, horizon);
+  check_conflict_objects<D>(objects, now, horizon,
+                            [&](std::size_t i) { return "id " + std::to_string(ids[i]); });
   std::vector<Conflict> out;
   find_conflicts<D>(objects, within, now, horizon,
                     [&](std::uint32_t i, std::uint32_t j, const Approach& ap) {
