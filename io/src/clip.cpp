@@ -145,6 +145,7 @@ std::size_t clip_layer(const ClipOptions& options) {
   const std::unique_ptr<OGRGeometry> window = window_of(options);
   refuse_overwriting(options.out_path, options.load.layer_path);
   if (!options.window_layer.empty()) refuse_overwriting(options.out_path, options.window_layer);
+  GDALDriver* driver = detail::driver_for(options.out_path);  // before any work
   const LayerIndex index = load_index(options.load);
   LayerQuery query(index, options.load.layer_path, index.layer_name());
   Query q;
@@ -160,7 +161,6 @@ std::size_t clip_layer(const ClipOptions& options) {
   query.run(q, 1, false, answers);
 
   auto src = detail::open_layer(options.load.layer_path, index.layer_name());
-  GDALDriver* driver = detail::driver_for(options.out_path);
   OutputDataset out(options.out_path);
   std::size_t written = 0;
   {
@@ -238,6 +238,18 @@ std::size_t clip_layer(const ClipOptions& options) {
       if (layer->CreateField(&fd) != OGRERR_NONE)
         throw Error("cannot write " + options.out_path + ": field " + fd.GetNameRef());
     }
+    // A shapefile holds one kind of geometry: a layer that mixes them (GeoJSON, GeoPackage) is
+    // refused with the two kinds, before anything is written.
+    if (!mixed_ok)
+      for (const Piece& p : pieces)
+        if (p.geometry->getDimension() != pieces.front().geometry->getDimension())
+          throw Error("cannot write " + options.out_path +
+                      ": a shapefile holds one kind of geometry, and the window meets feature " +
+                      std::to_string(pieces.front().feature->GetFID()) + " (" +
+                      OGRGeometryTypeToName(pieces.front().geometry->getGeometryType()) +
+                      ") and feature " + std::to_string(p.feature->GetFID()) + " (" +
+                      OGRGeometryTypeToName(p.geometry->getGeometryType()) +
+                      "); write a .gpkg or .geojson instead");
     for (Piece& p : pieces) {
       std::unique_ptr<OGRGeometry> piece = std::move(p.geometry);
       if (wkbFlatten(type) != wkbUnknown)
@@ -247,7 +259,7 @@ std::size_t clip_layer(const ClipOptions& options) {
       o.SetGeometryDirectly(piece.release());
       if (layer->CreateFeature(&o) != OGRERR_NONE)
         throw Error("cannot write " + options.out_path + ": feature " +
-                    std::to_string(p.feature->GetFID()));
+                    std::to_string(p.feature->GetFID()) + " (" + CPLGetLastErrorMsg() + ")");
       ++written;
     }
     // Closing flushes; GDAL reports a failed flush only through its error state.

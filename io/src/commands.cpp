@@ -342,6 +342,14 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
         throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + actual +
                     "' of " + o.layer_path + "; run 'loci index " + o.layer_path +
                     "' or give its own index with --index");
+      // An index given with --index may be another file's as well as a stale one: the command
+      // offered rewrites that index, not the layer's default sidecar.
+      if (!o.index_path.empty())
+        throw Error(path + ": does not match " + o.layer_path + " (" +
+                    stale_reason(sc.info().source, now) +
+                    "): the index of another file, or of this one before it changed; run 'loci "
+                    "index " +
+                    o.layer_path + " -o " + path + "'");
       throw Error(path + ": stale index, " + o.layer_path + " changed since it was indexed (" +
                   stale_reason(sc.info().source, now) + "); run 'loci index " + o.layer_path + "'");
     }

@@ -175,8 +175,10 @@ GDALDriver* driver_for(const std::string& path) {
   std::string ext = CPLGetExtension(path.c_str());
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return std::tolower(c); });
-  const char* name = "GeoJSON";
-  if (ext == "shp")
+  const char* name = nullptr;
+  if (ext == "geojson" || ext == "json")
+    name = "GeoJSON";
+  else if (ext == "shp")
     name = "ESRI Shapefile";
   else if (ext == "gpkg")
     name = "GPKG";
@@ -188,6 +190,10 @@ GDALDriver* driver_for(const std::string& path) {
     name = "KML";
   else if (ext == "gml")
     name = "GML";
+  if (!name)
+    throw InvalidArgument("cannot tell the output format of " + path +
+                          " from its extension: use .geojson, .shp, .gpkg, .fgb, .csv, .kml or "
+                          ".gml");
   GDALDriver* d = GetGDALDriverManager()->GetDriverByName(name);
   if (!d) throw Error(std::string("GDAL has no ") + name + " driver");
   return d;

@@ -54,7 +54,8 @@ class ReadCheck {
   std::string path_;
 };
 
-// A GDAL vector driver chosen from the output file name's extension (GeoJSON by default).
+// A GDAL vector driver chosen from the output file name's extension (.geojson or .json, .shp,
+// .gpkg, .fgb, .csv, .kml, .gml); any other extension is an InvalidArgument.
 GDALDriver* driver_for(const std::string& path);
 
 }  // namespace loci::io::detail

@@ -928,6 +928,29 @@ TEST_F(LayersCli, ReportsBadInput) {
   expect_error("query " + polys + " --bbox-file " + windows, "line 2");
 }
 
+// clip writes the format its output's extension names, and refuses an extension it does not
+// know (rather than writing GeoJSON under it) and a shapefile of mixed kinds of geometry,
+// naming two features of different kinds; neither leaves a file.
+TEST_F(LayersCli, ClipRefusesUnknownFormatsAndMixedShapefiles) {
+  const std::string polys = path("polys.shp");
+  expect_error("clip " + polys + " --bbox 0,0,50,50 -o " + path("c.xyz"),
+               "cannot tell the output format of " + path("c.xyz") + " from its extension");
+  EXPECT_FALSE(fs::exists(path("c.xyz")));
+  const CliRun json = run_loci("clip " + polys + " --bbox 0,0,50,50 -q -o " + path("c.json"));
+  EXPECT_EQ(json.status, 0) << json.err;
+  EXPECT_EQ(read_text(path("c.json")).rfind("{", 0), 0u);
+  const std::string mixed = path("mixed.geojson");
+  std::ofstream(mixed) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1,1]}},
+{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[2,2],[4,2],[4,4],[2,2]]]}}]})";
+  expect_error("clip " + mixed + " --bbox 0,0,9,9 -o " + path("mixed.shp"),
+               "a shapefile holds one kind of geometry, and the window meets feature 0 (Point) "
+               "and feature 1 (Polygon)");
+  EXPECT_FALSE(fs::exists(path("mixed.shp")));
+  const CliRun gpkg = run_loci("clip " + mixed + " --bbox 0,0,9,9 -q -o " + path("mixed.gpkg"));
+  EXPECT_EQ(gpkg.status, 0) << gpkg.err;
+}
+
 TEST_F(LayersCli, UnwritableOutputLeavesNothing) {
   const std::string polys = path("polys.shp");
   expect_error("query " + polys + " --bbox 0,0,50,50 -o /nonexistent-dir/out.txt", "cannot write");
@@ -1070,6 +1093,13 @@ TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {
     f.write(&c, 1);
   }
   expect_error("query " + layer + " --bbox 0,0,9,9", "stale index");
+  // Given with --index, the sidecar may as well be another file's: the message says both, and
+  // the command it offers rewrites that index (the layer's default sidecar path here).
+  expect_error("query " + layer + " --index " + layer + ".loci --bbox 0,0,9,9",
+               ".loci: does not match " + layer +
+                   " (contents changed): the index of another file, or of this "
+                   "one before it changed; run 'loci index " +
+                   layer + " -o " + layer + ".loci'");
   // Really changed: a feature added through GDAL.
   ASSERT_EQ(run_loci("index -q " + layer).status, 0);
   {
