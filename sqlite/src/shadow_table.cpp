@@ -75,37 +75,86 @@ void ShadowTable::rename_shadows(const char* new_name) {
   prepare_statements();
 }
 
-ShadowTable* Registry::find(std::string_view name) const {
-  ShadowTable* found = nullptr;
-  for (ShadowTable* t : tables) {
-    const std::string qualified = t->schema + "." + t->name;
-    const auto same = [&](const std::string& s) {
-      return s.size() == name.size() && strncasecmp(s.data(), name.data(), s.size()) == 0;
-    };
-    if (same(qualified)) return t;
-    if (same(t->name) && (!found || t->schema == "main")) found = t;
+namespace {
+
+bool same_name(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && strncasecmp(a.data(), b.data(), a.size()) == 0;
+}
+
+// Whether schema `schema` holds a table (of any kind) called `table`, as SQL names match
+// (case-insensitive).
+bool holds_table(sqlite3* db, const char* schema, const std::string& table) {
+  static const bool metadata = sqlite3_compileoption_used("ENABLE_COLUMN_METADATA") != 0;
+  if (metadata)
+    return sqlite3_table_column_metadata(db, schema, table.c_str(), nullptr, nullptr, nullptr,
+                                         nullptr, nullptr, nullptr) == SQLITE_OK;
+  sqlite3_stmt* s = nullptr;
+  const std::string sql = format_sql(
+      "SELECT 1 FROM \"%w\".sqlite_schema WHERE type = 'table' AND name = ?1 COLLATE NOCASE",
+      schema);
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) != SQLITE_OK) {
+    sqlite3_finalize(s);
+    return false;
   }
+  sqlite3_bind_text(s, 1, table.data(), int(table.size()), SQLITE_TRANSIENT);
+  const bool found = sqlite3_step(s) == SQLITE_ROW;
+  sqlite3_finalize(s);
   return found;
+}
+
+// The schema SQL would find table `table` in, unqualified: temp, then main, then the attached
+// databases in the order attached; null when none holds it.
+const char* schema_of(sqlite3* db, const std::string& table) {
+  const char* first[] = {"temp", "main"};
+  for (const char* schema : first)
+    if (holds_table(db, schema, table)) return schema;
+  for (int i = 2; const char* schema = sqlite3_db_name(db, i); ++i)
+    if (holds_table(db, schema, table)) return schema;
+  return nullptr;
+}
+
+bool is_schema(sqlite3* db, std::string_view name) {
+  for (int i = 0; const char* schema = sqlite3_db_name(db, i); ++i)
+    if (same_name(schema, name)) return true;
+  return false;
+}
+
+}  // namespace
+
+ShadowTable* Registry::find(std::string_view schema, std::string_view name) const {
+  for (ShadowTable* t : tables)
+    if (same_name(t->schema, schema) && same_name(t->name, name)) return t;
+  return nullptr;
 }
 
 ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* name,
                              const char* function) {
   if (!name) throw SqlError{SQLITE_ERROR, format_sql("%s: the table name is NULL", function)};
-  if (ShadowTable* t = registry.find(name)) return t;
-  // Not connected on this connection yet: naming it in a statement connects it.
+  // "schema.table" where that schema exists and holds that table; otherwise the whole name is
+  // a table's, looked up as SQL looks up an unqualified name.
+  const std::string whole = name;
+  std::string schema, table;
+  if (const auto dot = whole.find('.'); dot != std::string::npos) {
+    const std::string s = whole.substr(0, dot), t = whole.substr(dot + 1);
+    if (is_schema(db, s) && holds_table(db, s.c_str(), t)) schema = s, table = t;
+  }
+  if (schema.empty()) {
+    const char* found = schema_of(db, whole);
+    if (!found) throw SqlError{SQLITE_ERROR, format_sql("%s: no such table: %s", function, name)};
+    schema = found;
+    table = whole;
+  }
+  if (ShadowTable* t = registry.find(schema, table)) return t;
+  // Not connected on this connection yet: naming it in a statement connects it (or says what
+  // is wrong with it, a missing shadow table for instance).
   sqlite3_stmt* s = nullptr;
-  const std::string dot = name;
-  std::string sql;
-  if (const auto p = dot.find('.'); p != std::string::npos && !registry.find(dot.substr(p + 1)))
-    sql = format_sql("SELECT 1 FROM \"%w\".\"%w\" LIMIT 0", dot.substr(0, p).c_str(),
-                     dot.substr(p + 1).c_str());
-  else
-    sql = format_sql("SELECT 1 FROM \"%w\" LIMIT 0", name);
+  const std::string sql =
+      format_sql("SELECT 1 FROM \"%w\".\"%w\" LIMIT 0", schema.c_str(), table.c_str());
   const int rc = sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr);
   sqlite3_finalize(s);
   if (rc != SQLITE_OK)
-    throw SqlError{SQLITE_ERROR, format_sql("%s: no such table: %s", function, name)};
-  return registry.find(name);
+    throw SqlError{SQLITE_ERROR, format_sql("%s: %s: %s", function, name, sqlite3_errmsg(db))};
+  return registry.find(schema, table);
 }
 
 std::vector<std::string> column_arguments(int argc, const char* const* argv, const char* module) {

@@ -76,12 +76,15 @@ struct ShadowTable : sqlite3_vtab {
 // The loci tables connected on one database connection.
 struct Registry {
   std::vector<ShadowTable*> tables;
-  // The table called `name` (case-insensitive; "schema.name" also works); null when absent.
-  ShadowTable* find(std::string_view name) const;
+  // The table `name` of `schema` (both case-insensitive); null when absent.
+  ShadowTable* find(std::string_view schema, std::string_view name) const;
 };
 
 // The table `name`, connecting it if this connection has not yet; null when it exists but is
-// not a loci table. Throws SqlError naming `function` when there is no such table.
+// not a loci table. `name` is found as SQL finds a table name in FROM (temp, then main, then
+// the attached databases in the order attached), or "schema.table" in that schema. Throws
+// SqlError naming `function` when there is no such table, or with SQLite's reason when the
+// table cannot be opened (a shadow table missing, say).
 ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* name,
                              const char* function);
 

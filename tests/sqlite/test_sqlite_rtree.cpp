@@ -526,6 +526,77 @@ TEST(SqliteRtreeSql, CorruptShadowTablesAreReportedNotTrusted) {
   }
 }
 
+// The functions find a table by name as SQL finds it in FROM: temp, then main, then the
+// attached databases in the order attached; "schema.table" in that schema, whichever tables
+// the connection has already opened. Two tables called t (in main and in an attached
+// database, then one in temp too) were mixed up: the bare name answered from the one opened
+// first, and "aux.t" was refused once main's t was open.
+TEST(SqliteRtreeSql, FunctionsFindTablesAsSqlDoes) {
+  TempDir dir;
+  {
+    Db setup(dir.file("main.db"));
+    setup.exec("ATTACH '" + dir.file("aux.db") + "' AS aux");
+    for (const char* schema : {"main", "aux"}) {
+      const std::string id = std::string(schema) == "main" ? "1" : "2";
+      setup.exec(std::string("CREATE VIRTUAL TABLE ") + schema +
+                 ".t USING loci_rtree(id, minx, maxx, miny, maxy)");
+      setup.exec(std::string("INSERT INTO ") + schema + ".t VALUES (" + id + ", 0, 1, 0, 1)");
+      setup.exec(std::string("CREATE VIRTUAL TABLE ") + schema +
+                 ".f USING loci_fleet(id, t, x, y, vx, vy)");
+      setup.exec(std::string("INSERT INTO ") + schema + ".f VALUES (" + id + ", 0, 0, 0, 0, 0)");
+    }
+  }
+  for (const bool aux_first : {true, false}) {
+    Db db(dir.file("main.db"));
+    db.exec("ATTACH '" + dir.file("aux.db") + "' AS aux");
+    const auto nearest = [&](const char* name) {
+      return db.value(std::string("SELECT id FROM loci_nearest('") + name + "', 0, 0, 5)");
+    };
+    const auto window = [&](const char* name) {
+      return db.value(std::string("SELECT id FROM loci_fleet_window('") + name +
+                      "', -1, -1, 1, 1, 0)");
+    };
+    if (aux_first) {
+      EXPECT_EQ(nearest("aux.t"), "2");
+      EXPECT_EQ(window("aux.f"), "2");
+    }
+    EXPECT_EQ(nearest("t"), "1") << aux_first;
+    EXPECT_EQ(window("f"), "1") << aux_first;
+    EXPECT_EQ(db.value("SELECT id FROM t"), "1");
+    EXPECT_EQ(nearest("aux.t"), "2") << aux_first;
+    EXPECT_EQ(nearest("MAIN.T"), "1");
+    EXPECT_EQ(window("aux.f"), "2") << aux_first;
+    EXPECT_EQ(db.value("SELECT loci_check('aux.t')"), "ok");
+    EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+    // A table in temp comes first, as in FROM.
+    db.exec("CREATE VIRTUAL TABLE temp.t USING loci_rtree(id, minx, maxx, miny, maxy)");
+    db.exec("INSERT INTO temp.t VALUES (7, 0, 1, 0, 1)");
+    EXPECT_EQ(db.value("SELECT id FROM t"), "7");
+    EXPECT_EQ(nearest("t"), "7");
+    EXPECT_EQ(nearest("main.t"), "1");
+    EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('nosuch.t', 0, 0, 1)")
+                  .find("loci_nearest: no such table: nosuch.t"),
+              std::string::npos);
+  }
+}
+
+// A table whose shadow table is gone is reported with SQLite's reason, not as missing itself.
+TEST(SqliteRtreeSql, AMissingShadowTableIsNamed) {
+  TempDir dir;
+  {
+    Db db(dir.file("s.db"));
+    db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy)");
+    db.exec("INSERT INTO t VALUES (1, 0, 0, 0, 0)");
+    db.exec("DROP TABLE t_node");
+  }
+  Db db(dir.file("s.db"));
+  EXPECT_NE(db.error_of("SELECT loci_check('t')").find("loci_check: t: no such table: main.t_node"),
+            std::string::npos)
+      << db.error_of("SELECT loci_check('t')");
+  EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', 0, 0, 1)").find("main.t_node"),
+            std::string::npos);
+}
+
 // A base stored with its items in builder order (as the first versions of the extension wrote
 // it) answers like one numbered in packed order: the stored payload is renumbered by a random
 // permutation, item slots and ids together, so it holds the same rows.
