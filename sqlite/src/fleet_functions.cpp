@@ -134,8 +134,8 @@ void conflicts(sqlite3* db, const Registry& registry, std::span<sqlite3_value* c
 }
 
 const TableFunction kFleetWindow{"loci_fleet_window",
-                                 "CREATE TABLE x(id, x, y, tab HIDDEN, xmin HIDDEN, ymin HIDDEN, "
-                                 "xmax HIDDEN, ymax HIDDEN, t HIDDEN)",
+                                 "CREATE TABLE x(id, x, y, arg_table HIDDEN, arg_xmin HIDDEN, "
+                                 "arg_ymin HIDDEN, arg_xmax HIDDEN, arg_ymax HIDDEN, arg_t HIDDEN)",
                                  3,
                                  6,
                                  0,
@@ -144,7 +144,8 @@ const TableFunction kFleetWindow{"loci_fleet_window",
                                  fleet_window};
 const TableFunction kFleetNearest{
     "loci_fleet_nearest",
-    "CREATE TABLE x(id, distance, tab HIDDEN, x HIDDEN, y HIDDEN, k HIDDEN, t HIDDEN)",
+    "CREATE TABLE x(id, distance, arg_table HIDDEN, arg_x HIDDEN, arg_y HIDDEN, arg_k HIDDEN, "
+    "arg_t HIDDEN)",
     2,
     4,
     1,
@@ -153,7 +154,7 @@ const TableFunction kFleetNearest{
     fleet_nearest};
 const TableFunction kConflicts{"loci_conflicts",
                                "CREATE TABLE x(id_a, id_b, tcpa, dcpa, t_enter, t_exit, "
-                               "tab HIDDEN, d HIDDEN, h HIDDEN, now HIDDEN)",
+                               "arg_table HIDDEN, arg_d HIDDEN, arg_h HIDDEN, arg_now HIDDEN)",
                                6,
                                3,
                                1,

@@ -24,7 +24,7 @@ void nearest(sqlite3* db, const Registry& registry, std::span<sqlite3_value* con
 
 const TableFunction kNearest{
     "loci_nearest",
-    "CREATE TABLE x(id, distance, tab HIDDEN, x HIDDEN, y HIDDEN, k HIDDEN)",
+    "CREATE TABLE x(id, distance, arg_table HIDDEN, arg_x HIDDEN, arg_y HIDDEN, arg_k HIDDEN)",
     2,
     4,
     0,

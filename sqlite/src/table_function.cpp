@@ -20,6 +20,17 @@ struct FunctionCursor : sqlite3_vtab_cursor {
   FunctionRows rows;
   std::size_t at = 0;
   std::size_t count = 0;
+  std::vector<sqlite3_value*> args;  // copies of the arguments, read back as hidden columns
+
+  FunctionCursor() = default;
+  FunctionCursor(const FunctionCursor&) = delete;
+  FunctionCursor& operator=(const FunctionCursor&) = delete;
+  ~FunctionCursor() { forget_args(); }
+  void forget_args() {
+    for (sqlite3_value* v : args)
+      sqlite3_value_free(v);
+    args.clear();
+  }
 };
 
 const TableFunction& function_of(sqlite3_vtab* v) {
@@ -88,6 +99,12 @@ int x_filter(sqlite3_vtab_cursor* cur, int, const char*, int argc, sqlite3_value
   return guarded(cur->pVtab, [&] {
     c.rows.clear();
     c.at = c.count = 0;
+    c.forget_args();
+    for (int i = 0; i < argc; ++i) {
+      sqlite3_value* copy = sqlite3_value_dup(argv[i]);
+      if (!copy) throw std::bad_alloc();
+      c.args.push_back(copy);
+    }
     const TableFunction& f = *t.handle->function;
     f.answer(t.db, *t.handle->registry, std::span<sqlite3_value* const>(argv, std::size_t(argc)),
              c.rows);
@@ -108,7 +125,13 @@ int x_column(sqlite3_vtab_cursor* cur, sqlite3_context* ctx, int column) {
   const FunctionCursor& c = *static_cast<FunctionCursor*>(cur);
   const TableFunction& f = function_of(cur->pVtab);
   if (column >= f.columns) {
-    sqlite3_result_null(ctx);  // the hidden arguments are not read back
+    // An argument column reads back the argument given (NULL for an optional one left out),
+    // as SQLite's own table-valued functions do, so that a condition on it holds.
+    const std::size_t a = std::size_t(column - f.columns);
+    if (a < c.args.size())
+      sqlite3_result_value(ctx, c.args[a]);
+    else
+      sqlite3_result_null(ctx);
     return SQLITE_OK;
   }
   const FunctionRows::Cell& cell = c.rows.at(c.at, column, f.columns);

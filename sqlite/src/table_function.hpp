@@ -2,9 +2,12 @@
 // loci_fleet_window, loci_fleet_nearest and loci_conflicts.
 //
 // Each is an eponymous virtual table whose declared columns are the answer's columns followed
-// by one HIDDEN column per argument; `FROM f('t', 1, 2)` constrains the hidden columns to the
-// arguments in order. The planner is told that a plan without every required argument cannot
-// run (SQLITE_CONSTRAINT from xBestIndex), so joins that feed an argument from another table
+// by one HIDDEN column per argument (arg_table, arg_x, ...: names a caller's own columns are
+// unlikely to have, so that `loci_nearest('t', x, y, 1)` in a subquery over a table with
+// columns x and y reads that table's); `FROM f('t', 1, 2)` constrains the hidden columns to the
+// arguments in order, and they read back the arguments given. The planner is told that a plan
+// without every required argument cannot run (SQLITE_CONSTRAINT from xBestIndex), so joins that
+// feed an argument from another table
 // (`FROM probes p, loci_nearest('t', p.x, p.y, 3)`) run the function once per row of the other
 // table. The answer is computed at xFilter into a flat array of integer and real cells.
 #pragma once

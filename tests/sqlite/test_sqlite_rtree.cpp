@@ -189,6 +189,17 @@ TEST_P(SqliteRtree, NearestMatchesBruteForce) {
       "(1000, 0)");
   EXPECT_EQ(db.value("SELECT count(*) FROM probes p, loci_nearest('t', p.x, p.y, 3) n"), "9");
   EXPECT_EQ(db.value("SELECT count(*) FROM loci_nearest('t', 1, 2, 0)"), "0");
+  // Unqualified, x and y are the probes' (the argument columns are arg_x, arg_y, ...), in a
+  // join and in a correlated subquery; the argument columns read back what was given, so a
+  // condition on one holds.
+  EXPECT_EQ(db.value("SELECT count(*) FROM probes, loci_nearest('t', x, y, 3)"), "9");
+  EXPECT_EQ(db.value("SELECT sum((SELECT count(*) FROM loci_nearest('t', x, y, 2))) FROM probes"),
+            "6");
+  EXPECT_EQ(db.value("SELECT count(*) FROM loci_nearest('t', 0, 0, 3) WHERE arg_k = 3"), "3");
+  EXPECT_EQ(db.value("SELECT count(*) FROM loci_nearest('t', 0, 0, 3) WHERE arg_k = 2"), "0");
+  EXPECT_EQ(db.value("SELECT arg_table || ',' || arg_x || ',' || arg_y || ',' || arg_k FROM "
+                     "loci_nearest('t', 1.5, 2, 1)"),
+            "t,1.5,2,1");
 }
 
 INSTANTIATE_TEST_SUITE_P(Shapes, SqliteRtree, ::testing::ValuesIn(loci::test::kAllShapes),
