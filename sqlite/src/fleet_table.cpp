@@ -457,6 +457,7 @@ std::vector<FleetReport> FleetTable::in_force_at(double t) {
 
 std::string FleetTable::check() {
   try {
+    if (std::string meta = check_meta(kFormat); !meta.empty()) return meta;
     // %_current against the latest report of each id in %_report.
     Statement latest, count;
     latest.prepare(db, format_sql("SELECT r.id, r.t, r.x, r.y, r.vx, r.vy FROM %s r WHERE r.t = "

@@ -113,6 +113,7 @@ struct FleetTable : ShadowTable {
   std::vector<FleetReport> in_force_at(double t);
 
   std::string check() override;
+  const char* module_name() const override { return kModule; }
   std::vector<const char*> shadow_suffixes() const override;
   void prepare_statements() override;
   void finalize_statements() override;

@@ -584,9 +584,15 @@ RTreeIndex RTreeTable::load_stored() {
         if (sqlite3_column_type(s, i) != SQLITE_FLOAT &&
             sqlite3_column_type(s, i) != SQLITE_INTEGER)
           throw Error("%_delta holds a coordinate that is not a number");
-      delta.push_back({sqlite3_column_int64(s, 0),
-                       Box2{{{sqlite3_column_double(s, 1), sqlite3_column_double(s, 3)}},
-                            {{sqlite3_column_double(s, 2), sqlite3_column_double(s, 4)}}}});
+      const Box2 b{{{sqlite3_column_double(s, 1), sqlite3_column_double(s, 3)}},
+                   {{sqlite3_column_double(s, 2), sqlite3_column_double(s, 4)}}};
+      // As a write would have taken it: within +-1e150, min <= max.
+      for (int a = 0; a < 2; ++a)
+        if (!(std::abs(b.min[a]) <= kMaxCoordinate && std::abs(b.max[a]) <= kMaxCoordinate &&
+              b.min[a] <= b.max[a]))
+          throw Error("%_delta holds a box no write would store (id " +
+                      std::to_string(sqlite3_column_int64(s, 0)) + ")");
+      delta.push_back({sqlite3_column_int64(s, 0), b});
     }
   }
   std::vector<RowId> dead;
@@ -671,6 +677,7 @@ void RTreeTable::flush(bool may_repack) {
 
 std::string RTreeTable::check() {
   try {
+    if (std::string meta = check_meta(int(RTreeIndex::kFormat)); !meta.empty()) return meta;
     RTreeIndex stored = load_stored();
     stored.validate();
     RTreeIndex& live = current();

@@ -51,6 +51,7 @@ struct RTreeTable : ShadowTable {
   // SqlError when it is inconsistent.
   RTreeIndex load_stored();
   std::string check() override;
+  const char* module_name() const override { return kModule; }
 
   std::vector<const char*> shadow_suffixes() const override;
   void prepare_statements() override;

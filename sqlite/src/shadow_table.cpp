@@ -38,7 +38,41 @@ void ShadowTable::prepare_generation() {
 
 sqlite3_int64 ShadowTable::stored_generation() {
   const ResetOnExit reset{get_generation};
-  return get_generation.step() ? sqlite3_column_int64(get_generation.get(), 0) : -1;
+  if (get_generation.step() && sqlite3_column_type(get_generation.get(), 0) == SQLITE_INTEGER &&
+      sqlite3_column_int64(get_generation.get(), 0) >= 0)
+    return sqlite3_column_int64(get_generation.get(), 0);
+  throw SqlError{SQLITE_CORRUPT_VTAB,
+                 format_sql("%s %s: the stored index is corrupt: %s_meta has no generation (a "
+                            "whole number >= 0)",
+                            module_name(), name.c_str(), name.c_str())};
+}
+
+std::string ShadowTable::check_meta(int format) {
+  Statement s;
+  s.prepare(db, format_sql("SELECT k, v, quote(v) FROM %s", shadow("meta").c_str()));
+  bool has_format = false, has_generation = false;
+  const auto text = [&](int column) {
+    const unsigned char* t = sqlite3_column_text(s.get(), column);
+    return std::string(t ? reinterpret_cast<const char*>(t) : "");
+  };
+  while (s.step()) {
+    const std::string key = text(0);
+    const bool integer = sqlite3_column_type(s.get(), 1) == SQLITE_INTEGER;
+    const sqlite3_int64 v = sqlite3_column_int64(s.get(), 1);
+    if (key == "format") {
+      if (!integer || v != format)
+        return format_sql("%s_meta holds format %s, not %d", name.c_str(), text(2).c_str(), format);
+      has_format = true;
+    } else if (key == "generation") {
+      if (!integer || v < 0)
+        return format_sql("%s_meta holds generation %s, not a whole number >= 0", name.c_str(),
+                          text(2).c_str());
+      has_generation = true;
+    }
+  }
+  if (!has_format) return format_sql("%s_meta has no format", name.c_str());
+  if (!has_generation) return format_sql("%s_meta has no generation", name.c_str());
+  return "";
 }
 
 void ShadowTable::bump_generation() {

@@ -49,6 +49,8 @@ struct ShadowTable : sqlite3_vtab {
 
   // "ok", or what is wrong with the stored or in-memory rows.
   virtual std::string check() = 0;
+  // "loci_rtree" or "loci_fleet", for messages.
+  virtual const char* module_name() const = 0;
   // The suffixes of the shadow tables this table has ("node", "report", ...).
   virtual std::vector<const char*> shadow_suffixes() const = 0;
   // Prepares or finalizes every statement on the shadow tables (they keep them open).
@@ -62,8 +64,13 @@ struct ShadowTable : sqlite3_vtab {
   std::string shadow(const char* suffix) const;
   // Prepares get_generation and set_generation on %_meta(k, v).
   void prepare_generation();
-  sqlite3_int64 stored_generation();  // 'generation' in %_meta, -1 when missing
-  void bump_generation();             // 'generation' + 1, stored and remembered
+  // 'generation' in %_meta; SqlError (corrupt) when it is missing or not a whole number >= 0,
+  // since changes by other connections would then go unnoticed.
+  sqlite3_int64 stored_generation();
+  // "" when %_meta holds 'format' = `format` and a 'generation' (a whole number >= 0), else
+  // what is wrong (loci_check).
+  std::string check_meta(int format);
+  void bump_generation();  // 'generation' + 1, stored and remembered
   // Whether another connection committed a change to this table since `generation` was read.
   bool changed_elsewhere();
   void forget_version() { data_version_known = false; }

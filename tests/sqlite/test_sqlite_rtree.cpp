@@ -3,6 +3,8 @@
 // against brute force, transactions, reopening, a killed writer, errors and corruption.
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -535,6 +537,33 @@ TEST(SqliteRtreeSql, CorruptShadowTablesAreReportedNotTrusted) {
     db.exec("DELETE FROM t_node; INSERT INTO t_delta VALUES (5, 2, 1, 0, 0)");
     EXPECT_NE(db.error_of("SELECT count(*) FROM t").find("corrupt"), std::string::npos);
   }
+  // %_meta: its format and its generation (without which other connections' changes would go
+  // unnoticed) are checked, and a query refuses a table whose generation is gone; a delta box
+  // no write would store (beyond 1e150) is refused too. loci_check said ok to each.
+  const auto fresh = [&](const std::string& damage) {
+    {
+      Db db(path);
+      db.exec("DROP TABLE IF EXISTS t");
+      db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy)");
+      db.exec("INSERT INTO t VALUES (1, 0, 1, 0, 1)");
+      db.exec(damage);
+    }
+    return std::make_unique<Db>(path);
+  };
+  EXPECT_EQ(fresh("DELETE FROM t_meta")->value("SELECT loci_check('t')"), "t_meta has no format");
+  EXPECT_EQ(fresh("DELETE FROM t_meta WHERE k = 'generation'")->value("SELECT loci_check('t')"),
+            "t_meta has no generation");
+  EXPECT_EQ(fresh("UPDATE t_meta SET v = 99 WHERE k = 'format'")->value("SELECT loci_check('t')"),
+            "t_meta holds format 99, not 1");
+  EXPECT_EQ(
+      fresh("UPDATE t_meta SET v = 'x' WHERE k = 'generation'")->value("SELECT loci_check('t')"),
+      "t_meta holds generation 'x', not a whole number >= 0");
+  EXPECT_NE(fresh("DELETE FROM t_meta WHERE k = 'generation'")
+                ->error_of("SELECT count(*) FROM t")
+                .find("the stored index is corrupt: t_meta has no generation"),
+            std::string::npos);
+  EXPECT_EQ(fresh("UPDATE t_delta SET maxx = 1e200")->value("SELECT loci_check('t')"),
+            "%_delta holds a box no write would store (id 1)");
 }
 
 // The functions find a table by name as SQL finds it in FROM: temp, then main, then the
