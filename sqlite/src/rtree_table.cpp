@@ -384,9 +384,21 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
                        format_sql("loci_rtree %s: the id must be an integer", t.name.c_str())};
     } else {
       const std::optional<RowId> top = index.max_id();
-      if (top == std::numeric_limits<RowId>::max())
-        throw SqlError{SQLITE_FULL, format_sql("loci_rtree %s: no id left", t.name.c_str())};
-      id = top ? *top + 1 : 1;
+      if (top == std::numeric_limits<RowId>::max()) {
+        // As a rowid table does once its largest rowid is taken: an unused one at random, or
+        // SQLITE_FULL when a hundred tries find none.
+        id = 0;
+        for (int attempt = 0; attempt < 100 && id == 0; ++attempt) {
+          RowId r = 0;
+          sqlite3_randomness(int(sizeof r), &r);
+          r &= std::numeric_limits<RowId>::max();
+          if (r != 0 && !index.find(r)) id = r;
+        }
+        if (id == 0)
+          throw SqlError{SQLITE_FULL, format_sql("loci_rtree %s: no id left", t.name.c_str())};
+      } else {
+        id = top ? *top + 1 : 1;
+      }
     }
     Box2 b;
     b.min[0] = coordinate(argv[3], "minx", t);

@@ -321,6 +321,14 @@ TEST(SqliteRtreeSql, NewIdsFollowTheRowidTableRule) {
   both("DELETE FROM $T");
   both("INSERT INTO $T VALUES (NULL, 5, 6, 5, 6)");
   check("emptied");
+  // With the largest id taken, a NULL id takes an unused one (at random, as in a rowid table;
+  // it failed with SQLITE_FULL).
+  db.exec("INSERT INTO t VALUES (9223372036854775807, 0, 1, 0, 1)");
+  for (int i = 0; i < 3; ++i)
+    db.exec("INSERT INTO t(minx, maxx, miny, maxy) VALUES (1, 1, 1, 1)");
+  EXPECT_EQ(db.value("SELECT count(*) FROM t"), "5");
+  EXPECT_EQ(db.value("SELECT count(DISTINCT id) FROM t WHERE id > 0"), "5");
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
 }
 
 // Random INSERT, UPDATE, DELETE, bulk inserts and deletes, applied to t and m alike, under
