@@ -543,10 +543,10 @@ class MovingGrid {
 
   // A layout costs O(n + cells), so one follows at least (count + cells) / 8 changes (and
   // O(1) a change amortized, however many classes a few objects have): when the count
-  // doubled or fell to a quarter, when the clock passed t_ref,
-  // when that many changes placed objects beyond the positions or velocities laid out (a
-  // fleet that moved elsewhere, or sped up, while the clock stood still), and after as many
-  // changes as objects whatever the clock.
+  // doubled or fell to a quarter, when the clock passed t_ref, when that many changes placed
+  // objects beyond the positions or velocities laid out (a fleet that moved elsewhere, or
+  // sped up, while the clock stood still), and after as many changes as objects whatever the
+  // clock.
   void maybe_layout() {
     const std::size_t enough = (count_ + cells_.size()) / 8 + 16;
     const bool grew = count_ > 2 * laid_out_ + 16;
