@@ -54,6 +54,13 @@ std::shared_ptr<Registry> registry_for(sqlite3* db) {
 }
 
 int register_all(sqlite3* db, char** err) {
+  // The routines the extension calls that came last (sqlite3_db_name) are SQLite 3.39's; an
+  // older library's table of routines has no entry for them.
+  if (sqlite3_libversion_number() < 3039000) {
+    if (err)
+      *err = sqlite3_mprintf("loci: needs SQLite 3.39 or later (this is %s)", sqlite3_libversion());
+    return SQLITE_ERROR;
+  }
   try {
     const std::shared_ptr<Registry> registry = registry_for(db);
     int rc = register_rtree(db, registry);
