@@ -298,6 +298,33 @@ TYPED_TEST(BroadPhaseTest, TouchingCounts) {
   EXPECT_EQ(sorted(bp.pairs()), (std::vector<IdPair>{{0, 1}, {1, 2}}));
 }
 
+// Boxes of subnormal extent (1e-310) touching in a row, and a subnormal fixed cell: the grid's
+// cell side became subnormal, its inverse infinite and a coordinate of 0 a NaN cell (bad_alloc
+// or undefined behaviour).
+TYPED_TEST(BroadPhaseTest, SubnormalExtents) {
+  constexpr int D = TypeParam::dimension;
+  TypeParam bp;
+  const double e = 1e-310;
+  for (int i = 0; i < 3; ++i) {
+    Box<D> b;
+    for (int k = 0; k < D; ++k)
+      b.min[k] = 0, b.max[k] = e;
+    b.min[0] = i * e, b.max[0] = i * e + e;
+    bp.add(Id(i), b);
+  }
+  EXPECT_EQ(sorted(bp.pairs()), (std::vector<IdPair>{{0, 1}, {1, 2}}));
+  bp.validate();
+}
+
+TEST(UniformGrid, SubnormalFixedCell) {
+  UniformGrid<2> g(1e-310);
+  g.add(1, Box2{{0, 0}, {1, 1}});
+  g.add(2, Box2{{1, 1}, {2, 2}});
+  g.add(3, Box2{{-1e-310, -1e-310}, {0, 0}});
+  EXPECT_EQ(sorted(g.pairs()), (std::vector<IdPair>{{1, 2}, {1, 3}}));
+  g.validate();
+}
+
 TYPED_TEST(BroadPhaseTest, Errors) {
   constexpr int D = TypeParam::dimension;
   TypeParam bp;

@@ -170,6 +170,10 @@ class UniformGrid {
       if (!(h > 0)) h = fallback_cell();
       cell_ = h;
     }
+    // Subnormal sides (boxes of extent 1e-310) would make 1 / cell infinite and a coordinate
+    // of 0 a NaN cell: cells are at least 2^-1000 wide (any finite coordinate times the
+    // inverse is then a number, clamped as the others).
+    cell_ = std::max(cell_, 0x1p-1000);
     inv_cell_ = 1.0 / cell_;
   }
 
