@@ -128,6 +128,96 @@ TEST(BspTree, OverlappingPolygons) {
   }
 }
 
+// Borders met by three edges or more, of duplicated polygons, of islands filling holes, of
+// rectangles touching them: where the edges that cancel pair off, the one left covers a
+// polygon on its other side too. Whole solid regions were lost (a rectangle beside a
+// duplicated one read as empty; an island touched by a square; the inside of a hole filled
+// by two polygons at once).
+TEST(BspTree, BordersOfDuplicatedAndNestedPolygons) {
+  const auto square = [](double x0, double y0, double x1, double y1) {
+    return std::vector<Point2>{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  };
+  {
+    const std::vector<BspPolygon> polys{
+        {square(0, 1, 1, 3), {}}, {square(1, 1, 3, 3), {}}, {square(1, 1, 3, 3), {}}};
+    const BspTree tree = BspTree::build(polys);
+    EXPECT_TRUE(tree.solid({0.25, 1.25}));
+    EXPECT_TRUE(tree.solid({0.5, 2}));
+    EXPECT_FALSE(tree.solid({4, 2}));
+    const BspHit h = tree.trace({-1, 2}, {4, 2}, BspPoint{});
+    ASSERT_TRUE(h.hit);
+    EXPECT_NEAR(h.t, 0.2, 1e-12);
+  }
+  {
+    const std::vector<BspPolygon> polys{{square(4, 0, 5, 3), {}},
+                                        {square(4, 3, 5, 4), {}},
+                                        {square(3, 2, 7, 6), {square(4, 3, 5, 4)}}};
+    EXPECT_TRUE(BspTree::build(polys).solid({4.5, 3.5}));
+  }
+  {
+    const std::vector<BspPolygon> polys{{square(1, 0, 5, 4), {square(2, 1, 3, 3)}},
+                                        {square(2, 2, 4, 4), {}},
+                                        {square(1, 1, 5, 5), {square(2, 2, 4, 4)}}};
+    const BspTree tree = BspTree::build(polys);
+    EXPECT_TRUE(tree.solid({2.5, 1.5}));
+    EXPECT_TRUE(tree.solid({2.5, 2.5}));
+  }
+  {
+    // Two polygons meeting along part of a side: the line beyond them stays empty.
+    const std::vector<BspPolygon> polys{{square(0, 4, 4, 8), {square(1, 5, 2, 6)}},
+                                        {square(1, 3, 2, 4), {}}};
+    const BspTree tree = BspTree::build(polys);
+    EXPECT_FALSE(tree.solid({-1, 4}));
+    EXPECT_FALSE(tree.solid({-0.5, 4}));
+    EXPECT_FALSE(tree.solid({0.5, 3.5}));
+    EXPECT_TRUE(tree.solid({1.5, 3.5}));
+  }
+}
+
+// Random rectangles on a small integer grid, duplicated, holed, their holes filled by islands,
+// touching and overlapping in every way: every point off the borders as brute force says.
+TEST(BspTree, GridRectanglesSharingEdgesEveryWay) {
+  for (std::uint64_t seed = 0; seed < 300; ++seed) {
+    std::mt19937_64 rng(seed);
+    const auto pick = [&](int lo, int hi) {
+      return std::uniform_int_distribution<int>(lo, hi)(rng);
+    };
+    const auto square = [](double x0, double y0, double x1, double y1, bool cw) {
+      std::vector<Point2> r{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+      if (cw) std::reverse(r.begin(), r.end());
+      return r;
+    };
+    std::vector<BspPolygon> polys;
+    const int n = pick(1, 6);
+    for (int i = 0; i < n; ++i) {
+      BspPolygon p;
+      if (pick(0, 1)) {
+        const double x = pick(0, 5), y = pick(0, 5);
+        p.outer = square(x, y, x + pick(1, 3), y + pick(1, 3), pick(0, 1));
+        if (pick(0, 3) == 0 && !polys.empty())
+          p = polys[std::size_t(pick(0, int(polys.size()) - 1))];
+      } else {
+        const double x = pick(0, 4), y = pick(0, 4);
+        p.outer = square(x, y, x + 4, y + 4, pick(0, 1));
+        p.holes.push_back(square(x + 1, y + 1, x + 1 + pick(1, 2), y + 1 + pick(1, 2), pick(0, 1)));
+        if (pick(0, 1)) polys.push_back({p.holes[0], {}});
+      }
+      polys.push_back(std::move(p));
+    }
+    BspParams params;
+    params.candidates = std::uint32_t(pick(1, 8));
+    const BspTree tree = BspTree::build(polys, params);
+    tree.validate();
+    for (int xi = -2; xi <= 24; ++xi)
+      for (int yi = -2; yi <= 24; ++yi) {
+        const Point2 p{xi * 0.5, yi * 0.5};
+        if (dist_to_edges(polys, p) < 1e-9) continue;
+        ASSERT_EQ(tree.solid(p), in_solid(polys, p))
+            << "seed " << seed << " at " << p[0] << "," << p[1];
+      }
+  }
+}
+
 TEST(BspTree, VerticesAndBordersCountAsSolid) {
   const auto polys = random_layer(4);
   const BspTree tree = BspTree::build(polys);

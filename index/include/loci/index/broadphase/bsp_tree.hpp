@@ -22,9 +22,13 @@
 // polygon covers it). In front it is empty unless another polygon covers the splitter's
 // piece, which happens where polygons overlap (neighbouring countries in real data do, by
 // rounding): the middle of the piece is located by crossing parity against the other
-// polygons (edges bucketed in bands of y), a polygon whose boundary it lies on not counting.
-// Deciding from the piece rather than from a point inside the cell keeps thin cells right.
-// Polygons may overlap and share borders.
+// polygons (edges bucketed in bands of y), just in front of the line: a polygon with an edge
+// along the line there covers the front when that edge faces the other way (a border of three
+// edges or more, of a duplicated polygon or an island filling a hole, of which the edges that
+// cancel pair off), and a polygon with a vertex there makes another point of the piece be
+// tried. Deciding from the piece rather than from a point inside the cell keeps thin cells
+// right; a front cell of no thickness (the splitter on its own border) is empty. Polygons may
+// overlap and share borders.
 //
 // Plane shifting. An object occupies x + K (K a convex shape around its reference point x).
 // It meets a convex solid cell C exactly when x lies in C + (-K), which is contained in the
@@ -349,9 +353,15 @@ struct BspEdge {
   std::uint32_t polygon;
 };
 
-// Whether a point lies inside any of the polygons but one, by crossing parity of the ray
-// towards +x against each polygon's edges (decided exactly, half-open in y), the edges
-// bucketed in horizontal bands. A polygon with the point on its boundary does not count.
+// Whether a point of a splitter's line lies, just in front of that line, inside any of the
+// polygons but the splitter's: by crossing parity of the ray towards +x against each polygon's
+// edges (decided exactly, half-open in y), the edges bucketed in horizontal bands. A polygon
+// with the point inside one of its edges that lies on the splitter's line covers the front
+// there when that edge faces the other way (a shared border whose edges did not all cancel: a
+// duplicated polygon, an island filling a hole), and not when it faces the same way. A
+// polygon with the point on its boundary otherwise (at a vertex) leaves the answer
+// undecided, unless another polygon covers the point: the caller then tries another point of
+// the piece.
 class BspPointLocator {
  public:
   BspPointLocator(const std::vector<BspEdge>& edges, std::uint32_t polygons, const Box2& bounds)
@@ -365,11 +375,22 @@ class BspPointLocator {
             },
             bounds.min[1], bounds.max[1], std::clamp<std::size_t>(edges.size() / 8, 1, 1 << 14)) {}
 
-  bool inside_other(const Point2& p, std::uint32_t except) {
+  enum class Cover { no, yes, undecided };
+  // p lies on the line of `splitter` (a, b), whose front is to the right of a -> b.
+  Cover inside_other(const Point2& p, const BspEdge& splitter) {
+    const std::uint32_t except = splitter.polygon;
     bool any = false;
     touched_.clear();
     auto touch = [&](std::uint32_t q) {
       if (!parity_[q]) touched_.push_back(q);
+    };
+    // Along the splitter's line, whether a direction runs the splitter's way (its dominant
+    // axis: exact signs of differences).
+    const bool along_x =
+        std::abs(splitter.b[0] - splitter.a[0]) >= std::abs(splitter.b[1] - splitter.a[1]);
+    const auto forward = [&](const Point2& from, const Point2& to) {
+      return along_x ? (to[0] > from[0]) == (splitter.b[0] > splitter.a[0])
+                     : (to[1] > from[1]) == (splitter.b[1] > splitter.a[1]);
     };
     for (const std::uint32_t k : bands_.at(p[1])) {
       const BspEdge& e = edges_[k];
@@ -382,6 +403,12 @@ class BspPointLocator {
         if (std::min(lo[0], hi[0]) <= p[0] && p[0] <= std::max(lo[0], hi[0])) {
           touch(e.polygon);
           parity_[e.polygon] |= 2;  // on its boundary
+          // Inside an edge on the splitter's line facing the other way: the polygon (on the
+          // edge's left) lies in front of the splitter there.
+          if (p != e.a && p != e.b &&
+              orientation(splitter.a, splitter.b, e.a) == Orientation::collinear &&
+              orientation(splitter.a, splitter.b, e.b) == Orientation::collinear)
+            parity_[e.polygon] |= forward(e.a, e.b) ? 16 : 8;
         }
         continue;
       }
@@ -390,11 +417,14 @@ class BspPointLocator {
       parity_[e.polygon] ^= 1;
       parity_[e.polygon] |= 4;  // touched
     }
+    bool undecided = false;
     for (const std::uint32_t q : touched_) {
-      any = any || parity_[q] == 5;
+      const std::uint8_t f = parity_[q];
+      any = any || f == 5 || (f & 8) != 0;
+      undecided = undecided || ((f & 2) != 0 && (f & 24) == 0);
       parity_[q] = 0;
     }
-    return any;
+    return any ? Cover::yes : undecided ? Cover::undecided : Cover::no;
   }
 
  private:
@@ -657,6 +687,7 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
         if (score < best_score) best_score = score, best = ci;
       }
     }
+    const BspPiece pieces_best = pieces[best];
     const std::uint32_t li = pieces[best].edge;
     const BspEdge& l = edges[li];
     const double mid = (pieces[best].s0 + pieces[best].s1) / 2;
@@ -700,9 +731,35 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
     std::vector<BspCellVertex> back_cell = detail::bsp_clip_cell(w.cell, l.nx, l.ny, l.d, 1);
     std::vector<BspCellVertex> front_cell = detail::bsp_clip_cell(w.cell, l.nx, l.ny, l.d, -1);
     if (front.empty()) {
-      // Empty unless another polygon covers the splitter's piece.
+      // Empty unless another polygon covers the splitter's piece. A front cell of no thickness
+      // (the splitter on the cell's own border, a shared border seen from the other side; its
+      // corners off the line by the rounding of the clipping only) stays empty, so that it
+      // claims no point of the line beyond the polygons.
+      double thickness = 0, scale = 0;
+      for (const detail::BspCellVertex& v : front_cell) {
+        thickness = std::max(thickness, l.nx * v.p[0] + l.ny * v.p[1] - l.d);
+        scale = std::max({scale, std::abs(v.p[0]), std::abs(v.p[1])});
+      }
+      // The piece's middle first; where it lies on another polygon's vertex, points of the
+      // piece at golden-ratio fractions (still undecided: not covered).
+      bool covered = false;
+      if (thickness > 1e-12 * scale) {
+        using Cover = detail::BspPointLocator::Cover;
+        Cover c = locator.inside_other(piece_mid, l);
+        const double s0 = pieces_best.s0, s1 = pieces_best.s1;
+        // (A sliver of a piece, left by rounding where another line crosses the splitter, has
+        // points beyond the cell: no other point of it is tried.)
+        for (const double f : {0.3819660112501051, 0.6180339887498949, 0.2360679774997897,
+                               0.7639320225002103, 0.1458980337503155, 0.8541019662496845}) {
+          if (c != Cover::undecided || !(s1 - s0 > 1e-9)) break;
+          const double u = s0 + f * (s1 - s0);
+          c = locator.inside_other({l.a[0] + u * (l.b[0] - l.a[0]), l.a[1] + u * (l.b[1] - l.a[1])},
+                                   l);
+        }
+        covered = c == Cover::yes;
+      }
       std::int32_t leaf = kEmpty;
-      if (locator.inside_other(piece_mid, l.polygon)) leaf = solid_leaf(front_cell, w.depth + 1);
+      if (covered) leaf = solid_leaf(front_cell, w.depth + 1);
       tree.nodes_[static_cast<std::size_t>(k)].front = leaf;
       tree.depth_ = std::max(tree.depth_, w.depth + 1);
     } else {
