@@ -174,6 +174,34 @@ TEST(BspTree, BordersOfDuplicatedAndNestedPolygons) {
   }
 }
 
+// Points of the boundary count as solid, though planes carry rounding: the vertices of a
+// thin triangle (bevel planes pass through computed corners), a point of a slanted edge (a
+// unit normal rounded), a point of an edge where a hole's line meets it; and a move ending
+// there touches. Each was outside.
+TEST(BspTree, BoundaryPointsThroughRoundedPlanes) {
+  {
+    const std::vector<BspPolygon> polys{{{{0, 2}, {6, 0}, {0, 1}}, {}}};
+    for (const double angle : {BspParams{}.bevel_angle, std::numbers::pi}) {
+      BspParams params;
+      params.bevel_angle = angle;
+      const BspTree tree = BspTree::build(polys, params);
+      for (const Point2& v : polys[0].outer)
+        EXPECT_TRUE(tree.solid(v)) << v[0] << "," << v[1] << " bevels " << angle;
+    }
+  }
+  EXPECT_TRUE(
+      BspTree::build(std::vector<BspPolygon>{{{{1, 7}, {0, 2}, {4, 3}}, {}}}).solid({0.5, 4.5}));
+  const std::vector<BspPolygon> polys{
+      {{{3, 4}, {7, 4}, {7, 8}, {3, 8}}, {{{4, 5}, {6, 5}, {6, 7}, {4, 7}}}},
+      {{{4, 0}, {8, 0}, {8, 4}, {4, 4}}, {{{5, 1}, {6, 1}, {6, 2}, {5, 2}}}}};
+  const BspTree tree = BspTree::build(polys);
+  EXPECT_TRUE(tree.solid({7, 7}));
+  EXPECT_TRUE(tree.solid({7, 8}));
+  const BspHit h = tree.trace({9, 7}, {7, 7}, BspPoint{});
+  ASSERT_TRUE(h.hit);
+  EXPECT_NEAR(h.t, 1, 1e-12);
+}
+
 // Random rectangles on a small integer grid, duplicated, holed, their holes filled by islands,
 // touching and overlapping in every way: every point off the borders as brute force says.
 TEST(BspTree, GridRectanglesSharingEdgesEveryWay) {

@@ -58,7 +58,9 @@
 //     exact first contact of a disc of radius R / cos(alpha / 2).
 // With the default alpha = 30 degrees that disc is 3.5% larger than R (for a circle, than
 // its radius); the paper's games used 90-95 degrees (41% and more). Arithmetic is double
-// precision: the times carry the rounding of a few operations on the coordinates.
+// precision: the times carry the rounding of a few operations on the coordinates, and every
+// cell is grown by 1e-14 of the magnitudes involved, so that a point of the boundary (a
+// vertex, a point of a slanted edge, whose planes are rounded) touches, as it does exactly.
 //
 // Layout: nodes in one flat array (plane and two children, 32 bytes), children encoded as
 // node indices or the two leaf codes. Built once, immutable: all queries are const and may
@@ -173,6 +175,11 @@ class BspTree {
     out.point = to;
     if (root_ == kEmpty) return out;
     const Point2 delta{to[0] - from[0], to[1] - from[1]};
+    // Planes carry rounding (unit normals, bevels through computed corners): every cell is
+    // grown by 1e-14 of the magnitudes involved, so that a point on the boundary (a vertex, a
+    // point of a slanted edge) counts as touching, as it does exactly.
+    const double scale =
+        std::max({std::fabs(from[0]), std::fabs(from[1]), std::fabs(to[0]), std::fabs(to[1])});
     double best = std::numeric_limits<double>::infinity();
     Point2 best_normal{};
     bool best_plane = false;
@@ -197,8 +204,9 @@ class BspTree {
       const Point2 nn{n.nx, n.ny};
       const double f0 = n.nx * from[0] + n.ny * from[1] - n.d;
       const double fd = n.nx * delta[0] + n.ny * delta[1];
-      const double up = shape.support(Point2{-n.nx, -n.ny});  // back cells grow by this
-      const double down = shape.support(nn);                  // front cells grow by this
+      const double slack = 1e-14 * (scale + std::fabs(n.d));
+      const double up = shape.support(Point2{-n.nx, -n.ny}) + slack;  // back cells grow by this
+      const double down = shape.support(nn) + slack;                  // front cells grow by this
       // Back part: f0 + t fd <= up; front part: f0 + t fd >= -down.
       Item back{n.back, it.t0, it.t1, it.normal, it.has_plane};
       Item front{n.front, it.t0, it.t1, it.normal, it.has_plane};
