@@ -212,6 +212,18 @@ std::size_t clip_layer(const ClipOptions& options) {
       }
       pieces.push_back({std::move(f), std::move(piece)});
     }
+    // A shapefile holds one kind of geometry: a layer that mixes them (GeoJSON, GeoPackage) is
+    // refused with the two kinds, before its layer is made.
+    if (!mixed_ok)
+      for (const Piece& p : pieces)
+        if (p.geometry->getDimension() != pieces.front().geometry->getDimension())
+          throw Error("cannot write " + options.out_path +
+                      ": a shapefile holds one kind of geometry, and the window meets feature " +
+                      std::to_string(pieces.front().feature->GetFID()) + " (" +
+                      OGRGeometryTypeToName(pieces.front().geometry->getGeometryType()) +
+                      ") and feature " + std::to_string(p.feature->GetFID()) + " (" +
+                      OGRGeometryTypeToName(p.geometry->getGeometryType()) +
+                      "); write a .gpkg or .geojson instead");
     // A layer that says Polygon (as every shapefile of polygons does) may hold features the
     // window cuts into several parts: forced back to one polygon, the parts would turn into
     // holes of the first. Such a layer is written as MultiPolygon (likewise for lines and
@@ -238,18 +250,6 @@ std::size_t clip_layer(const ClipOptions& options) {
       if (layer->CreateField(&fd) != OGRERR_NONE)
         throw Error("cannot write " + options.out_path + ": field " + fd.GetNameRef());
     }
-    // A shapefile holds one kind of geometry: a layer that mixes them (GeoJSON, GeoPackage) is
-    // refused with the two kinds, before anything is written.
-    if (!mixed_ok)
-      for (const Piece& p : pieces)
-        if (p.geometry->getDimension() != pieces.front().geometry->getDimension())
-          throw Error("cannot write " + options.out_path +
-                      ": a shapefile holds one kind of geometry, and the window meets feature " +
-                      std::to_string(pieces.front().feature->GetFID()) + " (" +
-                      OGRGeometryTypeToName(pieces.front().geometry->getGeometryType()) +
-                      ") and feature " + std::to_string(p.feature->GetFID()) + " (" +
-                      OGRGeometryTypeToName(p.geometry->getGeometryType()) +
-                      "); write a .gpkg or .geojson instead");
     for (Piece& p : pieces) {
       std::unique_ptr<OGRGeometry> piece = std::move(p.geometry);
       if (wkbFlatten(type) != wkbUnknown)

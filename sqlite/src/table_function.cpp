@@ -100,6 +100,7 @@ int x_filter(sqlite3_vtab_cursor* cur, int, const char*, int argc, sqlite3_value
     c.rows.clear();
     c.at = c.count = 0;
     c.forget_args();
+    c.args.reserve(std::size_t(argc));  // so that no copy is lost to a failed push_back
     for (int i = 0; i < argc; ++i) {
       sqlite3_value* copy = sqlite3_value_dup(argv[i]);
       if (!copy) throw std::bad_alloc();

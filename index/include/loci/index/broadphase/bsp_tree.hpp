@@ -695,10 +695,10 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
         if (score < best_score) best_score = score, best = ci;
       }
     }
-    const BspPiece pieces_best = pieces[best];
-    const std::uint32_t li = pieces[best].edge;
+    const BspPiece splitter = pieces[best];
+    const std::uint32_t li = splitter.edge;
     const BspEdge& l = edges[li];
-    const double mid = (pieces[best].s0 + pieces[best].s1) / 2;
+    const double mid = (splitter.s0 + splitter.s1) / 2;
     const Point2 piece_mid{l.a[0] + mid * (l.b[0] - l.a[0]), l.a[1] + mid * (l.b[1] - l.a[1])};
 
     std::vector<BspPiece> back, front;
@@ -754,7 +754,7 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
       if (thickness > 1e-12 * scale) {
         using Cover = detail::BspPointLocator::Cover;
         Cover c = locator.inside_other(piece_mid, l);
-        const double s0 = pieces_best.s0, s1 = pieces_best.s1;
+        const double s0 = splitter.s0, s1 = splitter.s1;
         // (A sliver of a piece, left by rounding where another line crosses the splitter, has
         // points beyond the cell: no other point of it is tried.)
         for (const double f : {0.3819660112501051, 0.6180339887498949, 0.2360679774997897,
