@@ -127,24 +127,92 @@ namespace {
 struct Edges {
   std::vector<Segment2> segs;
   std::vector<Box2> boxes;
+  std::vector<bool> ring;  // the edge bounds a polygon
   Edges(const FlatGeometry& g, double grow, const Box2& window) {
-    auto add = [&](const Segment2& e) {
+    auto add = [&](const Segment2& e, bool of_ring) {
       const Box2 box = grow > 0 ? outset(e.box(), grow) : e.box();
       if (!intersects(box, window)) return;
       segs.push_back(e);
       boxes.push_back(box);
+      ring.push_back(of_ring);
     };
     for (const Part& part : g.parts) {
       if (part.end - part.begin == 1 || part.kind == PartKind::point) {
         for (std::uint32_t i = part.begin; i < part.end; ++i)
-          add({g.points[i], g.points[i]});
+          add({g.points[i], g.points[i]}, false);
         continue;
       }
       for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-        add({g.points[i], g.points[i + 1]});
+        add({g.points[i], g.points[i + 1]}, part.kind == PartKind::ring);
     }
   }
 };
+
+// Cut parameters along one segment and the stretches of it that run along other linework.
+struct Cuts {
+  std::vector<double> at;
+  std::vector<std::pair<double, double>> along;
+
+  // Calls f(t) with the middle parameter of every piece of the segment between its cuts that
+  // does not run along the other linework, until f returns false; false then.
+  template <class F>
+  bool each_piece(F&& f) {
+    at.push_back(0);
+    at.push_back(1);
+    std::sort(at.begin(), at.end());
+    for (std::size_t k = 0; k + 1 < at.size(); ++k) {
+      const double t0 = at[k], t1 = at[k + 1];
+      if (!(t1 > t0)) continue;
+      bool on_other = false;
+      for (const auto& [lo, hi] : along)
+        on_other = on_other || (lo <= t0 && t1 <= hi);
+      if (!on_other && !f((t0 + t1) / 2)) return false;
+    }
+    return true;
+  }
+};
+
+Point2 point_at(const Segment2& s, double t) {
+  return {s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])};
+}
+
+// A point strictly inside the polygon bounded by `rings` (parts of g, by the even-odd rule),
+// found on a horizontal line between two of its vertices' heights and checked exactly against
+// g; nothing when rounding leaves no such point (a polygon thinner than the rounding).
+std::optional<Point2> interior_point(const FlatGeometry& g, std::span<const std::uint32_t> rings,
+                                     const PreparedGeometry& pg) {
+  std::vector<double> ys;
+  for (const std::uint32_t r : rings)
+    for (std::uint32_t i = g.parts[r].begin; i < g.parts[r].end; ++i)
+      ys.push_back(g.points[i][1]);
+  std::sort(ys.begin(), ys.end());
+  ys.erase(std::unique(ys.begin(), ys.end()), ys.end());
+  // Heights between consecutive vertex heights, widest gaps first.
+  std::vector<std::pair<double, double>> gaps;
+  for (std::size_t k = 0; k + 1 < ys.size(); ++k)
+    gaps.emplace_back(ys[k + 1] - ys[k], ys[k] + (ys[k + 1] - ys[k]) / 2);
+  std::sort(gaps.begin(), gaps.end(), std::greater<>());
+  if (gaps.size() > 4) gaps.resize(4);
+  std::vector<double> xs;
+  for (const auto& [gap, y] : gaps) {
+    xs.clear();
+    for (const std::uint32_t r : rings) {
+      const Part& part = g.parts[r];
+      for (std::uint32_t i = part.begin; i + 1 < part.end; ++i) {
+        const Point2& a = g.points[i];
+        const Point2& b = g.points[i + 1];
+        if ((a[1] > y) == (b[1] > y)) continue;
+        xs.push_back(a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]));
+      }
+    }
+    std::sort(xs.begin(), xs.end());
+    for (std::size_t k = 0; k + 1 < xs.size(); k += 2) {
+      const Point2 p{xs[k] + (xs[k + 1] - xs[k]) / 2, y};
+      if (pg.locate(p) == Location::inside) return p;
+    }
+  }
+  return std::nullopt;
+}
 
 Box2 common(const Box2& a, const Box2& b) {
   return {{std::max(a.min[0], b.min[0]), std::max(a.min[1], b.min[1])},
@@ -190,46 +258,61 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
   const FlatGeometry& b = pb.geometry();
   if (a.empty() || b.empty() || !within(pb.envelope(), pa.envelope())) return false;
   const Edges ea(a, 0, pb.envelope()), eb(b, 0, pb.envelope());
-  // Where a's linework meets each edge of b: cut parameters, and the stretches along a's
-  // edges (collinear overlaps), which lie in a.
-  std::vector<std::vector<double>> cuts(eb.segs.size());
-  std::vector<std::vector<std::pair<double, double>>> along(eb.segs.size());
+  const bool areas = b.polygons > 0;
+  if (areas && a.polygons == 0) return false;  // linework and points cover no area
+  // Where the edges of a and b meet: cut parameters on b's edges, and on a's ring edges when b
+  // has polygons, with the stretches where they run along each other.
+  std::vector<Cuts> cb(eb.segs.size()), ca(areas ? ea.segs.size() : 0);
   join(std::span<const Box2>(eb.boxes), std::span<const Box2>(ea.boxes), [&](Id i, Id j) {
     const Segment2& s = eb.segs[i];
-    const SegmentIntersection x = intersection(s, ea.segs[j]);
+    const Segment2& e = ea.segs[j];
+    const SegmentIntersection x = intersection(s, e);
     if (x.kind == SegmentMeet::none) return true;
-    const double u = parameter(s, x.a), v = parameter(s, x.b);
-    cuts[i].push_back(u);
-    if (x.kind != SegmentMeet::point) {
-      cuts[i].push_back(v);
-      along[i].emplace_back(std::min(u, v), std::max(u, v));
-    }
+    auto record = [&](Cuts& c, const Segment2& on) {
+      const double u = parameter(on, x.a), v = parameter(on, x.b);
+      c.at.push_back(u);
+      if (x.kind != SegmentMeet::point) {
+        c.at.push_back(v);
+        c.along.emplace_back(std::min(u, v), std::max(u, v));
+      }
+    };
+    record(cb[i], s);
+    if (areas && ea.ring[j]) record(ca[j], e);
     return true;
   });
+  // Every point of b's linework lies in a: its vertices, and the middle of each piece between
+  // cuts (pieces running along a's edges do).
   for (std::size_t i = 0; i < eb.segs.size(); ++i) {
     const Segment2& s = eb.segs[i];
     if (!pa.meets(s.a) || !pa.meets(s.b)) return false;
     if (s.a == s.b) continue;
-    std::vector<double>& c = cuts[i];
-    c.push_back(0);
-    c.push_back(1);
-    std::sort(c.begin(), c.end());
-    for (std::size_t k = 0; k + 1 < c.size(); ++k) {
-      const double t0 = c[k], t1 = c[k + 1];
-      if (!(t1 > t0)) continue;
-      bool on_a = false;
-      for (const auto& [lo, hi] : along[i])
-        on_a = on_a || (lo <= t0 && t1 <= hi);
-      if (on_a) continue;
-      const double t = (t0 + t1) / 2;
-      if (!pa.meets({s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])})) return false;
-    }
+    if (!cb[i].each_piece([&](double t) { return pa.meets(point_at(s, t)); })) return false;
   }
-  if (b.polygons > 0) {
-    if (a.polygons == 0) return false;  // linework and points cover no area
-    const Box2& env = pb.envelope();
-    for (const Point2& v : a.points)
-      if (intersects(env, v) && pb.locate(v) == Location::inside) return false;
+  if (!areas) return true;
+  // No point of a's polygons' boundary lies strictly inside b's polygons: a vertex there, or a
+  // piece of a ring edge between its cuts with b's edges (a hole or notch of a inside b; the
+  // boundary of a has a's outside beside it).
+  const Box2& env = pb.envelope();
+  for (const Point2& v : a.points)
+    if (intersects(env, v) && pb.locate(v) == Location::inside) return false;
+  for (std::size_t j = 0; j < ea.segs.size(); ++j) {
+    const Segment2& e = ea.segs[j];
+    if (!ea.ring[j] || e.a == e.b) continue;
+    if (!ca[j].each_piece([&](double t) { return pb.locate(point_at(e, t)) != Location::inside; }))
+      return false;
+  }
+  // So the inside of each polygon of b lies wholly inside a or wholly outside it (say, a's hole
+  // filled exactly by b), and one point strictly inside it decides which.
+  std::vector<std::vector<std::uint32_t>> rings(b.polygons);
+  for (std::uint32_t r = 0; r < b.parts.size(); ++r)
+    if (b.parts[r].kind == PartKind::ring && b.parts[r].polygon < b.polygons)
+      rings[b.parts[r].polygon].push_back(r);
+  for (const std::vector<std::uint32_t>& polygon : rings) {
+    const std::optional<Point2> p = interior_point(b, polygon, pb);
+    if (!p) continue;
+    const Location where = pa.locate(*p);
+    if (where == Location::outside) return false;
+    if (where == Location::boundary && !inside_polygon(a, *p)) return false;
   }
   return true;
 }

@@ -179,5 +179,61 @@ TEST(PreparedGeometry, PairTestsAgreeWithPointTests) {
   }
 }
 
+TEST(PreparedGeometry, CoversWithHolesAgainstLatticeEvidence) {
+  // Rectangles with integer corners, each with a rectangular hole or none (a hole filled
+  // exactly by the other, a hole sharing edges with it, a hole inside it): half-lattice
+  // points decide covers. A polygon whose hole is filled exactly by b was once said to cover b.
+  std::mt19937_64 rng(36);
+  std::uniform_int_distribution<int> c(0, 12), s(1, 8), coin(0, 2);
+  auto rect = [](FlatGeometry& g, double x0, double y0, double x1, double y1) {
+    add_ring(g, {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, 0);
+  };
+  auto shape = [&](FlatGeometry& g, double x, double y, double w, double h) {
+    rect(g, x, y, x + w, y + h);
+    g.polygons = 1;
+    if (w >= 2 && h >= 2 && coin(rng)) {
+      std::uniform_int_distribution<int> hx(int(x), int(x + w) - 1), hy(int(y), int(y + h) - 1);
+      double x0 = hx(rng), y0 = hy(rng);
+      std::uniform_int_distribution<int> ex(1, int(x + w - x0)), ey(1, int(y + h - y0));
+      double x1 = x0 + ex(rng), y1 = y0 + ey(rng);
+      // Keep the hole off the shell's boundary where it would touch along an edge (invalid).
+      x0 = std::max(x0, x + 1), y0 = std::max(y0, y + 1);
+      x1 = std::min(x1, x + w - 1), y1 = std::min(y1, y + h - 1);
+      if (x1 > x0 && y1 > y0) rect(g, x0, y0, x1, y1);
+    }
+  };
+  int filled = 0, covered = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    FlatGeometry a, b;
+    shape(a, c(rng), c(rng), s(rng) + 2, s(rng) + 2);
+    if (trial % 3 == 0 && a.parts.size() == 2) {
+      // b is a's hole exactly, or the hole grown or shrunk on one side.
+      const Part& hole = a.parts[1];
+      Point2 lo = a.points[hole.begin], hi = a.points[hole.begin + 2];
+      const int side = coin(rng);
+      if (side == 1) lo[0] -= 1;
+      if (side == 2) hi[1] += 0.5;
+      rect(b, lo[0], lo[1], hi[0], hi[1]);
+      b.polygons = 1;
+      ++filled;
+    } else {
+      shape(b, c(rng), c(rng), s(rng), s(rng));
+    }
+    const PreparedGeometry pa(a), pb(b);
+    bool b_in_a = true;
+    for (double x = 0; x <= 32 && b_in_a; x += 0.5)
+      for (double y = 0; y <= 32; y += 0.5)
+        if (brute(b, {x, y}) != Location::outside && brute(a, {x, y}) == Location::outside) {
+          b_in_a = false;
+          break;
+        }
+    covered += b_in_a;
+    EXPECT_EQ(covers(pa, pb), b_in_a) << trial;
+    EXPECT_EQ(covers(a, b), b_in_a) << trial;
+  }
+  EXPECT_GT(filled, 300);
+  EXPECT_GT(covered, 100);
+}
+
 }  // namespace
 }  // namespace loci::io

@@ -71,9 +71,12 @@ std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry&
 
 // True when every point of b lies in a, a's boundary included (OGC's "covers"). b's edges
 // are cut where a's linework meets them; every vertex of b and the middle of every piece must
-// lie in a (pieces running along a's edges do), and when b has polygons no vertex of a may lie
-// strictly inside them (a hole of a, or a notch, inside b). The vertex tests are exact; the
-// middle of a piece is rounded, which can matter only for pieces shorter than the rounding.
+// lie in a (pieces running along a's edges do). When b has polygons, no point of the boundary
+// of a's polygons may lie strictly inside them (a vertex, or the middle of a piece of a ring
+// edge cut by b's edges: a hole or notch of a inside b); then the inside of each polygon of b
+// lies wholly in a or wholly outside (a hole of a filled exactly by b), and one point strictly
+// inside it decides. The vertex tests are exact; the middles of pieces and the inside point are
+// rounded, which can matter only for pieces or polygons thinner than the rounding.
 bool covers(const FlatGeometry& a, const FlatGeometry& b);
 
 // Where a point lies with respect to a geometry: outside it, on its boundary (a point, an
