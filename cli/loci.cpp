@@ -225,9 +225,16 @@ int run_clip(const Args& a) {
   o.window_layer = a.get("--window-layer");
   o.window_layer_name = a.get("--window-layer-name");
   o.out_path = a.get("--output");
-  const std::size_t n = clip_layer(o);
-  if (!a.has("--quiet"))
-    std::fprintf(stderr, "loci: %zu features clipped into %s\n", n, o.out_path.c_str());
+  const ClipResult r = clip_layer(o);
+  if (!a.has("--quiet")) {
+    std::fprintf(stderr, "loci: %zu feature%s clipped into %s\n", r.written,
+                 r.written == 1 ? "" : "s", o.out_path.c_str());
+    if (r.dropped > 0)
+      std::fprintf(stderr,
+                   "loci: %zu piece%s of lower dimension left out (points or lines where the "
+                   "window only touches a feature, or beside its cut parts)\n",
+                   r.dropped, r.dropped == 1 ? "" : "s");
+  }
   return 0;
 }
 
@@ -535,7 +542,8 @@ const std::vector<Command>& commands() {
        "-o OUT",
        "windowing: the features meeting the window, cut to it (format from OUT's extension)",
        {{"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX", "the window"},
-        {"--wkt", nullptr, "WKT", "a polygonal window: POLYGON or MULTIPOLYGON in WKT"},
+        {"--wkt", nullptr, "WKT",
+         "a polygonal window: a valid POLYGON or MULTIPOLYGON in WKT (polygons apart)"},
         {"--window-layer", nullptr, "POLYGONS",
          "a polygonal window: the union of the polygons of this layer"},
         {"--window-layer-name", nullptr, "NAME", "layer of POLYGONS (default: its first)"},

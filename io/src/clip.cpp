@@ -5,7 +5,9 @@
 // before it is cut. A feature that only touches the window keeps its piece of lower dimension
 // (a polygon sharing an edge leaves a line, a corner a point) in formats whose layers hold mixed
 // geometry (GeoJSON, GeoPackage, ...); a shapefile holds one geometry type, so there such
-// pieces are dropped and counted.
+// pieces are dropped and counted. A cut that has parts of the feature's dimension keeps only
+// those (the two arms of a U cut off from its bar, without the line where the window's edge
+// touches the notch), and the parts left out are counted too.
 //
 // A polygonal window (--wkt, or the union of a layer's polygons with --window-layer) is the
 // windowing problem with a non-rectangular window: the index gives the features meeting the
@@ -41,6 +43,14 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o) {
     w.reset(g);
     if (!polygonal(*w))
       throw InvalidGeometry("--wkt: the window must be a POLYGON or MULTIPOLYGON");
+    // A window the user wrote is taken as written or refused: repairing it would choose an
+    // answer (the overlap of two polygons of a MULTIPOLYGON repaired by crossing parity is
+    // outside, while --window-layer unites them).
+    if (!w->IsEmpty() && !w->IsValid())
+      throw InvalidGeometry(
+          "--wkt: the window is not a valid polygon (rings that cross, or polygons that overlap "
+          "or touch along an edge); give polygons apart from each other, or use --window-layer, "
+          "which unites them");
   } else if (!o.window_layer.empty()) {
     auto wl = detail::open_layer(o.window_layer, o.window_layer_name);
     const detail::ReadCheck check(o.window_layer);
@@ -137,9 +147,54 @@ std::unique_ptr<OGRGeometry> near_window(const OGRGeometry& g, const OGREnvelope
   return out;
 }
 
+// Gathers the members of `g` of dimension `dim`, through nested collections; counts those of
+// lower dimension in `lower`.
+void members_of_dimension(const OGRGeometry& g, int dim, std::vector<const OGRGeometry*>& out,
+                          std::size_t& lower) {
+  if (OGR_GT_IsSubClassOf(wkbFlatten(g.getGeometryType()), wkbGeometryCollection)) {
+    for (const OGRGeometry* m : *g.toGeometryCollection())
+      members_of_dimension(*m, dim, out, lower);
+  } else if (!g.IsEmpty()) {
+    if (g.getDimension() == dim)
+      out.push_back(&g);
+    else
+      ++lower;
+  }
+}
+
+// A cut that mixes dimensions (GEOS gives a collection: two arms of a U cut off from its bar,
+// and the line where the window's edge touches the notch) made of its members of the highest
+// dimension only, as one geometry or a multi-geometry; `dropped` is set when members of lower
+// dimension were left out. Forced into the layer's type as it came, such a collection's rings
+// would have become holes of its first polygon.
+std::unique_ptr<OGRGeometry> of_one_dimension(std::unique_ptr<OGRGeometry> piece, bool& dropped) {
+  dropped = false;
+  if (wkbFlatten(piece->getGeometryType()) != wkbGeometryCollection) return piece;
+  const int dim = piece->getDimension();
+  std::vector<const OGRGeometry*> keep;
+  std::size_t lower = 0;
+  members_of_dimension(*piece, dim, keep, lower);
+  dropped = lower > 0;
+  std::unique_ptr<OGRGeometry> out;
+  if (keep.size() == 1) {
+    out.reset(keep.front()->clone());
+  } else {
+    out.reset(OGRGeometryFactory::createGeometry(dim == 2   ? wkbMultiPolygon
+                                                 : dim == 1 ? wkbMultiLineString
+                                                            : wkbMultiPoint));
+    for (const OGRGeometry* m : keep) {
+      // Members of multi-geometries were gathered one by one: each is a single geometry.
+      if (out->toGeometryCollection()->addGeometry(m) != OGRERR_NONE)
+        throw Error("cannot gather the pieces of a cut geometry");
+    }
+  }
+  out->assignSpatialReference(piece->getSpatialReference());
+  return out;
+}
+
 }  // namespace
 
-std::size_t clip_layer(const ClipOptions& options) {
+ClipResult clip_layer(const ClipOptions& options) {
   if (!OGRGeometryFactory::haveGEOS()) throw Error("clipping needs GDAL built with GEOS");
   const bool rectangle = options.window_wkt.empty() && options.window_layer.empty();
   const std::unique_ptr<OGRGeometry> window = window_of(options);
@@ -162,7 +217,7 @@ std::size_t clip_layer(const ClipOptions& options) {
 
   auto src = detail::open_layer(options.load.layer_path, index.layer_name());
   OutputDataset out(options.out_path);
-  std::size_t written = 0;
+  ClipResult result;
   {
     GDALDatasetUniquePtr ds(
         driver->Create(out.staging_path().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
@@ -207,9 +262,15 @@ std::size_t clip_layer(const ClipOptions& options) {
                     " cannot be cut to the window (" + CPLGetLastErrorMsg() + ")");
       if (piece->IsEmpty()) continue;
       if (piece->getDimension() < f->GetGeometryRef()->getDimension()) {
-        if (!mixed_ok) continue;
+        if (!mixed_ok) {
+          ++result.dropped;
+          continue;
+        }
         degenerate = true;
       }
+      bool lower = false;
+      piece = of_one_dimension(std::move(piece), lower);
+      result.dropped += lower;
       pieces.push_back({std::move(f), std::move(piece)});
     }
     // A shapefile holds one kind of geometry: a layer that mixes them (GeoJSON, GeoPackage) is
@@ -260,7 +321,7 @@ std::size_t clip_layer(const ClipOptions& options) {
       if (layer->CreateFeature(&o) != OGRERR_NONE)
         throw Error("cannot write " + options.out_path + ": feature " +
                     std::to_string(p.feature->GetFID()) + " (" + CPLGetLastErrorMsg() + ")");
-      ++written;
+      ++result.written;
     }
     // Closing flushes; GDAL reports a failed flush only through its error state.
     CPLErrorReset();
@@ -268,7 +329,7 @@ std::size_t clip_layer(const ClipOptions& options) {
     if (CPLGetLastErrorType() == CE_Failure) throw Error("cannot write " + options.out_path);
   }
   out.commit();
-  return written;
+  return result;
 }
 
 }  // namespace loci::io

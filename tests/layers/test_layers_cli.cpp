@@ -951,6 +951,55 @@ TEST_F(LayersCli, ClipRefusesUnknownFormatsAndMixedShapefiles) {
   EXPECT_EQ(gpkg.status, 0) << gpkg.err;
 }
 
+// A cut of several parts plus a touching piece of lower dimension (GEOS gives a collection)
+// is written as its parts of the feature's dimension: a U cut off from its bar is two arms, not
+// one polygon with the second arm as a hole outside it; a line that also touches the window's
+// edge at a vertex is a line (into a shapefile too, which once failed); what is left out is
+// counted. An invalid --wkt window is refused.
+TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
+  const std::string u = path("u.geojson"), line = path("touch.geojson");
+  std::ofstream(u) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"n":1},"geometry":{"type":"Polygon","coordinates":
+[[[0,0],[6,0],[6,6],[4,6],[4,2],[2,2],[2,6],[0,6],[0,0]]]}}]})";
+  std::ofstream(line) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"n":1},"geometry":{"type":"LineString","coordinates":
+[[-5,5],[5,5],[5,15],[8,10],[11,15]]}}]})";
+  for (const char* ext : {".geojson", ".gpkg", ".shp"}) {
+    const std::string out = path(std::string("u-cut") + ext);
+    const CliRun r = run_loci("clip " + u + " --bbox -1,2,7,7 -o " + out);
+    ASSERT_EQ(r.status, 0) << ext << r.err;
+    EXPECT_NE(r.err.find("1 piece of lower dimension left out"), std::string::npos) << r.err;
+    const OgrFeatureSet got = read_with_ogr(out);
+    ASSERT_EQ(got.geoms.size(), 1u) << ext;
+    const OGRGeometry& g = *got.geoms[0];
+    ASSERT_EQ(wkbFlatten(g.getGeometryType()), wkbMultiPolygon) << ext;
+    EXPECT_EQ(g.toMultiPolygon()->getNumGeometries(), 2) << ext;
+    EXPECT_TRUE(g.IsValid()) << ext;
+    EXPECT_DOUBLE_EQ(g.toMultiPolygon()->get_Area(), 16.0) << ext;
+
+    const std::string lout = path(std::string("l-cut") + ext);
+    const CliRun l = run_loci("clip " + line + " --bbox 0,0,10,10 -o " + lout);
+    ASSERT_EQ(l.status, 0) << ext << l.err;
+    EXPECT_NE(l.err.find("1 piece of lower dimension left out"), std::string::npos) << l.err;
+    const OgrFeatureSet lines = read_with_ogr(lout);
+    ASSERT_EQ(lines.geoms.size(), 1u) << ext;
+    const OGRGeometry& lg = *lines.geoms[0];
+    const auto type = wkbFlatten(lg.getGeometryType());
+    ASSERT_TRUE(type == wkbLineString || type == wkbMultiLineString) << ext << " " << type;
+    const double length = type == wkbLineString ? lg.toLineString()->get_Length()
+                                                : lg.toMultiLineString()->get_Length();
+    EXPECT_DOUBLE_EQ(length, 10.0) << ext;
+  }
+  expect_error("clip " + u + " --wkt " +
+                   shell_quote("MULTIPOLYGON(((0 0,4 0,4 4,0 4,0 0)),((2 2,6 2,6 6,2 6,2 2)))") +
+                   " -o " + path("w.geojson"),
+               "--wkt: the window is not a valid polygon");
+  expect_error("clip " + u + " --wkt " + shell_quote("POLYGON((0 0,4 4,4 0,0 4,0 0))") + " -o " +
+                   path("w.geojson"),
+               "--wkt: the window is not a valid polygon");
+  EXPECT_FALSE(fs::exists(path("w.geojson")));
+}
+
 TEST_F(LayersCli, UnwritableOutputLeavesNothing) {
   const std::string polys = path("polys.shp");
   expect_error("query " + polys + " --bbox 0,0,50,50 -o /nonexistent-dir/out.txt", "cannot write");

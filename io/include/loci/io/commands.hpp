@@ -115,8 +115,11 @@ struct ClipOptions {
   std::string out_path;
 };
 
-// Returns the number of features written.
-std::size_t clip_layer(const ClipOptions& options);
+struct ClipResult {
+  std::size_t written = 0;  // features written
+  std::size_t dropped = 0;  // cut pieces of a lower dimension than their feature left out
+};
+ClipResult clip_layer(const ClipOptions& options);
 
 struct DrawOptions {
   std::string
