@@ -293,6 +293,12 @@ void AtomicDataset::commit() {
   }
 }
 
+bool same_file(const std::string& a, const std::string& b) {
+  if (a == b) return true;
+  std::error_code ec;
+  return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
+}
+
 void refuse_overwriting(const std::string& out, const std::string& input, const char* what) {
   if (out.empty() || input.empty()) return;
   std::error_code ec;

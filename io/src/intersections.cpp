@@ -7,6 +7,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/segment_intersections.hpp"
+#include "loci/io/atomic_file.hpp"
 #include "loci/io/layer_reader.hpp"
 
 namespace loci::io {
@@ -14,26 +15,40 @@ namespace loci::io {
 Linework::Linework(const std::vector<SegmentRecord>& recs) {
   segs.reserve(recs.size());
   fid.reserve(recs.size());
-  for (const SegmentRecord& r : recs) {
-    segs.push_back(r.segment);
-    fid.push_back(r.fid);
-  }
-  first.resize(recs.size());
-  last.resize(recs.size());
+  // A repeated vertex (a segment of length zero) is left out of its line when the line has
+  // segments of some length: it lies on both of its neighbours, so it meets nothing they do
+  // not, and kept it would part them, and their shared vertex would read as the line crossing
+  // itself. A line that is one point repeated keeps one such segment.
   for (std::size_t i = 0; i < recs.size();) {
     std::size_t j = i;
+    bool any_length = recs[i].segment.a != recs[i].segment.b;
     while (j + 1 < recs.size() && recs[j + 1].fid == recs[i].fid &&
-           recs[j + 1].part == recs[i].part)
+           recs[j + 1].part == recs[i].part) {
       ++j;
-    for (std::size_t k = i; k <= j; ++k)
-      first[k] = std::uint32_t(i), last[k] = std::uint32_t(j);
+      any_length = any_length || recs[j].segment.a != recs[j].segment.b;
+    }
+    const auto begin = std::uint32_t(segs.size());
+    for (std::size_t k = i; k <= j; ++k) {
+      if (any_length && recs[k].segment.a == recs[k].segment.b) continue;
+      segs.push_back(recs[k].segment);
+      fid.push_back(recs[k].fid);
+      if (!any_length) break;
+    }
+    const auto end = std::uint32_t(segs.size());
+    for (std::uint32_t k = begin; k < end; ++k) {
+      first.push_back(begin);
+      last.push_back(end - 1);
+    }
     i = j + 1;
   }
 }
 
 std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
   const Linework left(read_segments(o.layer_path, o.layer_name, o.progress));
-  if (o.other_path.empty()) return intersection_rows(left, nullptr, o.pairs_only, o.jobs);
+  // The layer given twice (however its path is spelled) is the layer against itself.
+  if (o.other_path.empty() ||
+      (same_file(o.layer_path, o.other_path) && o.layer_name == o.other_name))
+    return intersection_rows(left, nullptr, o.pairs_only, o.jobs);
   const Linework right(read_segments(o.other_path, o.other_name, o.progress));
   return intersection_rows(left, &right, o.pairs_only, o.jobs);
 }

@@ -174,20 +174,34 @@ TEST(IntersectionsCli, HandCasesFormatsAndErrors) {
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[1,-1],[1,1]]}},
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[3,0],[6,0]]}},
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[10,0],[12,2],[12,0],[10,2]]}},
-{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[20,0],[22,0],[22,2],[20,0]]]}}
+{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[20,0],[22,0],[22,2],[20,0]]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[30,0],[31,0],[31,0],[31,1]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[40,0],[42,0],[42,0],[42,2],[40,0],[40,0]]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[50,0],[50,0]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[60,0],[62,2],[62,2],[62,0],[60,2]]}}
 ]})";
   const CliRun r = run_loci("intersections " + shell_quote(p.string()));
   ASSERT_EQ(r.status, 0) << r.err;
   // 0 x 1 cross at (1,0); 0 and 2 overlap on [3,4]; 3 crosses itself at (11,1); the ring of
-  // 4 closes on itself but is simple
-  EXPECT_EQ(r.out, "fid_a,fid_b,x,y\n0,1,1,0\n0,2,3,0\n0,2,4,0\n3,3,11,1\n");
+  // 4 closes on itself but is simple; 5 and 6 repeat a vertex but are simple, 7 is one point
+  // repeated; 8 repeats a vertex and crosses itself at (61,1)
+  EXPECT_EQ(r.out, "fid_a,fid_b,x,y\n0,1,1,0\n0,2,3,0\n0,2,4,0\n3,3,11,1\n8,8,61,1\n");
   const CliRun pairs = run_loci("intersections " + shell_quote(p.string()) + " --pairs-only");
-  EXPECT_EQ(pairs.out, "fid_a,fid_b\n0,1\n0,2\n3,3\n");
+  EXPECT_EQ(pairs.out, "fid_a,fid_b\n0,1\n0,2\n3,3\n8,8\n");
+  // The layer named twice, spelled differently, is the layer against itself: no feature met by
+  // itself for sharing its own linework, and the closest pair is two features.
+  const std::string again = shell_quote((dir / "." / "hand.geojson").string());
+  const CliRun twice = run_loci("intersections " + shell_quote(p.string()) + " " + again);
+  ASSERT_EQ(twice.status, 0) << twice.err;
+  EXPECT_EQ(twice.out, r.out);
+  const CliRun closest = run_loci("join " + shell_quote(p.string()) + " " + again + " --closest");
+  ASSERT_EQ(closest.status, 0) << closest.err;
+  EXPECT_EQ(closest.out.substr(closest.out.find('\n') + 1, 4), "0,1,");
   const CliRun gj = run_loci("intersections " + shell_quote(p.string()) + " -f geojson -o " +
                              shell_quote((dir / "x.geojson").string()));
   ASSERT_EQ(gj.status, 0) << gj.err;
   const OgrFeatureSet pts = read_with_ogr((dir / "x.geojson").string());
-  EXPECT_EQ(pts.fids.size(), 4u);
+  EXPECT_EQ(pts.fids.size(), 5u);
   const CliRun ids = run_loci("intersections " + shell_quote(p.string()) + " -f ids");
   EXPECT_EQ(ids.status, 1);
   EXPECT_NE(ids.err.find("loci: error:"), std::string::npos);

@@ -70,6 +70,10 @@ class AtomicDataset {
   std::string staging_;
 };
 
+// True when the two paths name one file (spelled alike, or the same file through another
+// spelling, a link or a relative path).
+bool same_file(const std::string& a, const std::string& b);
+
 // Throws loci::Error when writing `out` would overwrite the layer `input` or one of its
 // companion files (a shapefile's .shp, .shx, .dbf, ...): the same file, or the same stem in
 // the same directory for a shapefile. The message calls `input` `what`.
