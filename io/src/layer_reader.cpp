@@ -26,19 +26,21 @@ std::vector<SegmentRecord> read_segments(const std::string& path, const std::str
     ticker.tick(double(++seen));
     const std::int64_t fid = feature->GetFID();
     std::int32_t part = 0;
-    detail::for_each_curve(
-        feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
-          const int n = c.getNumPoints();
-          for (int i = 0; i + 1 < n; ++i) {
-            const Segment<2> s{{c.getX(i), c.getY(i)}, {c.getX(i + 1), c.getY(i + 1)}};
-            if (!within_coordinate_range(s.a) || !within_coordinate_range(s.b)) {
-              detail::check_layer_point(s.a, where(path, fid));
-              detail::check_layer_point(s.b, where(path, fid));
-            }
-            out.push_back({s, fid, part});
-          }
-          ++part;
-        });
+    detail::for_each_curve(feature->GetGeometryRef(),
+                           [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
+                             const int n = c.getNumPoints();
+                             // A curve of one point is that point: a segment of length zero.
+                             for (int i = 0; i + 1 < n || (i == 0 && n == 1); ++i) {
+                               const int j = std::min(i + 1, n - 1);
+                               const Segment<2> s{{c.getX(i), c.getY(i)}, {c.getX(j), c.getY(j)}};
+                               if (!within_coordinate_range(s.a) || !within_coordinate_range(s.b)) {
+                                 detail::check_layer_point(s.a, where(path, fid));
+                                 detail::check_layer_point(s.b, where(path, fid));
+                               }
+                               out.push_back({s, fid, part});
+                             }
+                             ++part;
+                           });
   }
   read_check.finish();
   return out;
@@ -85,8 +87,11 @@ void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& pat
   std::int32_t part = 0;
   detail::for_each_curve(g, [&](const OGRSimpleCurve& c, bool ring, std::uint32_t) {
     const int n = c.getNumPoints();
-    for (int i = 0; i + 1 < n; ++i) {
-      const Point2 a{c.getX(i), c.getY(i)}, b{c.getX(i + 1), c.getY(i + 1)};
+    // A curve of one point is that point: a segment of length zero, so that a per-segment
+    // index answers for it as the feature's own geometry does.
+    for (int i = 0; i + 1 < n || (i == 0 && n == 1); ++i) {
+      const int j = std::min(i + 1, n - 1);
+      const Point2 a{c.getX(i), c.getY(i)}, b{c.getX(j), c.getY(j)};
       if (!within_coordinate_range(a) || !within_coordinate_range(b)) {
         detail::check_layer_point(a, where(path, fid));
         detail::check_layer_point(b, where(path, fid));

@@ -398,7 +398,8 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
 
 // A record's segments, as a per-segment read through GDAL gives them: each line or ring's
 // consecutive points (parts numbered in file order), each point of a point or multipoint
-// shape as a zero-length segment. The record was read and checked by read_record.
+// shape, and a part of one point, as a zero-length segment. The record was read and checked by
+// read_record.
 void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::int64_t fid,
                          LayerItems& out) {
   const auto point = [](const unsigned char* xy) {
@@ -424,6 +425,10 @@ void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
         const std::uint32_t begin = le32(c + 44 + 4 * std::uint64_t(k)),
                             end = k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n;
         Point2 a = point(xy + 16 * std::uint64_t(begin));
+        if (end - begin == 1) {  // a part of one point is that point
+          out.boxes.push_back(Box2::of_point(a));
+          out.records.push_back({fid, std::int32_t(k), segment_flags(a, a, ring)});
+        }
         for (std::uint32_t i = begin + 1; i < end; ++i) {
           const Point2 b = point(xy + 16 * std::uint64_t(i));
           out.boxes.push_back(Segment2{a, b}.box());

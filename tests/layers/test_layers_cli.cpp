@@ -1000,6 +1000,47 @@ TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
   EXPECT_FALSE(fs::exists(path("w.geojson")));
 }
 
+// A line or ring of one point, or a shapefile part of one point, is that point: the
+// per-segment index (read through GDAL, and straight from a shapefile's records) answers for
+// it as the feature's own geometry does.
+TEST_F(LayersCli, PerSegmentKeepsPartsOfOnePoint) {
+  const std::string deg = path("deg.geojson"), multi = path("deg2.geojson");
+  std::ofstream(deg) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[1,1]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[2,2],[2,2]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[3,3]]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"MultiPoint","coordinates":[[5,5],[5,5]]}}
+]})";
+  std::ofstream(multi) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"a":1},"geometry":{"type":"MultiLineString","coordinates":[[[1,1]],[[5,0],[6,0]]]}},
+{"type":"Feature","properties":{"a":2},"geometry":{"type":"MultiLineString","coordinates":[[[10,0],[11,0]],[[3,3]]]}}
+]})";
+  const std::string shp = path("deg2.shp");
+  ASSERT_EQ(std::system(("ogr2ogr " + shell_quote(shp) + " " + shell_quote(multi)).c_str()), 0);
+  struct Case {
+    std::string layer;
+    std::string point;
+    std::string fid;
+  };
+  const std::vector<Case> cases = {{deg, "1,1", "0"}, {deg, "2,2", "1"}, {deg, "3,3", "2"},
+                                   {deg, "5,5", "3"}, {shp, "1,1", "0"}, {shp, "3,3", "1"}};
+  for (const std::string& layer : {deg, shp}) {
+    const CliRun r = run_loci("index " + layer + " --per segment -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  for (const Case& c : cases) {
+    for (const std::string how : {" --per segment", " --per feature", ""}) {
+      // "" reads the sidecar written above (per segment, from the shapefile's records).
+      const CliRun r = run_loci("query " + c.layer + " --point " + c.point + how);
+      EXPECT_EQ(r.out, c.fid + "\n") << c.layer << " " << c.point << how << r.err;
+      const CliRun n =
+          run_loci("query " + c.layer + " --nearest " + c.point + " -k 1 -f csv" + how);
+      EXPECT_NE(n.out.find("\n" + c.fid + ",0"), std::string::npos)
+          << c.layer << " " << c.point << how << n.out << n.err;
+    }
+  }
+}
+
 TEST_F(LayersCli, UnwritableOutputLeavesNothing) {
   const std::string polys = path("polys.shp");
   expect_error("query " + polys + " --bbox 0,0,50,50 -o /nonexistent-dir/out.txt", "cannot write");
