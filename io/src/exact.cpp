@@ -547,18 +547,41 @@ std::size_t PreparedGeometry::memory_bytes() const {
 }
 
 double distance(const FlatGeometry& g, const Point2& p) {
+  // Floating point, except for the edges passing within rounding of p (1e-10 of the
+  // coordinates' magnitude), measured exactly: 0 exactly when p lies on g.
+  const Box2 env = g.envelope();
+  const double reach = std::max(
+      {std::fabs(env.min[0]), std::fabs(env.min[1]), std::fabs(env.max[0]), std::fabs(env.max[1])});
+  const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * reach);
   double best = std::numeric_limits<double>::infinity();
+  auto offer = [&](const Segment2& s) {
+    const double d2 = squared_distance(p, s);
+    best = std::min(best, d2 > zone * zone ? d2 : accurate_squared_distance(p, s));
+  };
   for (const Part& part : g.parts) {
     if (part.end - part.begin == 1 || part.kind == PartKind::point) {
       for (std::uint32_t i = part.begin; i < part.end; ++i)
-        best = std::min(best, squared_distance(p, g.points[i]));
+        offer({g.points[i], g.points[i]});
       continue;
     }
     for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-      best = std::min(best, squared_distance(p, Segment2{g.points[i], g.points[i + 1]}));
+      offer({g.points[i], g.points[i + 1]});
   }
   if (best > 0 && inside_polygon(g, p)) return 0;
   return std::sqrt(best);
+}
+
+bool within_distance(const FlatGeometry& g, const Point2& p, double d) {
+  for (const Part& part : g.parts) {
+    if (part.end - part.begin == 1 || part.kind == PartKind::point) {
+      for (std::uint32_t i = part.begin; i < part.end; ++i)
+        if (compare_distance(p, {g.points[i], g.points[i]}, d) <= 0) return true;
+      continue;
+    }
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+      if (compare_distance(p, {g.points[i], g.points[i + 1]}, d) <= 0) return true;
+  }
+  return inside_polygon(g, p);
 }
 
 }  // namespace loci::io

@@ -231,15 +231,21 @@ Region region_of(const Query& q) {
       r.search = around(p, rad);
       r.probe = p;
       r.with_distance = true;
-      r.box_ok = [p, rad](const Box2& b) { return std::sqrt(squared_distance(p, b)) <= rad; };
+      // Boxes pass with the slack of rounding (a superset); segments and features are
+      // decided exactly.
+      r.box_ok = [p, rad](const Box2& b) {
+        const double slack =
+            1e-14 * (std::fabs(p[0]) + std::fabs(p[1]) + std::fabs(b.min[0]) + std::fabs(b.min[1]) +
+                     std::fabs(b.max[0]) + std::fabs(b.max[1])) +
+            4e-16 * rad;
+        return std::sqrt(squared_distance(p, b)) <= rad + slack;
+      };
       r.segment_ok = [p, rad](const Segment2& e) -> std::optional<double> {
-        const double d = std::sqrt(squared_distance(p, e));
-        if (d <= rad) return d;
+        if (compare_distance(p, e, rad) <= 0) return std::sqrt(accurate_squared_distance(p, e));
         return std::nullopt;
       };
       r.feature_ok = [p, rad](const FlatGeometry& g, const Box2&) -> std::optional<double> {
-        const double d = distance(g, p);
-        if (d <= rad) return d;
+        if (within_distance(g, p, rad)) return distance(g, p);
         return std::nullopt;
       };
       break;
@@ -603,7 +609,9 @@ struct FeatureDescent {
         }
         // A segment is no nearer than its box, so only those whose box is nearer are measured.
         const Segment2 s = segment_of(leaf.box(e), r->flags);
-        best = std::min(best, squared_distance(p, s));
+        const double d2 = squared_distance(p, s);
+        // Measured exactly where rounding could be much of it (a point on the segment: 0).
+        if (d2 < best) best = std::min(best, accurate_squared_distance(p, s));
       }
       return;
     }
@@ -789,7 +797,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       if (candidates_only)
         offer(f, box_distance);
       else if (per_segment)
-        offer(f, std::sqrt(squared_distance(p, segment_of(b, r.flags))));
+        offer(f, std::sqrt(accurate_squared_distance(p, segment_of(b, r.flags))));
       else
         offer(f, distance(geometries_->get(r.fid), p));
       return true;

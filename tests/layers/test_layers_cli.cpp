@@ -1041,6 +1041,23 @@ TEST_F(LayersCli, PerSegmentKeepsPartsOfOnePoint) {
   }
 }
 
+// A point lying exactly on a slanted segment (where the floating distance is about 2e-15) is at
+// distance 0: --within at 0 finds what --point finds, and --nearest says 0; a distance equal to
+// the true one is decided exactly.
+TEST_F(LayersCli, DistancesAtRoundingAreExact) {
+  const std::string on = path("on.geojson");
+  std::ofstream(on) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":
+[[39008.1,2.9000000000000004],[39048.06,-39.28]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[39021.42,-11.17]}}]})";
+  for (const std::string how : {" --per segment", " --per feature"}) {
+    EXPECT_EQ(run_loci("query " + on + " --point 39021.42,-11.16" + how).out, "0\n") << how;
+    EXPECT_EQ(run_loci("query " + on + " --within 39021.42,-11.16,0" + how).out, "0\n") << how;
+    const CliRun n = run_loci("query " + on + " --nearest 39021.42,-11.16 -k 1 -f csv" + how);
+    EXPECT_EQ(n.out, "fid,distance\n0,0\n") << how << n.err;
+  }
+}
+
 TEST_F(LayersCli, UnwritableOutputLeavesNothing) {
   const std::string polys = path("polys.shp");
   expect_error("query " + polys + " --bbox 0,0,50,50 -o /nonexistent-dir/out.txt", "cannot write");

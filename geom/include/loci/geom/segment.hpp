@@ -6,10 +6,14 @@
 // axes and the cross products of the segment with them, each of which lies in a coordinate
 // plane, so the segment meets the box exactly when its three axis-plane projections meet the
 // projected rectangles. Segment-segment intersection is decided by exact orientations, with
-// touching and collinear overlap counted as intersecting. Distances are plain floating point.
+// touching and collinear overlap counted as intersecting. Distances are plain floating point,
+// except the 2D point-segment ones below: compared with a distance exactly, and recomputed
+// exactly (then rounded) where the point lies within rounding of the segment, so that a point
+// on a segment is at distance 0 and no other is.
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include "loci/geom/box.hpp"
@@ -113,6 +117,41 @@ double squared_distance(const Point<D>& p, const Segment<D>& s) {
     r += d * d;
   }
   return r;
+}
+
+namespace detail {
+// The exact squared distance from p to s, rounded to a double (0 only when p lies on s).
+double squared_distance_exact(const Point<2>& p, const Segment<2>& s);
+// The sign of |p s|^2 - d^2, decided exactly.
+int compare_distance_exact(const Point<2>& p, const Segment<2>& s, double d);
+
+// A bound on the rounding error of sqrt(squared_distance(p, s)): a few dozen units in the last
+// place of the largest coordinate involved (the projection is computed from absolute
+// coordinates, so the error scales with them, not with the distance).
+inline double distance_rounding(const Point<2>& p, const Segment<2>& s) {
+  return 1e-14 * (std::fabs(p[0]) + std::fabs(p[1]) + std::fabs(s.a[0]) + std::fabs(s.a[1]) +
+                  std::fabs(s.b[0]) + std::fabs(s.b[1]));
+}
+}  // namespace detail
+
+// squared_distance(p, s), recomputed exactly (then rounded) where p lies within 1e-10 of the
+// coordinates' magnitude of s, where rounding could be much of it: 0 exactly when p lies on s,
+// and positive otherwise.
+inline double accurate_squared_distance(const Point<2>& p, const Segment<2>& s) {
+  const double d2 = squared_distance(p, s);
+  const double zone = 1e4 * detail::distance_rounding(p, s);
+  return d2 > zone * zone ? d2 : detail::squared_distance_exact(p, s);
+}
+
+// The sign of the distance from p to the closed segment s minus d (d finite and >= 0), decided
+// exactly: -1 nearer than d, 0 at exactly d, +1 farther. Floating point decides when the
+// distance is clearly apart from d.
+inline int compare_distance(const Point<2>& p, const Segment<2>& s, double d) {
+  const double got = std::sqrt(squared_distance(p, s));
+  const double margin = detail::distance_rounding(p, s) + 4e-16 * d;
+  if (got > d + margin) return 1;
+  if (got < d - margin) return -1;
+  return detail::compare_distance_exact(p, s, d);
 }
 
 }  // namespace loci

@@ -14,7 +14,9 @@
 // rings of a feature are taken together (the even-odd rule, as GEOS and the per-segment index
 // count them): for valid geometries that is polygon by polygon, and where polygons of one
 // invalid multi-polygon overlap, their overlap is outside.
-// Touching counts. Distances are computed in floating point and are 0 inside a polygon.
+// Touching counts. Distances are computed in floating point and are 0 inside a polygon; a
+// point's distance is 0 exactly when the point lies on the geometry, and whether it is within
+// a distance is decided exactly.
 // Thread-safety: plain values; the functions are pure.
 #pragma once
 
@@ -49,8 +51,11 @@ struct FlatGeometry {
 bool meets(const FlatGeometry& g, const Box2& box);
 // True when the geometry and the closed segment share at least one point.
 bool meets(const FlatGeometry& g, const Segment2& s);
-// Euclidean distance from p to the nearest point of the geometry (0 inside a polygon).
+// Euclidean distance from p to the nearest point of the geometry (0 inside a polygon), in
+// floating point except where p lies within rounding of an edge: 0 exactly when p lies on g.
 double distance(const FlatGeometry& g, const Point2& p);
+// True when the geometry comes within distance d (>= 0) of p, decided exactly.
+bool within_distance(const FlatGeometry& g, const Point2& p, double d);
 
 // Where the closed segment s first meets g, as the parameter t in [0, 1] of the point
 // s.a + t (s.b - s.a) (0 when s starts inside or on g); nothing when they do not meet. Whether
