@@ -97,6 +97,17 @@ void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
   w.flush();
 }
 
+// The name a layer's field is written under beside loci's own columns: `layer_NAME` when NAME
+// is one of them (a layer with a field `fid` or `distance`), so that no column is written twice
+// and none is lost.
+std::string attribute_name(const std::string& name, bool numbered, bool with_distance,
+                           bool with_point) {
+  const bool taken = name == "fid" || (numbered && name == "query") ||
+                     (with_distance && name == "distance") ||
+                     (with_point && (name == "x" || name == "y"));
+  return taken ? "layer_" + name : name;
+}
+
 void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
                bool with_distance, bool with_point, std::FILE* out) {
   auto ol = detail::open_layer(src.layer_path, src.layer_name);
@@ -109,7 +120,8 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
   if (with_distance) line += ",distance";
   if (with_point) line += ",x,y";
   for (int i = 0; i < defn->GetFieldCount(); ++i)
-    line += "," + csv_quoted(defn->GetFieldDefn(i)->GetNameRef());
+    line += "," + csv_quoted(attribute_name(defn->GetFieldDefn(i)->GetNameRef(), numbered,
+                                            with_distance, with_point));
   std::fprintf(out, "%s\n", line.c_str());
   AnswerFeatures features(ol, src, answers, [&](std::int64_t fid) {
     return OGRFeatureUniquePtr(ol.layer->GetFeature(fid));
@@ -155,11 +167,9 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
   const OGRFeatureDefn* defn = ol.layer->GetLayerDefn();
   for (int i = 0; i < defn->GetFieldCount(); ++i) {
     const OGRFieldDefn* fd = defn->GetFieldDefn(i);
-    const std::string name = fd->GetNameRef();
-    if (name == "query" || name == "fid" || name == "distance" ||
-        (with_point && (name == "x" || name == "y")))
-      continue;
+    const std::string name = attribute_name(fd->GetNameRef(), numbered, with_distance, with_point);
     OGRFieldDefn copy(fd);
+    copy.SetName(name.c_str());
     if (layer->CreateField(&copy) != OGRERR_NONE) throw Error("cannot create field " + name);
     copied.emplace_back(i, out_index++);
   }

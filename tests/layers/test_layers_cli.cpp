@@ -1058,6 +1058,24 @@ TEST_F(LayersCli, DistancesAtRoundingAreExact) {
   }
 }
 
+// A layer's own fields named like loci's columns (fid, distance) are written as layer_fid and
+// layer_distance, in CSV (which wrote two columns named fid) and in GeoJSON (which left them
+// out).
+TEST_F(LayersCli, FieldsNamedLikeLociColumnsAreKept) {
+  const std::string layer = path("named.geojson");
+  std::ofstream(layer) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"fid":"A","distance":7,"name":"x"},"geometry":{"type":"Point","coordinates":[1,1]}}]})";
+  const CliRun csv = run_loci("query " + layer + " --nearest 0,0 -k 1 -f csv");
+  EXPECT_EQ(csv.out, "fid,distance,layer_fid,layer_distance,name\n0,1.4142135623730951,A,7,x\n")
+      << csv.err;
+  const std::string out = path("named-out.geojson");
+  const CliRun gj = run_loci("query " + layer + " --nearest 0,0 -k 1 -f geojson -o " + out);
+  ASSERT_EQ(gj.status, 0) << gj.err;
+  const std::string text = read_text(out);
+  EXPECT_NE(text.find("\"layer_fid\": \"A\""), std::string::npos) << text;
+  EXPECT_NE(text.find("\"layer_distance\": 7"), std::string::npos) << text;
+}
+
 TEST_F(LayersCli, UnwritableOutputLeavesNothing) {
   const std::string polys = path("polys.shp");
   expect_error("query " + polys + " --bbox 0,0,50,50 -o /nonexistent-dir/out.txt", "cannot write");
