@@ -317,14 +317,18 @@ RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32
           44 + 4 * parts + 16 * n > length)
         return r;
       // Parts start at 0 and each holds at least one point.
-      std::uint64_t previous = 0;
+      // A part of one point counts as one segment (of length zero), the others one fewer
+      // than their points.
+      std::uint64_t previous = 0, single = 0;
       for (std::uint64_t i = 0; i < parts; ++i) {
         const std::uint64_t start = le32(c + 44 + 4 * i);
         if ((i == 0 && start != 0) || (i > 0 && start <= previous) || start >= n) return r;
+        single += i > 0 && start - previous == 1;
         previous = start;
       }
+      single += n - previous == 1;
       add_points(c + 44 + 4 * parts, n, r.box, path, fid);
-      r.segments = n - parts;
+      r.segments = n - parts + single;
       break;
     }
     case Kind::other:
