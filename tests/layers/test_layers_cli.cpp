@@ -578,6 +578,19 @@ TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
   r = run_loci("info " + layer);
   EXPECT_NE(r.out.find("fresh"), std::string::npos) << r.out;
   fs::remove(layer + ".loci");
+  // A GeoPackage of two layers indexed for one: the other's info does not call it fresh.
+  const std::string two = path("two.gpkg");
+  fs::remove(two);
+  ASSERT_EQ(std::system(("ogr2ogr -f GPKG " + two + " " + layer +
+                         " -nln alpha && ogr2ogr -update " + two + " " + layer + " -nln beta")
+                            .c_str()),
+            0);
+  ASSERT_EQ(run_loci("index -q " + two + " --layer beta").status, 0);
+  r = run_loci("info " + two + " --layer alpha");
+  EXPECT_NE(r.out.find("not this layer's (it indexes layer 'beta'"), std::string::npos) << r.out;
+  r = run_loci("info " + two + " --layer beta");
+  EXPECT_NE(r.out.find(": fresh"), std::string::npos) << r.out;
+  fs::remove(two + ".loci");
 }
 
 TEST_F(LayersCli, HelpDocumentsEveryCommand) {
