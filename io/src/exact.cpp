@@ -261,32 +261,66 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
   const bool areas = b.polygons > 0;
   if (areas && a.polygons == 0) return false;  // linework and points cover no area
   // Where the edges of a and b meet: cut parameters on b's edges, and on a's ring edges when b
-  // has polygons, with the stretches where they run along each other.
-  std::vector<Cuts> cb(eb.segs.size()), ca(areas ? ea.segs.size() : 0);
+  // has polygons, with the stretches where they run along each other; kept flat, then
+  // gathered edge by edge.
+  struct Cut {
+    std::uint32_t edge;
+    double u, v;  // u == v: a crossing; else a stretch along the other's edge
+    bool operator<(const Cut& o) const { return edge < o.edge; }
+  };
+  // Cuts at an edge's ends divide nothing, and an edge running wholly along the other's has no
+  // piece to test: neither is kept (for a feature joined with itself, that is nearly all).
+  std::vector<Cut> on_b, on_a;
+  std::vector<bool> along_b(eb.segs.size()), along_a(areas ? ea.segs.size() : 0);
   join(std::span<const Box2>(eb.boxes), std::span<const Box2>(ea.boxes), [&](Id i, Id j) {
     const Segment2& s = eb.segs[i];
     const Segment2& e = ea.segs[j];
     const SegmentIntersection x = intersection(s, e);
     if (x.kind == SegmentMeet::none) return true;
-    auto record = [&](Cuts& c, const Segment2& on) {
-      const double u = parameter(on, x.a), v = parameter(on, x.b);
-      c.at.push_back(u);
-      if (x.kind != SegmentMeet::point) {
-        c.at.push_back(v);
-        c.along.emplace_back(std::min(u, v), std::max(u, v));
-      }
+    auto record = [&](std::vector<Cut>& cuts, std::vector<bool>& along, std::uint32_t edge,
+                      const Segment2& on) {
+      if (along[edge]) return;
+      const double u = parameter(on, x.a);
+      const double v = x.kind == SegmentMeet::point ? u : parameter(on, x.b);
+      const double lo = std::min(u, v), hi = std::max(u, v);
+      if (lo == 0 && hi == 1 && x.kind != SegmentMeet::point) along[edge] = true;
+      if (lo == hi && (lo == 0 || lo == 1)) return;
+      cuts.push_back({edge, lo, hi});
     };
-    record(cb[i], s);
-    if (areas && ea.ring[j]) record(ca[j], e);
+    record(on_b, along_b, std::uint32_t(i), s);
+    if (areas && ea.ring[j]) record(on_a, along_a, std::uint32_t(j), e);
     return true;
   });
+  std::sort(on_b.begin(), on_b.end());
+  std::sort(on_a.begin(), on_a.end());
+  // Calls f(t) for the middle of every piece of edge `edge` between its cuts that does not run
+  // along the other's edges; false when f does.
+  Cuts pieces;
+  auto each_piece = [&pieces](const std::vector<Cut>& cuts, std::size_t& k, std::uint32_t edge,
+                              auto&& f) {
+    pieces.at.clear();
+    pieces.along.clear();
+    for (; k < cuts.size() && cuts[k].edge == edge; ++k) {
+      pieces.at.push_back(cuts[k].u);
+      if (cuts[k].v != cuts[k].u) {
+        pieces.at.push_back(cuts[k].v);
+        pieces.along.emplace_back(cuts[k].u, cuts[k].v);
+      }
+    }
+    return pieces.each_piece(f);
+  };
   // Every point of b's linework lies in a: its vertices, and the middle of each piece between
   // cuts (pieces running along a's edges do).
-  for (std::size_t i = 0; i < eb.segs.size(); ++i) {
+  std::size_t k = 0;
+  for (std::uint32_t i = 0; i < eb.segs.size(); ++i) {
     const Segment2& s = eb.segs[i];
     if (!pa.meets(s.a) || !pa.meets(s.b)) return false;
-    if (s.a == s.b) continue;
-    if (!cb[i].each_piece([&](double t) { return pa.meets(point_at(s, t)); })) return false;
+    if (s.a == s.b || along_b[i]) {
+      while (k < on_b.size() && on_b[k].edge == i)
+        ++k;
+      continue;
+    }
+    if (!each_piece(on_b, k, i, [&](double t) { return pa.meets(point_at(s, t)); })) return false;
   }
   if (!areas) return true;
   // No point of a's polygons' boundary lies strictly inside b's polygons: a vertex there, or a
@@ -295,10 +329,16 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
   const Box2& env = pb.envelope();
   for (const Point2& v : a.points)
     if (intersects(env, v) && pb.locate(v) == Location::inside) return false;
-  for (std::size_t j = 0; j < ea.segs.size(); ++j) {
+  k = 0;
+  for (std::uint32_t j = 0; j < ea.segs.size(); ++j) {
     const Segment2& e = ea.segs[j];
-    if (!ea.ring[j] || e.a == e.b) continue;
-    if (!ca[j].each_piece([&](double t) { return pb.locate(point_at(e, t)) != Location::inside; }))
+    if (!ea.ring[j] || e.a == e.b || along_a[j]) {
+      while (k < on_a.size() && on_a[k].edge == j)
+        ++k;
+      continue;
+    }
+    if (!each_piece(on_a, k, j,
+                    [&](double t) { return pb.locate(point_at(e, t)) != Location::inside; }))
       return false;
   }
   // So the inside of each polygon of b lies wholly inside a or wholly outside it (say, a's hole
