@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -316,6 +317,44 @@ TYPED_TEST(MovingIndexTest, VisitorStopsEarly) {
   seen = 0;
   index.nearest(Point2{500, 500}, 3, 50, [&](Id, const Motion2&, double) { return ++seen < 3; });
   EXPECT_EQ(seen, 3);
+}
+
+// A query from inside another's visitor, both visitors of one type (std::function), answers
+// both in full: the R-trees' stack and the scan's hit buffer were once one per thread, and the
+// inner query emptied the outer's.
+TYPED_TEST(MovingIndexTest, QueriesNestInsideVisitors) {
+  const auto fleet = test::make_fleet(test::Fleet::uniform, 1500, 3);
+  TypeParam index;
+  Objects objs;
+  for (std::size_t i = 0; i < fleet.size(); ++i) {
+    index.insert(Id(i), fleet[i]);
+    objs[Id(i)] = fleet[i];
+  }
+  const double now = test::fleet_epoch(test::Fleet::uniform);
+  std::mt19937_64 rng(9);
+  for (int q = 0; q < 10; ++q) {
+    const MovingWindow<2> outer = random_window(rng, now, q % 3);
+    const MovingWindow<2> inner = random_window(rng, now, (q + 1) % 3);
+    const std::vector<Id> want_inner = brute_window(objs, inner);
+    using Visitor = std::function<bool(Id, const Motion2&)>;
+    std::vector<Id> got_inner;
+    Visitor in = [&](Id id, const Motion2&) {
+      got_inner.push_back(id);
+      return true;
+    };
+    std::vector<Id> got;
+    Visitor out = [&](Id id, const Motion2&) {
+      got.push_back(id);
+      got_inner.clear();
+      index.query(inner, in);
+      std::sort(got_inner.begin(), got_inner.end());
+      EXPECT_EQ(got_inner, want_inner) << q;
+      return true;
+    };
+    index.query(outer, out);
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, brute_window(objs, outer)) << q;
+  }
 }
 
 }  // namespace

@@ -27,6 +27,7 @@
 
 #include "loci/geom/motion.hpp"
 #include "loci/index/broadphase/detail/proxy_table.hpp"
+#include "loci/index/detail/scratch.hpp"
 #include "loci/index/moving/moving_index.hpp"
 
 namespace loci {
@@ -102,7 +103,9 @@ class MovingScan {
     st.nodes_visited = 1;
     const std::size_t n = ids_.size();
     st.entries_tested = n;
-    thread_local std::vector<std::uint32_t> hits;
+    // Leased, not a thread_local: a query from inside a visitor gets a buffer of its own.
+    detail::Scratch<std::uint32_t> hits_lease;
+    std::vector<std::uint32_t>& hits = *hits_lease;
     hits.resize(std::min<std::size_t>(n, kChunk));
     const bool slice = w.t1 == w.t2 && w.from == w.to;
     for (std::size_t base = 0; base < n; base += kChunk) {

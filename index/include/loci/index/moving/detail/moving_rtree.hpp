@@ -43,6 +43,7 @@
 #include "loci/index/detail/best_first.hpp"
 #include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/detail/node_pool.hpp"
+#include "loci/index/detail/scratch.hpp"
 #include "loci/index/detail/str_partition.hpp"
 #include "loci/index/moving/detail/tpbr.hpp"
 #include "loci/index/moving/moving_index.hpp"
@@ -264,8 +265,9 @@ class MovingRTree {
     QueryStats st;
     if (root_ == kNone) return st;
     if (w.t1 < clock_) return scan(w, visit);
-    thread_local std::vector<std::uint32_t> stack;
-    stack.clear();
+    // Leased, not a thread_local: a query from inside a visitor gets a stack of its own.
+    detail::Scratch<std::uint32_t> stack_lease;
+    std::vector<std::uint32_t>& stack = *stack_lease;
     stack.push_back(root_);
     // A timeslice compares each entry's box at the query time with the window: no divisions.
     const bool slice = w.t1 == w.t2 && w.from == w.to;
