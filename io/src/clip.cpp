@@ -164,17 +164,17 @@ void members_of_dimension(const OGRGeometry& g, int dim, std::vector<const OGRGe
 
 // A cut that mixes dimensions (GEOS gives a collection: two arms of a U cut off from its bar,
 // and the line where the window's edge touches the notch) made of its members of the highest
-// dimension only, as one geometry or a multi-geometry; `dropped` is set when members of lower
-// dimension were left out. Forced into the layer's type as it came, such a collection's rings
-// would have become holes of its first polygon.
-std::unique_ptr<OGRGeometry> of_one_dimension(std::unique_ptr<OGRGeometry> piece, bool& dropped) {
-  dropped = false;
+// dimension only, as one geometry or a multi-geometry; `dropped` counts the members of lower
+// dimension left out. Forced into the layer's type as it came, such a collection's rings would
+// have become holes of its first polygon.
+std::unique_ptr<OGRGeometry> of_one_dimension(std::unique_ptr<OGRGeometry> piece,
+                                              std::size_t& dropped) {
   if (wkbFlatten(piece->getGeometryType()) != wkbGeometryCollection) return piece;
   const int dim = piece->getDimension();
   std::vector<const OGRGeometry*> keep;
   std::size_t lower = 0;
   members_of_dimension(*piece, dim, keep, lower);
-  dropped = lower > 0;
+  dropped += lower;
   std::unique_ptr<OGRGeometry> out;
   if (keep.size() == 1) {
     out.reset(keep.front()->clone());
@@ -268,9 +268,9 @@ ClipResult clip_layer(const ClipOptions& options) {
         }
         degenerate = true;
       }
-      bool lower = false;
-      piece = of_one_dimension(std::move(piece), lower);
-      result.dropped += lower;
+      // A feature that is itself a collection of several dimensions keeps its cut as it comes.
+      if (wkbFlatten(f->GetGeometryRef()->getGeometryType()) != wkbGeometryCollection)
+        piece = of_one_dimension(std::move(piece), result.dropped);
       pieces.push_back({std::move(f), std::move(piece)});
     }
     // A shapefile holds one kind of geometry: a layer that mixes them (GeoJSON, GeoPackage) is

@@ -160,12 +160,24 @@ struct Cuts {
     at.push_back(0);
     at.push_back(1);
     std::sort(at.begin(), at.end());
+    // The stretches merged into disjoint ones in order, walked alongside the pieces (a piece
+    // lies between consecutive cuts, so within one merged stretch or outside all).
+    std::sort(along.begin(), along.end());
+    std::size_t m = 0;
+    for (std::size_t k = 0; k < along.size(); ++k) {
+      if (m > 0 && along[k].first <= along[m - 1].second)
+        along[m - 1].second = std::max(along[m - 1].second, along[k].second);
+      else
+        along[m++] = along[k];
+    }
+    along.resize(m);
+    std::size_t j = 0;
     for (std::size_t k = 0; k + 1 < at.size(); ++k) {
       const double t0 = at[k], t1 = at[k + 1];
       if (!(t1 > t0)) continue;
-      bool on_other = false;
-      for (const auto& [lo, hi] : along)
-        on_other = on_other || (lo <= t0 && t1 <= hi);
+      while (j < along.size() && along[j].second < t1)
+        ++j;
+      const bool on_other = j < along.size() && along[j].first <= t0 && t1 <= along[j].second;
       if (!on_other && !f((t0 + t1) / 2)) return false;
     }
     return true;
@@ -191,8 +203,10 @@ std::optional<Point2> interior_point(const FlatGeometry& g, std::span<const std:
   std::vector<std::pair<double, double>> gaps;
   for (std::size_t k = 0; k + 1 < ys.size(); ++k)
     gaps.emplace_back(ys[k + 1] - ys[k], ys[k] + (ys[k + 1] - ys[k]) / 2);
+  // Widest first; a polygon so thin that 256 of its widest bands hold no point of a double
+  // is passed over (its inside is within rounding of its boundary).
   std::sort(gaps.begin(), gaps.end(), std::greater<>());
-  if (gaps.size() > 4) gaps.resize(4);
+  if (gaps.size() > 256) gaps.resize(256);
   std::vector<double> xs;
   for (const auto& [gap, y] : gaps) {
     xs.clear();
@@ -337,8 +351,15 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
         ++k;
       continue;
     }
-    if (!each_piece(on_a, k, j,
-                    [&](double t) { return pb.locate(point_at(e, t)) != Location::inside; }))
+    // The middle is rounded: it decides only when it lies inside b farther from b's boundary
+    // than the rounding (b's edge running within a hair of a's, the piece may lie outside b).
+    const double hair =
+        1e-13 * (std::fabs(e.a[0]) + std::fabs(e.a[1]) + std::fabs(e.b[0]) + std::fabs(e.b[1])) +
+        1e-300;
+    if (!each_piece(on_a, k, j, [&](double t) {
+          const Point2 m = point_at(e, t);
+          return pb.locate(m) != Location::inside || pb.near_boundary(m, hair);
+        }))
       return false;
   }
   // So the inside of each polygon of b lies wholly inside a or wholly outside it (say, a's hole
@@ -440,6 +461,23 @@ PreparedGeometry::PreparedGeometry(const FlatGeometry& g) : g_(&g), envelope_(g.
       edges_.push_back({i, kind});
   }
   build(std::clamp<std::size_t>(edges_.size() / 2, 1, std::size_t(1) << 22));
+}
+
+bool PreparedGeometry::near_boundary(const Point2& p, double delta) const {
+  const Box2 box{{p[0] - delta, p[1] - delta}, {p[0] + delta, p[1] + delta}};
+  if (!intersects(envelope_, box)) return false;
+  const std::vector<Point2>& pts = g_->points;
+  for (std::uint32_t r = row(box.min[1]), r1 = row(box.max[1]); r <= r1; ++r)
+    for (std::uint32_t c = col(box.min[0]), c1 = col(box.max[0]); c <= c1; ++c) {
+      const std::size_t cell = std::size_t(r) * nx_ + c;
+      for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
+        const Edge& e = edges_[cell_edges_[i]];
+        const Point2& a = pts[e.first];
+        if (e.kind == kPoint ? intersects(box, a) : intersects(box, Segment2{a, pts[e.first + 1]}))
+          return true;
+      }
+    }
+  return false;
 }
 
 std::uint32_t PreparedGeometry::col(double x) const {
@@ -592,7 +630,7 @@ double distance(const FlatGeometry& g, const Point2& p) {
   const Box2 env = g.envelope();
   const double reach = std::max(
       {std::fabs(env.min[0]), std::fabs(env.min[1]), std::fabs(env.max[0]), std::fabs(env.max[1])});
-  const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * reach);
+  const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * reach) + 1e-146;
   double best = std::numeric_limits<double>::infinity();
   auto offer = [&](const Segment2& s) {
     const double d2 = squared_distance(p, s);

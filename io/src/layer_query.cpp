@@ -237,7 +237,7 @@ Region region_of(const Query& q) {
         const double slack =
             1e-14 * (std::fabs(p[0]) + std::fabs(p[1]) + std::fabs(b.min[0]) + std::fabs(b.min[1]) +
                      std::fabs(b.max[0]) + std::fabs(b.max[1])) +
-            4e-16 * rad;
+            4e-16 * rad + 1e-150;
         return std::sqrt(squared_distance(p, b)) <= rad + slack;
       };
       r.segment_ok = [p, rad](const Segment2& e) -> std::optional<double> {
@@ -586,7 +586,17 @@ struct FeatureDescent {
   const PackedRTree2& tree;
   Point2 p;
   bool boxes_only;
+  // Squared distances at most this are within rounding of 0 for segments of the tree's extent
+  // (accurate_squared_distance's zone for the largest coordinates there).
+  double near2 = near_zone(p, tree.bounds());
   mutable std::size_t visits = 0;  // nodes read by this query's walks (Features::node_count)
+
+  static double near_zone(const Point2& p, const Box2& extent) {
+    const double reach = std::max({std::fabs(extent.min[0]), std::fabs(extent.min[1]),
+                                   std::fabs(extent.max[0]), std::fabs(extent.max[1])});
+    const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * reach) + 1e-146;
+    return zone * zone;
+  }
 
   void operator()(std::uint32_t level, std::uint32_t i, double& best, bool touched) const {
     if (++visits > 2 * features.node_count) features.corrupt();
@@ -610,8 +620,9 @@ struct FeatureDescent {
         // A segment is no nearer than its box, so only those whose box is nearer are measured.
         const Segment2 s = segment_of(leaf.box(e), r->flags);
         const double d2 = squared_distance(p, s);
-        // Measured exactly where rounding could be much of it (a point on the segment: 0).
-        if (d2 < best) best = std::min(best, accurate_squared_distance(p, s));
+        // Measured exactly where rounding could be much of it (a point on the segment: 0),
+        // also when the rounded value does not beat the best (which may be rounded too).
+        if (d2 < best || d2 <= near2) best = std::min(best, accurate_squared_distance(p, s));
       }
       return;
     }

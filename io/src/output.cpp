@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <set>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -97,15 +99,33 @@ void write_ids(std::span<const Answer> answers, bool numbered, std::FILE* out) {
   w.flush();
 }
 
-// The name a layer's field is written under beside loci's own columns: `layer_NAME` when NAME
-// is one of them (a layer with a field `fid` or `distance`), so that no column is written twice
-// and none is lost.
-std::string attribute_name(const std::string& name, bool numbered, bool with_distance,
-                           bool with_point) {
-  const bool taken = name == "fid" || (numbered && name == "query") ||
-                     (with_distance && name == "distance") ||
-                     (with_point && (name == "x" || name == "y"));
-  return taken ? "layer_" + name : name;
+// The names the layer's fields are written under beside loci's own columns: a field named like
+// one of them (a layer with a field `fid` or `distance`) is written as `layer_NAME`, with `_2`,
+// `_3`, ... added while that is taken too, so that no column is written twice and none is lost
+// (the output of one query read by the next has both `fid` and `layer_fid`).
+std::vector<std::string> attribute_names(const OGRFeatureDefn& defn, bool numbered,
+                                         bool with_distance, bool with_point) {
+  std::set<std::string> taken = {"fid"};
+  if (numbered) taken.insert("query");
+  if (with_distance) taken.insert("distance");
+  if (with_point) taken.insert({"x", "y"});
+  const std::set<std::string> ours = taken;
+  for (int i = 0; i < defn.GetFieldCount(); ++i)
+    taken.insert(defn.GetFieldDefn(i)->GetNameRef());
+  std::vector<std::string> names;
+  for (int i = 0; i < defn.GetFieldCount(); ++i) {
+    const std::string name = defn.GetFieldDefn(i)->GetNameRef();
+    if (!ours.count(name)) {
+      names.push_back(name);
+      continue;
+    }
+    std::string renamed = "layer_" + name;
+    for (int k = 2; taken.count(renamed); ++k)
+      renamed = "layer_" + name + "_" + std::to_string(k);
+    taken.insert(renamed);
+    names.push_back(renamed);
+  }
+  return names;
 }
 
 void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
@@ -119,9 +139,8 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
   std::string line = numbered ? "query,fid" : "fid";
   if (with_distance) line += ",distance";
   if (with_point) line += ",x,y";
-  for (int i = 0; i < defn->GetFieldCount(); ++i)
-    line += "," + csv_quoted(attribute_name(defn->GetFieldDefn(i)->GetNameRef(), numbered,
-                                            with_distance, with_point));
+  for (const std::string& name : attribute_names(*defn, numbered, with_distance, with_point))
+    line += "," + csv_quoted(name);
   std::fprintf(out, "%s\n", line.c_str());
   AnswerFeatures features(ol, src, answers, [&](std::int64_t fid) {
     return OGRFeatureUniquePtr(ol.layer->GetFeature(fid));
@@ -165,9 +184,11 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
   const int x_field = with_point ? add_field("x", OFTReal) : -1;
   const int y_field = with_point ? add_field("y", OFTReal) : -1;
   const OGRFeatureDefn* defn = ol.layer->GetLayerDefn();
+  const std::vector<std::string> names =
+      attribute_names(*defn, numbered, with_distance, with_point);
   for (int i = 0; i < defn->GetFieldCount(); ++i) {
     const OGRFieldDefn* fd = defn->GetFieldDefn(i);
-    const std::string name = attribute_name(fd->GetNameRef(), numbered, with_distance, with_point);
+    const std::string& name = names[std::size_t(i)];
     OGRFieldDefn copy(fd);
     copy.SetName(name.c_str());
     if (layer->CreateField(&copy) != OGRERR_NONE) throw Error("cannot create field " + name);

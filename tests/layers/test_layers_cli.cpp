@@ -1003,6 +1003,19 @@ TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
                                                 : lg.toMultiLineString()->get_Length();
     EXPECT_DOUBLE_EQ(length, 10.0) << ext;
   }
+  // A feature that is itself a collection of polygon, line and point keeps all of them.
+  const std::string gc = path("gc.geojson"), gc_out = path("gc-cut.geojson");
+  std::ofstream(gc) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"GeometryCollection","geometries":[
+{"type":"Polygon","coordinates":[[[0,0],[4,0],[4,4],[0,4],[0,0]]]},
+{"type":"LineString","coordinates":[[10,0],[10,4]]},{"type":"Point","coordinates":[12,2]}]}}]})";
+  const CliRun g = run_loci("clip " + gc + " --bbox -1,-1,20,20 -o " + gc_out);
+  ASSERT_EQ(g.status, 0) << g.err;
+  EXPECT_EQ(g.err.find("left out"), std::string::npos) << g.err;
+  const OgrFeatureSet gcs = read_with_ogr(gc_out);
+  ASSERT_EQ(gcs.geoms.size(), 1u);
+  EXPECT_EQ(wkbFlatten(gcs.geoms[0]->getGeometryType()), wkbGeometryCollection);
+  EXPECT_EQ(gcs.geoms[0]->toGeometryCollection()->getNumGeometries(), 3);
   expect_error("clip " + u + " --wkt " +
                    shell_quote("MULTIPOLYGON(((0 0,4 0,4 4,0 4,0 0)),((2 2,6 2,6 6,2 6,2 2)))") +
                    " -o " + path("w.geojson"),
@@ -1063,6 +1076,16 @@ TEST_F(LayersCli, DistancesAtRoundingAreExact) {
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":
 [[39008.1,2.9000000000000004],[39048.06,-39.28]]}},
 {"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[39021.42,-11.17]}}]})";
+  // A point exactly on the second segment of a line whose first segment's rounded distance
+  // (8e-27) is smaller than the second's (1e-13): nearest through the per-segment sidecar's
+  // hierarchies says 0 too.
+  const std::string two = path("two-segments.geojson");
+  std::ofstream(two) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":
+[[84043.75,3042.875],[85298.125,196.625],[-1169076.8750000002,2846446.625]]}}]})";
+  ASSERT_EQ(run_loci("index " + two + " --per segment -q").status, 0);
+  const CliRun on_second = run_loci("query " + two + " --nearest 84768.5,1398.375 -k 1 -f csv");
+  EXPECT_EQ(on_second.out, "fid,distance\n0,0\n") << on_second.err;
   for (const std::string how : {" --per segment", " --per feature"}) {
     EXPECT_EQ(run_loci("query " + on + " --point 39021.42,-11.16" + how).out, "0\n") << how;
     EXPECT_EQ(run_loci("query " + on + " --within 39021.42,-11.16,0" + how).out, "0\n") << how;
@@ -1087,6 +1110,13 @@ TEST_F(LayersCli, FieldsNamedLikeLociColumnsAreKept) {
   const std::string text = read_text(out);
   EXPECT_NE(text.find("\"layer_fid\": \"A\""), std::string::npos) << text;
   EXPECT_NE(text.find("\"layer_distance\": 7"), std::string::npos) << text;
+  // That output queried again: fid, distance, layer_fid and layer_distance all kept, each under
+  // a name of its own.
+  const CliRun again = run_loci("query " + out + " --nearest 0,0 -k 1 -f csv");
+  EXPECT_EQ(again.out,
+            "fid,distance,layer_fid_2,layer_distance_2,layer_fid,layer_distance,name\n"
+            "0,1.4142135623730951,0,1.4142135623731,A,7,x\n")
+      << again.err;
 }
 
 TEST_F(LayersCli, UnwritableOutputLeavesNothing) {

@@ -235,5 +235,37 @@ TEST(PreparedGeometry, CoversWithHolesAgainstLatticeEvidence) {
   EXPECT_GT(covered, 100);
 }
 
+TEST(PreparedGeometry, CoversNearRoundingAndThinHoles) {
+  // b is a's triangle with one vertex moved a unit in the last place inwards: a covers it,
+  // though b's edges run within a hair of a's (a rounded middle of a's edge may fall inside b).
+  FlatGeometry a, b;
+  add_ring(a,
+           {{135401.49193606543, 141486.6504535633},
+            {135458.63329208002, 141498.15754682568},
+            {135425.6988831334, 141555.2314589824}},
+           0);
+  add_ring(b,
+           {{135401.49193606546, 141486.65045356334},
+            {135458.63329208002, 141498.15754682568},
+            {135425.6988831334, 141555.2314589824}},
+           0);
+  a.polygons = b.polygons = 1;
+  EXPECT_TRUE(covers(a, b));
+  // b fills a's hole exactly; the hole is a square with a spike thinner than a unit in the
+  // last place, its vertices placed so that the widest bands between vertex heights all fall
+  // in the spike: the square below still gives a point inside.
+  FlatGeometry h, plug;
+  add_ring(h, {{0, 0}, {1e7, 0}, {1e7, 1e7}, {0, 1e7}}, 0);
+  const std::vector<Point2> hole = {
+      {2, 2},       {2, 4},       {3, 4},       {3, 2250000},
+      {3, 4500000}, {3, 6750000}, {3, 9000000}, {std::nextafter(3.0, 4.0), 4},
+      {4, 4},       {4, 2}};
+  add_ring(h, hole, 0);
+  add_ring(plug, hole, 0);
+  h.polygons = plug.polygons = 1;
+  EXPECT_FALSE(covers(h, plug));
+  EXPECT_TRUE(covers(plug, plug));
+}
+
 }  // namespace
 }  // namespace loci::io

@@ -127,10 +127,12 @@ int compare_distance_exact(const Point<2>& p, const Segment<2>& s, double d);
 
 // A bound on the rounding error of sqrt(squared_distance(p, s)): a few dozen units in the last
 // place of the largest coordinate involved (the projection is computed from absolute
-// coordinates, so the error scales with them, not with the distance).
+// coordinates, so the error scales with them, not with the distance), and at least 1e-150,
+// below which the squares lose their digits to underflow.
 inline double distance_rounding(const Point<2>& p, const Segment<2>& s) {
   return 1e-14 * (std::fabs(p[0]) + std::fabs(p[1]) + std::fabs(s.a[0]) + std::fabs(s.a[1]) +
-                  std::fabs(s.b[0]) + std::fabs(s.b[1]));
+                  std::fabs(s.b[0]) + std::fabs(s.b[1])) +
+         1e-150;
 }
 }  // namespace detail
 

@@ -107,6 +107,8 @@ class PreparedGeometry {
   Location locate(const Point2& p) const;
   // The answer of meets(g, Box2::of_point(p)).
   bool meets(const Point2& p) const { return locate(p) != Location::outside; }
+  // True when an edge or point of g comes within delta of p in x and in y (exact).
+  bool near_boundary(const Point2& p, double delta) const;
   std::size_t memory_bytes() const;
 
  private:
