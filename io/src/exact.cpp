@@ -184,10 +184,6 @@ struct Cuts {
   }
 };
 
-Point2 point_at(const Segment2& s, double t) {
-  return {s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])};
-}
-
 // A point strictly inside the polygon bounded by `rings` (parts of g, by the even-odd rule),
 // found on a horizontal line between two of its vertices' heights and checked exactly against
 // g; nothing when rounding leaves no such point (a polygon thinner than the rounding).
@@ -625,16 +621,13 @@ std::size_t PreparedGeometry::memory_bytes() const {
 }
 
 double distance(const FlatGeometry& g, const Point2& p) {
-  // Floating point, except for the edges passing within rounding of p (1e-10 of the
-  // coordinates' magnitude), measured exactly: 0 exactly when p lies on g.
-  const Box2 env = g.envelope();
-  const double reach = std::max(
-      {std::fabs(env.min[0]), std::fabs(env.min[1]), std::fabs(env.max[0]), std::fabs(env.max[1])});
-  const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * reach) + 1e-146;
+  // Floating point, except for the edges passing within rounding of p, measured exactly: 0
+  // exactly when p lies on g.
+  const double near2 = near_zone_squared(p, g.envelope());
   double best = std::numeric_limits<double>::infinity();
   auto offer = [&](const Segment2& s) {
     const double d2 = squared_distance(p, s);
-    best = std::min(best, d2 > zone * zone ? d2 : accurate_squared_distance(p, s));
+    best = std::min(best, d2 > near2 ? d2 : accurate_squared_distance(p, s));
   };
   for (const Part& part : g.parts) {
     if (part.end - part.begin == 1 || part.kind == PartKind::point) {

@@ -275,12 +275,6 @@ double entry_parameter(const Segment2& s, const Box2& b) {
   return std::max(0.0, t0 - kSlack);
 }
 
-Point2 point_at(const Segment2& s, double t) {
-  if (t == 0) return s.a;
-  if (t == 1) return s.b;
-  return {s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])};
-}
-
 void check_query(const Query& q) {
   switch (q.kind) {
     case Query::Kind::bbox:
@@ -588,15 +582,8 @@ struct FeatureDescent {
   bool boxes_only;
   // Squared distances at most this are within rounding of 0 for segments of the tree's extent
   // (accurate_squared_distance's zone for the largest coordinates there).
-  double near2 = near_zone(p, tree.bounds());
+  double near2 = near_zone_squared(p, tree.bounds());
   mutable std::size_t visits = 0;  // nodes read by this query's walks (Features::node_count)
-
-  static double near_zone(const Point2& p, const Box2& extent) {
-    const double reach = std::max({std::fabs(extent.min[0]), std::fabs(extent.min[1]),
-                                   std::fabs(extent.max[0]), std::fabs(extent.max[1])});
-    const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * reach) + 1e-146;
-    return zone * zone;
-  }
 
   void operator()(std::uint32_t level, std::uint32_t i, double& best, bool touched) const {
     if (++visits > 2 * features.node_count) features.corrupt();

@@ -119,6 +119,13 @@ double squared_distance(const Point<D>& p, const Segment<D>& s) {
   return r;
 }
 
+// The point s.a + t (s.b - s.a), in floating point, and exactly an end point at t = 0 and 1.
+inline Point<2> point_at(const Segment<2>& s, double t) {
+  if (t == 0) return s.a;
+  if (t == 1) return s.b;
+  return {s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])};
+}
+
 namespace detail {
 // The exact squared distance from p to s, rounded to a double (0 only when p lies on s).
 double squared_distance_exact(const Point<2>& p, const Segment<2>& s);
@@ -135,6 +142,15 @@ inline double distance_rounding(const Point<2>& p, const Segment<2>& s) {
          1e-150;
 }
 }  // namespace detail
+
+// The square of the distance below which accurate_squared_distance measures exactly, for p and
+// any segment within `extent`: a bound on its zone for all of them at once.
+inline double near_zone_squared(const Point<2>& p, const Box<2>& extent) {
+  const double reach = std::max({std::fabs(extent.min[0]), std::fabs(extent.min[1]),
+                                 std::fabs(extent.max[0]), std::fabs(extent.max[1])});
+  const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * reach) + 1e-146;
+  return zone * zone;
+}
 
 // squared_distance(p, s), recomputed exactly (then rounded) where p lies within 1e-10 of the
 // coordinates' magnitude of s, where rounding could be much of it: 0 exactly when p lies on s,
