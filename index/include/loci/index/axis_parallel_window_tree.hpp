@@ -49,6 +49,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -65,6 +66,16 @@ namespace loci {
 class AxisParallelWindowTree {
  public:
   AxisParallelWindowTree() = default;
+  AxisParallelWindowTree(const AxisParallelWindowTree&) = default;
+  AxisParallelWindowTree& operator=(const AxisParallelWindowTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  AxisParallelWindowTree(AxisParallelWindowTree&& other) noexcept : AxisParallelWindowTree() {
+    swap(other);
+  }
+  AxisParallelWindowTree& operator=(AxisParallelWindowTree&& other) noexcept {
+    AxisParallelWindowTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Segment i gets id i. Throws InvalidGeometry on a NaN or infinite coordinate or a segment
   // that is neither horizontal nor vertical, InvalidArgument for 2^31 - 1 segments or more.
@@ -104,6 +115,11 @@ class AxisParallelWindowTree {
   }
 
  private:
+  void swap(AxisParallelWindowTree& other) noexcept {
+    std::swap(ends_, other.ends_);
+    std::swap(horizontal_, other.horizontal_);
+    std::swap(vertical_, other.vertical_);
+  }
   detail::SegmentEndpoints<KdTree<2>> ends_;  // the segments, and their endpoints in a kd-tree
   CenteredIntervalTree horizontal_;           // walked along the window's left edge
   CenteredIntervalTree vertical_;             // on (y, x): walked along the bottom edge

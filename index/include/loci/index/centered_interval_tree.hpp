@@ -31,6 +31,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/error.hpp"
@@ -44,6 +45,16 @@ class CenteredIntervalTree {
  public:
   CenteredIntervalTree() = default;
   CenteredIntervalTree(std::span<const Segment<2>> segs, bool swap);
+  CenteredIntervalTree(const CenteredIntervalTree&) = default;
+  CenteredIntervalTree& operator=(const CenteredIntervalTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  CenteredIntervalTree(CenteredIntervalTree&& other) noexcept : CenteredIntervalTree() {
+    swap(other);
+  }
+  CenteredIntervalTree& operator=(CenteredIntervalTree&& other) noexcept {
+    CenteredIntervalTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // s in frame coordinates, its ends ordered by x.
   static Segment<2> frame(const Segment<2>& s, bool swap) {
@@ -96,6 +107,12 @@ class CenteredIntervalTree {
   std::uint32_t build_at(std::span<Held> held, std::vector<double>& ends,
                          std::vector<detail::PstNode>& items);
 
+  void swap(CenteredIntervalTree& other) noexcept {
+    std::swap(swap_, other.swap_);
+    nodes_.swap(other.nodes_);
+    by_lo_.swap(other.by_lo_);
+    by_hi_.swap(other.by_hi_);
+  }
   bool swap_ = false;
   std::vector<Node> nodes_;             // preorder; node 0 is the root when there is one
   std::vector<detail::PstNode> by_lo_;  // per node: (left end x, y), a detail::PstSide::left tree

@@ -33,6 +33,7 @@
 #include <span>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/error.hpp"
@@ -45,6 +46,14 @@ namespace loci {
 class IntervalTree {
  public:
   IntervalTree() = default;
+  IntervalTree(const IntervalTree&) = default;
+  IntervalTree& operator=(const IntervalTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  IntervalTree(IntervalTree&& other) noexcept : IntervalTree() { swap(other); }
+  IntervalTree& operator=(IntervalTree&& other) noexcept {
+    IntervalTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Builds from intervals; interval i gets id i. Throws InvalidGeometry on a bad interval.
   // The tree comes out perfectly balanced and laid out in pre-order (a node, then its left
@@ -231,6 +240,12 @@ class IntervalTree {
     return s;
   }
 
+  void swap(IntervalTree& other) noexcept {
+    nodes_.swap(other.nodes_);
+    std::swap(root_, other.root_);
+    std::swap(size_, other.size_);
+    std::swap(inserted_, other.inserted_);
+  }
   detail::NodePool<Node, &Node::left> nodes_;
   std::uint32_t root_ = kNone;
   std::size_t size_ = 0;

@@ -40,6 +40,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -63,6 +64,14 @@ class KdTree {
 
   KdTree() = default;
   explicit KdTree(KdSplit split) : split_(split) {}
+  KdTree(const KdTree&) = default;
+  KdTree& operator=(const KdTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  KdTree(KdTree&& other) noexcept : KdTree() { swap(other); }
+  KdTree& operator=(KdTree&& other) noexcept {
+    KdTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Point i gets id i. Throws InvalidGeometry on a NaN or infinite coordinate.
   static KdTree build(std::span<const Point<D>> points, KdSplit split = KdSplit::median) {
@@ -155,6 +164,12 @@ class KdTree {
     std::uint32_t next_free;  // next free bucket while on the pool's free list
   };
 
+  void swap(KdTree& other) noexcept {
+    nodes_.swap(other.nodes_);
+    leaves_.swap(other.leaves_);
+    std::swap(root_, other.root_);
+    std::swap(split_, other.split_);
+  }
   KdTree(std::vector<Item>&& items, KdSplit split) : split_(split) {
     if (items.size() >= kNone) throw InvalidArgument("KdTree holds at most 2^32 - 2 points");
     if (items.empty()) return;

@@ -32,6 +32,7 @@
 #include <span>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -80,10 +81,14 @@ class PackedRTree {
   };
 
   PackedRTree() = default;
-  PackedRTree(PackedRTree&&) noexcept = default;
-  PackedRTree& operator=(PackedRTree&&) noexcept = default;
   PackedRTree(const PackedRTree&) = delete;
   PackedRTree& operator=(const PackedRTree&) = delete;
+  // Moving leaves `other` empty, as if default-constructed.
+  PackedRTree(PackedRTree&& other) noexcept : PackedRTree() { swap(other); }
+  PackedRTree& operator=(PackedRTree&& other) noexcept {
+    PackedRTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Builds from boxes; box i gets id i. Throws InvalidGeometry on a bad box.
   static PackedRTree build(std::span<const Box<D>> boxes, Packing packing = Packing::hilbert) {
@@ -246,6 +251,17 @@ class PackedRTree {
     std::uint32_t index;
   };
 
+  void swap(PackedRTree& other) noexcept {
+    std::swap(size_, other.size_);
+    std::swap(packing_, other.packing_);
+    levels_.swap(other.levels_);
+    std::swap(blocks_, other.blocks_);
+    std::swap(items_, other.items_);
+    own_blocks_.swap(other.own_blocks_);
+    own_items_.swap(other.own_items_);
+    keep_alive_.swap(other.keep_alive_);
+    std::swap(check_, other.check_);
+  }
   void compute_levels() { levels_ = layout(size_); }
   std::size_t level_blocks(int l) const { return level(l).blocks; }
   std::size_t total_blocks() const {

@@ -46,6 +46,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -75,6 +76,14 @@ class PrQuadtree {
     check_parameters();
     check_box(region, "quadtree region");
     make_root(cube(region));
+  }
+  PrQuadtree(const PrQuadtree&) = default;
+  PrQuadtree& operator=(const PrQuadtree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  PrQuadtree(PrQuadtree&& other) noexcept : PrQuadtree() { swap(other); }
+  PrQuadtree& operator=(PrQuadtree&& other) noexcept {
+    PrQuadtree(std::move(other)).swap(*this);
+    return *this;
   }
 
   // Point i gets id i; the region is the points' bounding box. Throws InvalidGeometry on a NaN
@@ -235,6 +244,12 @@ class PrQuadtree {
   }
   bool must_stay_leaf(const Node& x) const;
 
+  void swap(PrQuadtree& other) noexcept {
+    std::swap(bucket_, other.bucket_);
+    std::swap(max_depth_, other.max_depth_);
+    nodes_.swap(other.nodes_);
+    entries_.swap(other.entries_);
+  }
   std::uint32_t allocate_group() { return nodes_.allocate("PrQuadtree"); }
   std::uint32_t allocate_entry(const Point<D>& p, Id id) {
     const std::uint32_t e = entries_.allocate("PrQuadtree entry");
@@ -247,8 +262,8 @@ class PrQuadtree {
   void collapse(std::uint32_t n);
   void gather(std::uint32_t n, std::uint32_t& head);
 
-  std::uint32_t bucket_;
-  int max_depth_;
+  std::uint32_t bucket_ = 1;
+  int max_depth_ = 48;
   detail::NodePool<Node, &Node::child, fan_out> nodes_;  // runs of fan_out siblings
   detail::NodePool<Entry, &Entry::next> entries_;
 };

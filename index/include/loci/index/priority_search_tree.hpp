@@ -36,6 +36,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/error.hpp"
@@ -49,6 +50,14 @@ namespace loci {
 class PrioritySearchTree {
  public:
   PrioritySearchTree() = default;
+  PrioritySearchTree(const PrioritySearchTree&) = default;
+  PrioritySearchTree& operator=(const PrioritySearchTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  PrioritySearchTree(PrioritySearchTree&& other) noexcept : PrioritySearchTree() { swap(other); }
+  PrioritySearchTree& operator=(PrioritySearchTree&& other) noexcept {
+    PrioritySearchTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Point i gets id i. Throws InvalidGeometry on a NaN or infinite coordinate,
   // InvalidArgument for 2^32 - 1 points or more.
@@ -100,6 +109,11 @@ class PrioritySearchTree {
     return s;
   }
 
+  void swap(PrioritySearchTree& other) noexcept {
+    points_.swap(other.points_);
+    left_.swap(other.left_);
+    right_.swap(other.right_);
+  }
   std::vector<Point<2>> points_;        // by id
   std::vector<detail::PstNode> left_;   // min-heap on x, for query_left
   std::vector<detail::PstNode> right_;  // max-heap on x, for query_right

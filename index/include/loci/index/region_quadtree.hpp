@@ -50,6 +50,7 @@
 #include <string>
 #include <tuple>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -91,6 +92,14 @@ class RegionQuadtree {
   static constexpr int kMaxLevels = 30;
 
   RegionQuadtree() = default;
+  RegionQuadtree(const RegionQuadtree&) = default;
+  RegionQuadtree& operator=(const RegionQuadtree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  RegionQuadtree(RegionQuadtree&& other) noexcept : RegionQuadtree() { swap(other); }
+  RegionQuadtree& operator=(RegionQuadtree&& other) noexcept {
+    RegionQuadtree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // The tree of the region that `classify` describes over the square `region` (a given box
   // is extended to a square from its min corner), cut at most `levels` times.
@@ -121,7 +130,7 @@ class RegionQuadtree {
     const int s = levels_ - level;
     return {{grid(0, x << s), grid(1, y << s)}, {grid(0, (x + 1) << s), grid(1, (y + 1) << s)}};
   }
-  std::size_t node_count() const { return nodes_.size(); }
+  std::size_t node_count() const { return std::max<std::size_t>(nodes_.size(), 1); }
   std::size_t memory_bytes() const { return nodes_.size() * sizeof(std::uint32_t); }
   // Leaves of cover c, and their total area.
   std::size_t count(Cover c) const;
@@ -162,6 +171,10 @@ class RegionQuadtree {
   static bool is_leaf(std::uint32_t w) { return w >= kLeaf; }
   static Cover cover_of(std::uint32_t w) { return Cover(w - kLeaf); }
   static std::uint32_t leaf(Cover c) { return kLeaf + std::uint32_t(c); }
+  // Node n's word; a tree without nodes (default-constructed or moved from) is one outside leaf.
+  std::uint32_t word(std::uint32_t n) const {
+    return nodes_.empty() ? leaf(Cover::outside) : nodes_[n];
+  }
 
   RegionQuadtree(const Box2& region, int levels);
 
@@ -209,10 +222,16 @@ class RegionQuadtree {
   // Copies the subtree of `src` at node s into node n of this tree.
   void copy_subtree(const RegionQuadtree& src, std::uint32_t s, std::uint32_t n);
 
+  void swap(RegionQuadtree& other) noexcept {
+    std::swap(origin_, other.origin_);
+    std::swap(step_, other.step_);
+    std::swap(levels_, other.levels_);
+    nodes_.swap(other.nodes_);
+  }
   Point2 origin_{0, 0};
   double step_ = 1;  // side of a finest cell
   int levels_ = 0;
-  std::vector<std::uint32_t> nodes_{kLeaf};  // node 0 is the root
+  std::vector<std::uint32_t> nodes_;  // node 0 is the root; none: a single outside leaf
 };
 
 inline RegionQuadtree::RegionQuadtree(const Box2& region, int levels) : levels_(levels) {
@@ -231,6 +250,7 @@ inline RegionQuadtree::RegionQuadtree(const Box2& region, int levels) : levels_(
   if (!(step_ > 4 * ulp) || !std::isfinite(origin_[0] + side) || !std::isfinite(origin_[1] + side))
     throw InvalidArgument("quadtree region " + to_string(region) + " cannot be cut " +
                           std::to_string(levels) + " times in double precision");
+  nodes_.assign(1, leaf(Cover::outside));
 }
 
 inline RegionQuadtree RegionQuadtree::from_raster(const Box2& region, int levels,
@@ -269,6 +289,7 @@ inline RegionQuadtree RegionQuadtree::from_raster(const Box2& region, int levels
 }
 
 inline std::size_t RegionQuadtree::count(Cover c) const {
+  if (nodes_.empty()) return c == Cover::outside;
   std::size_t n = 0;
   for (std::uint32_t w : nodes_)
     n += w == leaf(c);
@@ -299,11 +320,11 @@ inline Cover RegionQuadtree::cover_at(const Point2& p) const {
     idx[a] = i;
   }
   std::uint32_t n = 0;
-  for (int l = 0; !is_leaf(nodes_[n]); ++l) {
+  for (int l = 0; !is_leaf(word(n)); ++l) {
     const int s = levels_ - l - 1;
     n = nodes_[n] + ((idx[0] >> s) & 1) + 2 * ((idx[1] >> s) & 1);
   }
-  return cover_of(nodes_[n]);
+  return cover_of(word(n));
 }
 
 template <class Emit, class Descend>
@@ -322,7 +343,7 @@ std::size_t RegionQuadtree::walk(Emit&& emit, Descend&& descend) const {
     const Box2 box = cell_box(f.x, f.y, f.level);
     if (!descend(box)) continue;
     ++visited;
-    const std::uint32_t w = nodes_[f.node];
+    const std::uint32_t w = word(f.node);
     if (is_leaf(w)) {
       if (!emit(QuadCell{box, cover_of(w), f.level, f.x, f.y})) break;
       continue;
@@ -349,7 +370,7 @@ QueryStats RegionQuadtree::query(const Box2& window, Visit&& visit) const {
 
 inline void RegionQuadtree::copy_subtree(const RegionQuadtree& src, std::uint32_t s,
                                          std::uint32_t n) {
-  const std::uint32_t w = src.nodes_[s];
+  const std::uint32_t w = src.word(s);
   if (is_leaf(w)) {
     nodes_[n] = w;
     return;
@@ -364,7 +385,7 @@ inline void RegionQuadtree::copy_subtree(const RegionQuadtree& src, std::uint32_
 template <class Combine>
 void RegionQuadtree::overlay_at(const RegionQuadtree& a, std::uint32_t na, const RegionQuadtree& b,
                                 std::uint32_t nb, std::uint32_t n, Combine& combine) {
-  const std::uint32_t wa = a.nodes_[na], wb = b.nodes_[nb];
+  const std::uint32_t wa = a.word(na), wb = b.word(nb);
   if (is_leaf(wa) && is_leaf(wb)) {
     nodes_[n] = leaf(combine(cover_of(wa), cover_of(wb)));
     return;
@@ -418,7 +439,7 @@ inline RegionQuadtree RegionQuadtree::intersect(const RegionQuadtree& a, const R
 
 inline void RegionQuadtree::validate() const {
   auto fail = [](const std::string& what) { throw Error("RegionQuadtree invalid: " + what); };
-  if (nodes_.empty()) fail("no root");
+  if (nodes_.empty()) return;  // a single outside leaf
   std::vector<bool> seen(nodes_.size(), false);
   std::vector<std::pair<std::uint32_t, int>> stack{{0, 0}};
   seen[0] = true;

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/error.hpp"
@@ -39,6 +40,14 @@ namespace loci {
 class SegmentTree {
  public:
   SegmentTree() = default;
+  SegmentTree(const SegmentTree&) = default;
+  SegmentTree& operator=(const SegmentTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  SegmentTree(SegmentTree&& other) noexcept : SegmentTree() { swap(other); }
+  SegmentTree& operator=(SegmentTree&& other) noexcept {
+    SegmentTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Interval i gets id i. Throws InvalidGeometry on a NaN, infinite or inverted interval.
   static SegmentTree build(std::span<const Interval> intervals) {
@@ -96,6 +105,10 @@ class SegmentTree {
   };
   Range range() const { return {&intervals_}; }
 
+  void swap(SegmentTree& other) noexcept {
+    intervals_.swap(other.intervals_);
+    std::swap(slots_, other.slots_);
+  }
   std::vector<Interval> intervals_;
   detail::SlotTree slots_;  // the intervals at their canonical nodes
 };

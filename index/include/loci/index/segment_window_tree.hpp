@@ -38,6 +38,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -53,6 +54,14 @@ namespace loci {
 class SegmentWindowTree {
  public:
   SegmentWindowTree() = default;
+  SegmentWindowTree(const SegmentWindowTree&) = default;
+  SegmentWindowTree& operator=(const SegmentWindowTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  SegmentWindowTree(SegmentWindowTree&& other) noexcept : SegmentWindowTree() { swap(other); }
+  SegmentWindowTree& operator=(SegmentWindowTree&& other) noexcept {
+    SegmentWindowTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Segment i gets id i. Throws InvalidGeometry on a NaN or infinite coordinate.
   static SegmentWindowTree build(std::span<const Segment<2>> segments) {
@@ -87,6 +96,11 @@ class SegmentWindowTree {
   }
 
  private:
+  void swap(SegmentWindowTree& other) noexcept {
+    std::swap(ends_, other.ends_);
+    std::swap(by_x_, other.by_x_);
+    std::swap(by_y_, other.by_y_);
+  }
   detail::SegmentEndpoints<KdTree<2>> ends_;  // the segments, and their endpoints in a kd-tree
   SlabTree by_x_;                             // for the left and right edges
   SlabTree by_y_;                             // on (y, x): for the bottom and top edges

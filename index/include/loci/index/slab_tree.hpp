@@ -45,6 +45,14 @@ namespace loci {
 class SlabTree {
  public:
   SlabTree() = default;
+  SlabTree(const SlabTree&) = default;
+  SlabTree& operator=(const SlabTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  SlabTree(SlabTree&& other) noexcept : SlabTree() { swap(other); }
+  SlabTree& operator=(SlabTree&& other) noexcept {
+    SlabTree(std::move(other)).swap(*this);
+    return *this;
+  }
   // The segments as given when `swap` is false, on (y, x) when it is true; segment i of the
   // span is item i.
   SlabTree(std::span<const Segment<2>> segs, bool swap);
@@ -78,6 +86,12 @@ class SlabTree {
   // Reorders node v's list into chains, appending their ends to chains_.
   void make_chains(std::size_t v);
 
+  void swap(SlabTree& other) noexcept {
+    local_.swap(other.local_);
+    std::swap(slots_, other.slots_);
+    node_chains_.swap(other.node_chains_);
+    chains_.swap(other.chains_);
+  }
   std::vector<Segment<2>> local_;           // frame coordinates, a.x <= b.x
   detail::SlotTree slots_;                  // held segments at their canonical nodes
   std::vector<std::uint32_t> node_chains_;  // node v's chains: [node_chains_[v], [v + 1])
@@ -198,6 +212,10 @@ bool SlabTree::stab(double x, double y1, double y2, F&& f, QueryStats& s) const 
 inline void SlabTree::validate(const std::string& owner) const {
   auto fail = [&](const std::string& what) { throw Error(owner + " invalid: " + what); };
   slots_.validate(local_.size(), Range{this}, owner);
+  if (!slots_.built()) {
+    if (!node_chains_.empty() || !chains_.empty()) fail("chains without a tree");
+    return;
+  }
   if (node_chains_.size() != slots_.nodes() + 1) fail("chain index does not match the tree");
   for (std::size_t v = 1; v < slots_.nodes(); ++v) {
     const std::span<const std::uint32_t> list = slots_.list(v);

@@ -159,6 +159,14 @@ class BspTree {
   static constexpr std::int32_t kSolid = -2;
 
   BspTree() = default;
+  BspTree(const BspTree&) = default;
+  BspTree& operator=(const BspTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  BspTree(BspTree&& other) noexcept : BspTree() { swap(other); }
+  BspTree& operator=(BspTree&& other) noexcept {
+    BspTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // The tree of the union of `polygons`. Throws InvalidGeometry on a non-finite coordinate
   // or a ring with fewer than three distinct vertices or no area, InvalidArgument on bad
@@ -344,6 +352,14 @@ class BspTree {
       throw InvalidGeometry(std::string(what) + " has a non-finite coordinate");
   }
 
+  void swap(BspTree& other) noexcept {
+    nodes_.swap(other.nodes_);
+    std::swap(root_, other.root_);
+    std::swap(edges_, other.edges_);
+    std::swap(bevels_, other.bevels_);
+    std::swap(solid_leaves_, other.solid_leaves_);
+    std::swap(depth_, other.depth_);
+  }
   std::vector<Node> nodes_;
   std::int32_t root_ = kEmpty;
   std::size_t edges_ = 0;

@@ -40,6 +40,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -66,6 +67,14 @@ class DynamicAabbTree {
     if (!(opt_.margin >= 0 && opt_.margin_fraction >= 0 && opt_.prediction >= 0) ||
         !std::isfinite(opt_.margin + opt_.margin_fraction + opt_.prediction))
       throw InvalidArgument("DynamicAabbTree: margins and prediction must be finite and >= 0");
+  }
+  DynamicAabbTree(const DynamicAabbTree&) = default;
+  DynamicAabbTree& operator=(const DynamicAabbTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  DynamicAabbTree(DynamicAabbTree&& other) noexcept : DynamicAabbTree() { swap(other); }
+  DynamicAabbTree& operator=(DynamicAabbTree&& other) noexcept {
+    DynamicAabbTree(std::move(other)).swap(*this);
+    return *this;
   }
 
   void add(Id id, const Box<D>& b) {
@@ -382,6 +391,20 @@ class DynamicAabbTree {
     moved_.clear();
   }
 
+  void swap(DynamicAabbTree& other) noexcept {
+    std::swap(opt_, other.opt_);
+    std::swap(proxies_, other.proxies_);
+    pool_.swap(other.pool_);
+    std::swap(tracker_, other.tracker_);
+    std::swap(root_, other.root_);
+    leaf_.swap(other.leaf_);
+    buffered_.swap(other.buffered_);
+    moved_.swap(other.moved_);
+    pairs_.swap(other.pairs_);
+    fresh_.swap(other.fresh_);
+    merged_.swap(other.merged_);
+    stack_.swap(other.stack_);
+  }
   AabbTreeOptions opt_;
   detail::ProxyTable<D> proxies_;
   detail::NodePool<Node, &Node::parent> pool_;

@@ -59,6 +59,7 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <utility>
 #endif
 
 #include "loci/geom/box.hpp"
@@ -111,6 +112,14 @@ class BasicSweepPrune {
 
   // SweepPrune cuts space into stripes once it holds `striped_from` proxies (see above).
   explicit BasicSweepPrune(std::size_t striped_from = kStripedFrom) : striped_from_(striped_from) {}
+  BasicSweepPrune(const BasicSweepPrune&) = default;
+  BasicSweepPrune& operator=(const BasicSweepPrune&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  BasicSweepPrune(BasicSweepPrune&& other) noexcept : BasicSweepPrune() { swap(other); }
+  BasicSweepPrune& operator=(BasicSweepPrune&& other) noexcept {
+    BasicSweepPrune(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Room for n proxies, so that adding them one by one does not move the tables.
   void reserve(std::size_t n) { proxies_.reserve(n); }
@@ -538,7 +547,33 @@ class BasicSweepPrune {
     return found;
   }
 
-  std::size_t striped_from_;
+  void swap(BasicSweepPrune& other) noexcept {
+    std::swap(striped_from_, other.striped_from_);
+    std::swap(proxies_, other.proxies_);
+    std::swap(tracker_, other.tracker_);
+    std::swap(axis_, other.axis_);
+    std::swap(sorted_once_, other.sorted_once_);
+    order_.swap(other.order_);
+    pos_.swap(other.pos_);
+    std::swap(holes_, other.holes_);
+    keyed_.swap(other.keyed_);
+    spare_.swap(other.spare_);
+    key_.swap(other.key_);
+    std::swap(stripe_axis_, other.stripe_axis_);
+    std::swap(stripes_, other.stripes_);
+    std::swap(stripe_origin_, other.stripe_origin_);
+    std::swap(stripe_inv_, other.stripe_inv_);
+    std::swap(count_, other.count_);
+    start_.swap(other.start_);
+    lo_.swap(other.lo_);
+    hi_.swap(other.hi_);
+    std::swap(olo_, other.olo_);
+    std::swap(ohi_, other.ohi_);
+    home_.swap(other.home_);
+    ids_.swap(other.ids_);
+    hits_.swap(other.hits_);
+  }
+  std::size_t striped_from_ = kStripedFrom;
   detail::ProxyTable<D> proxies_;
   detail::PairTracker tracker_;
   int axis_ = 0;                              // sweep axis of the last tick

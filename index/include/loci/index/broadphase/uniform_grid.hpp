@@ -37,6 +37,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -59,6 +60,14 @@ class UniformGrid {
   explicit UniformGrid(double cell_size = 0) : fixed_cell_(cell_size > 0 ? cell_size : 0) {
     if (!(cell_size <= 0 || std::isfinite(cell_size)))
       throw InvalidArgument("UniformGrid: cell size must be finite");
+  }
+  UniformGrid(const UniformGrid&) = default;
+  UniformGrid& operator=(const UniformGrid&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  UniformGrid(UniformGrid&& other) noexcept : UniformGrid() { swap(other); }
+  UniformGrid& operator=(UniformGrid&& other) noexcept {
+    UniformGrid(std::move(other)).swap(*this);
+    return *this;
   }
 
   void add(Id id, const Box<D>& b) { proxies_.add(id, b, kName); }
@@ -286,10 +295,25 @@ class UniformGrid {
     }
   }
 
+  void swap(UniformGrid& other) noexcept {
+    std::swap(proxies_, other.proxies_);
+    std::swap(tracker_, other.tracker_);
+    std::swap(fixed_cell_, other.fixed_cell_);
+    std::swap(cell_, other.cell_);
+    std::swap(inv_cell_, other.inv_cell_);
+    std::swap(shift_, other.shift_);
+    sample_.swap(other.sample_);
+    cells_.swap(other.cells_);
+    sorted_.swap(other.sorted_);
+    start_.swap(other.start_);
+    fill_.swap(other.fill_);
+    large_.swap(other.large_);
+    large_flag_.swap(other.large_flag_);
+  }
   detail::ProxyTable<D> proxies_;
   detail::PairTracker tracker_;
-  double fixed_cell_;  // the caller's cell size, or 0 to choose per tick
-  double cell_ = 1;    // cell side of the last tick
+  double fixed_cell_ = 0;  // the caller's cell size, or 0 to choose per tick
+  double cell_ = 1;        // cell side of the last tick
   double inv_cell_ = 1;
   int shift_ = 60;                    // 64 - log2(bucket count)
   std::vector<double> sample_;        // largest extents of a sample of boxes

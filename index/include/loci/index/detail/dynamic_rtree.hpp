@@ -61,7 +61,16 @@ class DynamicRTree {
     std::uint16_t level;    // 2: 0 for a leaf
   };
 
-  DynamicRTree() { root_ = new_node(0); }
+  // An empty tree holds no node: the root leaf is made by the first insertion.
+  DynamicRTree() = default;
+  DynamicRTree(const DynamicRTree&) = default;
+  DynamicRTree& operator=(const DynamicRTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  DynamicRTree(DynamicRTree&& other) noexcept { swap(other); }
+  DynamicRTree& operator=(DynamicRTree&& other) noexcept {
+    DynamicRTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Builds a tree from (box, id) pairs by top-down STR tiling with near-equal node sizes, so
   // every node respects the minimum fill. Throws InvalidGeometry on a bad box.
@@ -69,14 +78,17 @@ class DynamicRTree {
 
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
-  int height() const { return node(root_).level + 1; }
-  Box<D> bounds() const { return node(root_).boxes.bounds(node(root_).count); }
+  int height() const { return root_ == kNone ? 1 : node(root_).level + 1; }
+  Box<D> bounds() const {
+    return root_ == kNone ? Box<D>::empty() : node(root_).boxes.bounds(node(root_).count);
+  }
   std::size_t memory_bytes() const { return nodes_.memory_bytes(); }
 
   // Throws InvalidGeometry on a NaN, infinite or inverted box.
   void insert(const Box<D>& box, Id id) {
     check_box(box, "inserted box");
     reinserted_levels_ = 0;
+    if (root_ == kNone) root_ = new_node(0);
     insert_at({box, id}, 0);
     ++size_;
   }
@@ -116,6 +128,12 @@ class DynamicRTree {
   // tree's expansion around p.
   template <class Visit, class Walk>
   QueryStats walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const;
+  void swap(DynamicRTree& other) noexcept {
+    nodes_.swap(other.nodes_);
+    std::swap(root_, other.root_);
+    std::swap(size_, other.size_);
+    std::swap(reinserted_levels_, other.reinserted_levels_);
+  }
   const Node& node(std::uint32_t n) const { return nodes_[n]; }
   Node& node(std::uint32_t n) { return nodes_[n]; }
   std::uint32_t new_node(int level);
@@ -277,6 +295,7 @@ void DynamicRTree<D, M, P>::split(std::uint32_t n, const Entry<D>& extra) {
 template <int D, int M, class P>
 bool DynamicRTree<D, M, P>::erase(const Box<D>& box, Id id) {
   check_box(box, "erased box");
+  if (root_ == kNone) return false;
   Scratch<std::uint32_t> scratch;
   auto& stack = *scratch;
   stack.push_back(root_);
@@ -383,6 +402,7 @@ template <WindowVisitor<D> Visit>
 QueryStats DynamicRTree<D, M, P>::query(const Box<D>& window, Visit&& visit, Relation rel) const {
   check_box(window, "query window");
   QueryStats s;
+  if (root_ == kNone) return s;
   Scratch<std::uint32_t> scratch;
   auto& stack = *scratch;
   stack.push_back(root_);
@@ -452,7 +472,11 @@ QueryStats DynamicRTree<D, M, P>::walk_nearest(const Point<D>& p, Visit& visit, 
 template <int D, int M, class P>
 void DynamicRTree<D, M, P>::validate() const {
   auto fail = [](const std::string& what) { throw Error("R-tree invalid: " + what); };
-  if (root_ == kNone || node(root_).parent != kNone) fail("bad root");
+  if (root_ == kNone) {
+    if (size_ != 0 || nodes_.in_use() != 0) fail("entries or nodes without a root");
+    return;
+  }
+  if (!nodes_.contains(root_) || node(root_).parent != kNone) fail("bad root");
   if (node(root_).level > 0 && node(root_).count < 2) fail("inner root with fewer than 2 entries");
   std::size_t items = 0;
   std::vector<bool> seen(nodes_.size(), false);

@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/error.hpp"
@@ -31,6 +32,21 @@ class NodePool {
   static_assert(Group >= 1);
 
  public:
+  NodePool() = default;
+  NodePool(const NodePool&) = default;
+  NodePool& operator=(const NodePool&) = default;
+  // Moving leaves `other` empty: no node, an empty free list.
+  NodePool(NodePool&& other) noexcept { swap(other); }
+  NodePool& operator=(NodePool&& other) noexcept {
+    NodePool(std::move(other)).swap(*this);
+    return *this;
+  }
+  void swap(NodePool& other) noexcept {
+    nodes_.swap(other.nodes_);
+    std::swap(free_, other.free_);
+    std::swap(free_runs_, other.free_runs_);
+  }
+
   // Index of the first node of a fresh run of Group nodes. Throws InvalidArgument, naming
   // `owner`, when 32-bit indices would run out.
   std::uint32_t allocate(const char* owner) {

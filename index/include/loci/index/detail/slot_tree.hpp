@@ -48,6 +48,14 @@ void for_each_canonical_node(std::size_t leaves, std::size_t first, std::size_t 
 class SlotTree {
  public:
   SlotTree() = default;
+  SlotTree(const SlotTree&) = default;
+  SlotTree& operator=(const SlotTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  SlotTree(SlotTree&& other) noexcept : SlotTree() { swap(other); }
+  SlotTree& operator=(SlotTree&& other) noexcept {
+    SlotTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Items 0..n-1; range(k, lo, hi) sets item k's closed interval and returns true, or returns
   // false for an item the tree does not hold. Intervals must be finite with lo <= hi.
@@ -82,6 +90,8 @@ class SlotTree {
   }
 
   std::span<const double> coordinates() const { return xs_; }
+  // False for a default-constructed (or moved-from) tree, which holds no list.
+  bool built() const { return !offsets_.empty(); }
   std::size_t leaves() const { return leaves_; }
   std::size_t nodes() const { return 2 * leaves_; }  // node indices run from 1 to nodes() - 1
   std::size_t memory_bytes() const {
@@ -130,6 +140,13 @@ class SlotTree {
     auto fail = [&](const std::string& what) { throw Error(owner + " invalid: " + what); };
     for (std::size_t i = 1; i < xs_.size(); ++i)
       if (!(xs_[i - 1] < xs_[i])) fail("endpoints not strictly increasing");
+    if (offsets_.empty()) {  // never built: holds nothing
+      double lo = 0, hi = 0;
+      if (!xs_.empty() || !items_.empty() || leaves_ != 1) fail("lists missing");
+      for (std::size_t k = 0; k < n; ++k)
+        if (range(k, lo, hi)) fail("item " + std::to_string(k) + " not stored");
+      return;
+    }
     if (!std::has_single_bit(leaves_)) fail("leaf count not a power of two");
     if (offsets_.size() != 2 * leaves_ + 1 || offsets_.back() != items_.size())
       fail("offsets do not match the lists");
@@ -160,6 +177,13 @@ class SlotTree {
   }
 
  private:
+  void swap(SlotTree& other) noexcept {
+    xs_.swap(other.xs_);
+    std::swap(leaves_, other.leaves_);
+    offsets_.swap(other.offsets_);
+    items_.swap(other.items_);
+  }
+
   std::vector<double> xs_;              // sorted distinct endpoints
   std::size_t leaves_ = 1;              // power of two >= number of slots
   std::vector<std::uint32_t> offsets_;  // node v's list: items_[offsets_[v], offsets_[v + 1])

@@ -45,6 +45,7 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <utility>
 #endif
 
 #include "loci/geom/motion.hpp"
@@ -275,6 +276,15 @@ void check_conflict_objects(std::span<const Motion<D>> objects, double now, doub
 template <int D>
 class ConflictFinder {
  public:
+  ConflictFinder() = default;
+  ConflictFinder(const ConflictFinder&) = default;
+  ConflictFinder& operator=(const ConflictFinder&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  ConflictFinder(ConflictFinder&& other) noexcept : ConflictFinder() { swap(other); }
+  ConflictFinder& operator=(ConflictFinder&& other) noexcept {
+    ConflictFinder(std::move(other)).swap(*this);
+    return *this;
+  }
   template <ConflictVisitor F>
   QueryStats find(std::span<const Motion<D>> objects, double within, double now, double horizon,
                   F&& visit, std::size_t slices = 0) {
@@ -411,6 +421,17 @@ class ConflictFinder {
     }
   }
 
+  void swap(ConflictFinder& other) noexcept {
+    std::swap(broad_, other.broad_);
+    std::swap(held_, other.held_);
+    keyed_.swap(other.keyed_);
+    spare_.swap(other.spare_);
+    order_.swap(other.order_);
+    motion_.swap(other.motion_);
+    kin_.swap(other.kin_);
+    near_.swap(other.near_);
+    std::swap(scale_, other.scale_);
+  }
   SweepPrune<D> broad_;
   std::size_t held_ = 0;  // proxies 0 .. held_ - 1 are in broad_
   // Large arrays, so that a search made once does not spend its time faulting pages in.
@@ -507,6 +528,15 @@ class ConflictMonitor {
     check_conflict_query(within, 0, horizon);
     if (!std::isfinite(slack) || slack < 0)
       throw InvalidArgument("conflict monitor slack must be a finite number >= 0");
+  }
+  // Moving leaves `other` empty, with its parameters and no object.
+  ConflictMonitor(ConflictMonitor&& other) noexcept
+      : ConflictMonitor(other.within_, other.horizon_, other.slack_) {
+    swap(other);
+  }
+  ConflictMonitor& operator=(ConflictMonitor&& other) noexcept {
+    ConflictMonitor(std::move(other)).swap(*this);
+    return *this;
   }
 
   // A new report for id (added when new); the latest given replaces the earlier.
@@ -817,6 +847,42 @@ class ConflictMonitor {
     return st;
   }
 
+  void swap(ConflictMonitor& other) noexcept {
+    std::swap(within_, other.within_);
+    std::swap(horizon_, other.horizon_);
+    std::swap(slack_, other.slack_);
+    std::swap(base_, other.base_);
+    std::swap(now_, other.now_);
+    std::swap(scale_, other.scale_);
+    std::swap(keep_, other.keep_);
+    std::swap(margin_, other.margin_);
+    std::swap(computed_, other.computed_);
+    std::swap(full_, other.full_);
+    std::swap(incremental_, other.incremental_);
+    ids_.swap(other.ids_);
+    motion_.swap(other.motion_);
+    alive_.swap(other.alive_);
+    dirty_.swap(other.dirty_);
+    dirty_seen_.swap(other.dirty_seen_);
+    moved_.swap(other.moved_);
+    dirty_list_.swap(other.dirty_list_);
+    free_.swap(other.free_);
+    version_.swap(other.version_);
+    degree_.swap(other.degree_);
+    kept_.swap(other.kept_);
+    at_base_.swap(other.at_base_);
+    std::swap(forgotten_, other.forgotten_);
+    std::swap(slots_, other.slots_);
+    std::swap(count_, other.count_);
+    std::swap(packed_, other.packed_);
+    packed_entry_.swap(other.packed_entry_);
+    entry_of_.swap(other.entry_of_);
+    recent_.swap(other.recent_);
+    recent_entry_.swap(other.recent_entry_);
+    std::swap(recent_tree_, other.recent_tree_);
+    near_.swap(other.near_);
+    std::swap(finder_, other.finder_);
+  }
   double within_, horizon_, slack_;
   double base_ = 0, now_ = 0, scale_ = 0, keep_ = 0, margin_ = 0;
   bool computed_ = false;

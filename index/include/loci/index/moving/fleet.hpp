@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <limits>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "loci/index/moving/conflicts.hpp"
@@ -39,6 +40,14 @@ class Fleet {
   static constexpr int D = Index::dimension;
 
   explicit Fleet(Index index = Index{}) : index_(std::move(index)) {}
+  Fleet(const Fleet&) = default;
+  Fleet& operator=(const Fleet&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  Fleet(Fleet&& other) noexcept : Fleet() { swap(other); }
+  Fleet& operator=(Fleet&& other) noexcept {
+    Fleet(std::move(other)).swap(*this);
+    return *this;
+  }
 
   // Adds a report; the index takes it when it is the object's latest.
   void report(Id id, const Motion<D>& m) {
@@ -159,6 +168,11 @@ class Fleet {
     return !span.empty() && span.hi >= from && (open_end ? span.lo < to : span.lo <= to);
   }
 
+  void swap(Fleet& other) noexcept {
+    std::swap(index_, other.index_);
+    std::swap(history_, other.history_);
+    std::swap(reports_, other.reports_);
+  }
   Index index_;
   std::unordered_map<Id, std::vector<Motion<D>>> history_;  // by id, in time order
   std::size_t reports_ = 0;

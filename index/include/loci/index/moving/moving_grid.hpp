@@ -88,7 +88,14 @@ class MovingGrid {
     classes_ = 1;
     for (int a = 0; a < D; ++a)
       classes_ *= std::uint32_t(p.bands);
-    layout();
+  }
+  MovingGrid(const MovingGrid&) = default;
+  MovingGrid& operator=(const MovingGrid&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  MovingGrid(MovingGrid&& other) noexcept : MovingGrid() { swap(other); }
+  MovingGrid& operator=(MovingGrid&& other) noexcept {
+    MovingGrid(std::move(other)).swap(*this);
+    return *this;
   }
 
   void insert(Id id, const Motion<D>& m) {
@@ -97,6 +104,7 @@ class MovingGrid {
       throw InvalidArgument(std::string(kName) + ": id " + std::to_string(id) + " is already held");
     if (slots_.size() + 1 >= kNone && free_.empty())
       throw InvalidArgument(std::string(kName) + ": too many objects");
+    if (cells_.empty()) layout();  // the first object: an empty grid holds no cell
     std::uint32_t s;
     if (!free_.empty()) {
       s = free_.back();
@@ -154,7 +162,7 @@ class MovingGrid {
   // The reference time of the present layout, and the layouts made so far.
   double reference_time() const { return t_ref_; }
   std::size_t layouts() const { return layouts_; }
-  // The cells of the present layout, over every class.
+  // The cells of the present layout, over every class (none before the first insertion).
   std::size_t cells() const { return cells_.size(); }
 
   // The report held for id; throws InvalidArgument when there is none.
@@ -222,6 +230,7 @@ class MovingGrid {
     detail::check_nearest_time(s);
     detail::check_nearest_count(k);
     QueryStats st;
+    if (count_ == 0) return st;
     detail::Lease<NearestScratch> lease;  // nothing allocated per call in steady state
     NearestScratch& x = *lease;
     x.around.resize(classes_);
@@ -631,6 +640,36 @@ class MovingGrid {
     drift_ = 0;
   }
 
+  void swap(MovingGrid& other) noexcept {
+    std::swap(params_, other.params_);
+    std::swap(classes_, other.classes_);
+    std::swap(cells_per_class_, other.cells_per_class_);
+    std::swap(cells_axis_, other.cells_axis_);
+    std::swap(origin_, other.origin_);
+    std::swap(width_, other.width_);
+    std::swap(inverse_, other.inverse_);
+    std::swap(vmin_, other.vmin_);
+    std::swap(vinverse_, other.vinverse_);
+    cells_.swap(other.cells_);
+    band_.swap(other.band_);
+    slots_.swap(other.slots_);
+    free_.swap(other.free_);
+    std::swap(map_, other.map_);
+    std::swap(count_, other.count_);
+    std::swap(laid_out_, other.laid_out_);
+    std::swap(changes_, other.changes_);
+    std::swap(layouts_, other.layouts_);
+    std::swap(drift_, other.drift_);
+    std::swap(laid_lo_, other.laid_lo_);
+    std::swap(laid_hi_, other.laid_hi_);
+    std::swap(laid_vlo_, other.laid_vlo_);
+    std::swap(laid_vhi_, other.laid_vhi_);
+    std::swap(t_ref_, other.t_ref_);
+    std::swap(mag_, other.mag_);
+    std::swap(vabs_, other.vabs_);
+    std::swap(tabs_, other.tabs_);
+    std::swap(clock_, other.clock_);
+  }
   MovingGridParams<D> params_;
   std::uint32_t classes_ = 1, cells_per_class_ = 1;
   std::uint32_t cells_axis_[D] = {};

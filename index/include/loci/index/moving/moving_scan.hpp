@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/motion.hpp"
@@ -37,6 +38,16 @@ class MovingScan {
  public:
   static constexpr int dimension = D;
   static constexpr const char* kName = "MovingScan";
+
+  MovingScan() = default;
+  MovingScan(const MovingScan&) = default;
+  MovingScan& operator=(const MovingScan&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  MovingScan(MovingScan&& other) noexcept : MovingScan() { swap(other); }
+  MovingScan& operator=(MovingScan&& other) noexcept {
+    MovingScan(std::move(other)).swap(*this);
+    return *this;
+  }
 
   void insert(Id id, const Motion<D>& m) {
     check_motion(m);
@@ -223,6 +234,14 @@ class MovingScan {
     return found;
   }
 
+  void swap(MovingScan& other) noexcept {
+    std::swap(ids_, other.ids_);
+    std::swap(t_, other.t_);
+    std::swap(p_, other.p_);
+    std::swap(v_, other.v_);
+    std::swap(map_, other.map_);
+    std::swap(clock_, other.clock_);
+  }
   std::vector<Id> ids_;
   std::vector<double> t_;
   std::vector<double> p_[D];

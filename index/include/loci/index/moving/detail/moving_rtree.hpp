@@ -37,6 +37,7 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <utility>
 #endif
 
 #include "loci/index/broadphase/detail/proxy_table.hpp"
@@ -66,6 +67,14 @@ class MovingRTree {
   static constexpr int kMinFill = std::max(2, M * 2 / 5);
 
   explicit MovingRTree(const Params& params = {}) : params_(params) { Policy::check(params); }
+  MovingRTree(const MovingRTree&) = default;
+  MovingRTree& operator=(const MovingRTree&) = default;
+  // Moving leaves `other` empty, as if default-constructed.
+  MovingRTree(MovingRTree&& other) noexcept : MovingRTree() { swap(other); }
+  MovingRTree& operator=(MovingRTree&& other) noexcept {
+    MovingRTree(std::move(other)).swap(*this);
+    return *this;
+  }
 
   const Params& params() const { return params_; }
 
@@ -1225,6 +1234,27 @@ class MovingRTree {
     }
   }
 
+  void swap(MovingRTree& other) noexcept {
+    std::swap(params_, other.params_);
+    nodes_.swap(other.nodes_);
+    std::swap(root_, other.root_);
+    obj_id_.swap(other.obj_id_);
+    obj_motion_.swap(other.obj_motion_);
+    obj_leaf_.swap(other.obj_leaf_);
+    free_slots_.swap(other.free_slots_);
+    cells_.swap(other.cells_);
+    cells_tmp_.swap(other.cells_tmp_);
+    level_.swap(other.level_);
+    up_.swap(other.up_);
+    std::swap(map_, other.map_);
+    std::swap(count_, other.count_);
+    std::swap(epoch_, other.epoch_);
+    std::swap(clock_, other.clock_);
+    std::swap(max_choose_nodes_, other.max_choose_nodes_);
+    std::swap(regroups_, other.regroups_);
+    std::swap(mag_, other.mag_);
+    std::swap(vmag_, other.vmag_);
+  }
   Params params_;
   Pool nodes_;
   std::uint32_t root_ = kNone;
