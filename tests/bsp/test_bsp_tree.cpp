@@ -518,6 +518,19 @@ TEST(BspTree, RejectsBadInput) {
   EXPECT_THROW(BspTree::build(V{}, bad), InvalidArgument);
   const BspTree tree = BspTree::build(V{{{{0, 0}, {1, 0}, {1, 1}}, {}}});
   EXPECT_THROW(tree.trace({nan, 0}, {1, 1}, BspPoint{}), InvalidGeometry);
+  // Shapes: a NaN, infinite or negative size, or a polygon without vertices, is refused.
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(tree.trace({5, 5}, {6, 6}, BspCircle{nan}), InvalidGeometry);
+  EXPECT_THROW(tree.overlaps({5, 5}, BspCircle{inf}), InvalidGeometry);
+  EXPECT_THROW(tree.overlaps({5, 5}, BspCircle{-1}), InvalidGeometry);
+  EXPECT_THROW(tree.overlaps({5, 5}, BspBox{{1, nan}}), InvalidGeometry);
+  EXPECT_THROW(tree.overlaps({5, 5}, BspBox{{-1, 1}}), InvalidGeometry);
+  EXPECT_THROW(tree.overlaps({5, 5}, BspConvex{}), InvalidGeometry);
+  EXPECT_THROW(tree.slide({5, 5}, {6, 6}, BspConvex{{{0, 0}, {nan, 1}}}), InvalidGeometry);
+  // Sizes of zero are points, and a polygon away from its reference point is a shape too.
+  EXPECT_FALSE(tree.overlaps({5, 5}, BspCircle{0}));
+  EXPECT_TRUE(tree.overlaps({0.9, 0.1}, BspBox{{0, 0}}));
+  EXPECT_TRUE(tree.overlaps({5, 5}, BspConvex{{{-4.5, -4.9}, {-4.4, -4.9}, {-4.4, -4.8}}}));
 }
 
 }  // namespace

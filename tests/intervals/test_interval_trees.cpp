@@ -185,6 +185,8 @@ TEST(IntervalTree, RejectsBadInput) {
   const auto st = SegmentTree::build(std::vector<Interval>{{0, 1}});
   EXPECT_THROW(st.stab(inf), InvalidGeometry);
   EXPECT_TRUE(SegmentTree().stab(1).empty());
+  EXPECT_EQ(st.interval(0).hi, 1);
+  EXPECT_THROW(st.interval(1), InvalidArgument);  // an id not held: loci's error, not the STL's
 }
 
 // The shared churn harness (tests/support/churn.hpp) on intervals.

@@ -245,6 +245,38 @@ TEST(PrQuadtree, RejectsBadInput) {
   EXPECT_TRUE(tree.nearest({0, 0}, 3).empty());
 }
 
+// A point the region cannot grow to without overflowing is refused before anything changes:
+// the tree keeps its height and region (it used to double about a thousand times first), and
+// a refused first point leaves the tree empty (it used to stay rooted at that point, refusing
+// everything after).
+TEST(PrQuadtree, ARefusedFarPointChangesNothing) {
+  const double big = std::numeric_limits<double>::max();
+  const auto pts = make_points<2>(PointShape::uniform, 200, 4);
+  PrQuadtree2 tree;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    tree.insert(pts[i], Id(i));
+  const int height = tree.height();
+  const Box2 region = tree.region();
+  EXPECT_THROW(tree.insert({big, 0}, 999), InvalidGeometry);
+  EXPECT_THROW(tree.insert({0, -big}, 999), InvalidGeometry);
+  EXPECT_EQ(tree.height(), height);
+  EXPECT_TRUE(tree.region() == region);
+  EXPECT_EQ(tree.size(), pts.size());
+  tree.validate();
+  tree.insert({1e308, 0}, 999);  // far, but within reach: the region grows to it
+  tree.validate();
+  EXPECT_EQ(tree.query(Box2{{9e307, -1}, {1.1e308, 1}}), (std::vector<Id>{999}));
+
+  PrQuadtree2 empty;
+  EXPECT_THROW(empty.insert({big, 0}, 1), InvalidGeometry);
+  EXPECT_TRUE(empty.empty());
+  empty.validate();
+  empty.insert({1, 1}, 1);
+  empty.insert({2, 3}, 2);
+  empty.validate();
+  EXPECT_EQ(sorted(empty.query(Box2{{0, 0}, {5, 5}})), (std::vector<Id>{1, 2}));
+}
+
 // The shared churn harness (tests/support/churn.hpp) on points.
 
 TEST(PrQuadtreeDynamic, SharedChurnHarness) {

@@ -144,6 +144,8 @@ TEST(PrioritySearchTree, BadInputThrows) {
   EXPECT_THROW(t.query_left(nan, 0, 1), InvalidGeometry);
   EXPECT_THROW(t.query_right(0, nan, 1), InvalidGeometry);
   EXPECT_THROW(t.query_right(0, 0, inf), InvalidGeometry);
+  EXPECT_EQ(t.point(1)[0], 1);
+  EXPECT_THROW(t.point(2), InvalidArgument);  // an id not held: loci's error, not the STL's
   EXPECT_THROW(t.query_left(0, 1, 0), InvalidGeometry);
 }
 

@@ -248,6 +248,7 @@ TEST(AxisParallelWindowTree, BadInputThrows) {
   EXPECT_THROW(tree.query(Box2{{nan, 0}, {1, 1}}), InvalidGeometry);
   EXPECT_THROW(tree.query(Box2{{1, 0}, {0, 1}}), InvalidGeometry);
   EXPECT_THROW(tree.query(Box2{{0, 0}, {1, inf}}), InvalidGeometry);
+  EXPECT_THROW(tree.segment(100), InvalidArgument);  // an id not held: loci's error
 }
 
 }  // namespace

@@ -154,6 +154,9 @@ TEST(SegmentWindowTree, VisitorStopsEarlyAndBadInput) {
   const std::vector<Segment2> bad = {{{0, 0}, {1, std::numeric_limits<double>::infinity()}}};
   EXPECT_THROW(SegmentWindowTree::build(bad), InvalidGeometry);
   EXPECT_TRUE(SegmentWindowTree().query(Box2{{0, 0}, {1, 1}}).empty());
+  EXPECT_TRUE(tree.segment(499) == segs[499]);
+  EXPECT_THROW(tree.segment(500), InvalidArgument);  // an id not held: loci's error
+  EXPECT_THROW(SegmentWindowTree().segment(0), InvalidArgument);
 }
 
 }  // namespace

@@ -9,13 +9,15 @@
 // split when it holds more than `bucket` points, unless (a) its points all coincide, (b) it
 // sits at max_depth, or (c) its region can no longer be halved in double precision; those
 // three cases let duplicates and points closer than the precision limit share one leaf
-// instead of recursing forever. The tree is shaped by the space, not by the insertion order:
-// the same set of points always gives the same tree.
+// instead of recursing forever. Within a given region the tree is shaped by the space, not by
+// the insertion order: the same set of points always gives the same tree.
 //
 // Region. A cube (a given box is extended to one), half-open at its upper faces, given at
 // construction or taken from the first points, and grown on demand: a point outside the root makes
 // the root's region double towards it (the old root becomes one child of the new one), so the tree
-// accepts any finite input.
+// accepts any finite input. A point the region cannot grow to without overflowing is refused
+// before anything changes. Without a region given, the root's region comes from the first point
+// and the doublings since, so the tree then depends on which points came first.
 //
 // Layout. Nodes live in one pool indexed by 32-bit integers; the 2^D children of a node are
 // consecutive, allocated and freed as a group through a free list. Each node stores its region
@@ -220,8 +222,8 @@ class PrQuadtree {
   }
   // The root is half-open, [min, max): a point on its upper boundary would be routed away
   // from the old root by the cut that growing upwards puts there.
-  bool in_root(const Point<D>& p) const {
-    const Box<D>& r = nodes_[0].region;
+  bool in_root(const Point<D>& p) const { return in_region(nodes_[0].region, p); }
+  static bool in_region(const Box<D>& r, const Point<D>& p) {
     for (int a = 0; a < D; ++a)
       if (!(r.min[a] <= p[a] && p[a] < r.max[a])) return false;
     return true;
@@ -257,6 +259,9 @@ class PrQuadtree {
     return e;
   }
   void grow_towards(const Point<D>& p);
+  // One doubling of the root's region towards p (a leaf root is widened to fit p instead);
+  // slot gets where the old root goes among the new root's children. False on overflow.
+  static bool grow_step(Box<D>& region, bool leaf, const Point<D>& p, int& slot);
   void split(std::uint32_t n);
   // Moves every entry of n's subtree into n's list and frees its descendants.
   void collapse(std::uint32_t n);
@@ -278,29 +283,42 @@ bool PrQuadtree<D>::must_stay_leaf(const Node& x) const {
 }
 
 template <int D>
+bool PrQuadtree<D>::grow_step(Box<D>& region, bool leaf, const Point<D>& p, int& slot) {
+  const Box<D> old = region;
+  if (leaf) {  // nothing to re-route: widen the leaf to fit p
+    region = cube(merged(old, Box<D>{p, p}));
+    for (int a = 0; a < D; ++a)
+      region.max[a] = std::nextafter(region.max[a], std::numeric_limits<double>::infinity());
+    return is_finite(region.max);
+  }
+  slot = 0;
+  for (int a = 0; a < D; ++a) {
+    const double side = std::max(old.extent(a), 1e-300);
+    if (p[a] < old.min[a]) {
+      region.min[a] = old.min[a] - side;
+      slot |= 1 << a;
+    } else {
+      region.max[a] = old.max[a] + side;
+    }
+  }
+  return is_finite(region.min) && is_finite(region.max);
+}
+
+template <int D>
 void PrQuadtree<D>::grow_towards(const Point<D>& p) {
+  // the whole growth is tried on the region alone first, so that a refused point leaves the
+  // tree as it was (not doubled a thousand times on its way to overflowing)
+  Box<D> trial = nodes_[0].region;
+  for (int slot = 0; !in_region(trial, p);)
+    if (!grow_step(trial, nodes_[0].leaf(), p, slot))
+      throw InvalidGeometry("point too far from the quadtree's region: " + to_string(p));
   while (!in_root(p)) {
     const Box<D> old = nodes_[0].region;
     Box<D> grown = old;
     int slot = 0;  // where the old root goes among the new root's children
-    for (int a = 0; a < D; ++a) {
-      const double side = std::max(old.extent(a), 1e-300);
-      if (p[a] < old.min[a]) {
-        grown.min[a] = old.min[a] - side;
-        slot |= 1 << a;
-      } else {
-        grown.max[a] = old.max[a] + side;
-      }
-    }
-    if (!is_finite(grown.min) || !is_finite(grown.max))
-      throw InvalidGeometry("point too far from the quadtree's region: " + to_string(p));
-    if (nodes_[0].leaf()) {  // nothing to re-route: widen the leaf to fit p
-      Box<D> r = cube(merged(old, Box<D>{p, p}));
-      for (int a = 0; a < D; ++a)
-        r.max[a] = std::nextafter(r.max[a], std::numeric_limits<double>::infinity());
-      if (!is_finite(r.max))
-        throw InvalidGeometry("point too far from the quadtree's region: " + to_string(p));
-      nodes_[0].region = r;
+    grow_step(grown, nodes_[0].leaf(), p, slot);
+    if (nodes_[0].leaf()) {
+      nodes_[0].region = grown;
       continue;
     }
     const std::uint32_t g = allocate_group();
@@ -352,8 +370,17 @@ void PrQuadtree<D>::split(std::uint32_t n) {
 template <int D>
 void PrQuadtree<D>::insert(const Point<D>& p, Id id) {
   check_point(p, "inserted point");
-  if (nodes_.size() == 0) make_root(Box<D>{p, p});
-  grow_towards(p);
+  if (nodes_.size() == 0) {
+    make_root(Box<D>{p, p});
+    try {
+      grow_towards(p);
+    } catch (...) {  // a refused first point leaves the tree empty, not rooted at it
+      nodes_.clear();
+      throw;
+    }
+  } else {
+    grow_towards(p);
+  }
   const std::uint32_t e = allocate_entry(p, id);
   std::uint32_t n = 0;
   for (;;) {

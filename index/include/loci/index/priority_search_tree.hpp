@@ -65,7 +65,12 @@ class PrioritySearchTree {
 
   std::size_t size() const { return points_.size(); }
   bool empty() const { return points_.empty(); }
-  const Point<2>& point(Id id) const { return points_.at(std::size_t(id)); }
+  // Throws InvalidArgument for an id the tree does not hold.
+  const Point<2>& point(Id id) const {
+    if (id >= points_.size())
+      throw InvalidArgument("PrioritySearchTree: no point with id " + std::to_string(id));
+    return points_[std::size_t(id)];
+  }
   std::size_t memory_bytes() const {
     return points_.size() * sizeof(Point<2>) +
            (left_.size() + right_.size()) * sizeof(detail::PstNode);

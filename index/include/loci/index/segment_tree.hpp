@@ -63,7 +63,12 @@ class SegmentTree {
 
   std::size_t size() const { return intervals_.size(); }
   bool empty() const { return intervals_.empty(); }
-  const Interval& interval(Id id) const { return intervals_.at(std::size_t(id)); }
+  // Throws InvalidArgument for an id the tree does not hold.
+  const Interval& interval(Id id) const {
+    if (id >= intervals_.size())
+      throw InvalidArgument("SegmentTree: no interval with id " + std::to_string(id));
+    return intervals_[std::size_t(id)];
+  }
   std::size_t memory_bytes() const {
     return intervals_.size() * sizeof(Interval) + slots_.memory_bytes();
   }

@@ -179,6 +179,7 @@ class BspTree {
                QueryStats* stats = nullptr) const {
     check_point(from, "trace start");
     check_point(to, "trace end");
+    check_shape(shape);
     BspHit out;
     out.point = to;
     if (root_ == kEmpty) return out;
@@ -347,6 +348,20 @@ class BspTree {
     }
   }
 
+  // A shape's extent along each axis (its support one way plus the other) must be a finite
+  // number >= 0: a NaN or negative radius or half-extent, or a polygon without vertices, is
+  // refused rather than traced as a point or a hole.
+  template <class S>
+  static void check_shape(const S& shape) {
+    if constexpr (requires { shape.vertices; })
+      for (const Point2& v : shape.vertices)
+        check_point(v, "traced polygon's vertex");
+    for (const Point2& n : {Point2{1, 0}, Point2{0, 1}}) {
+      const double a = shape.support(n), b = shape.support(Point2{-n[0], -n[1]});
+      if (!std::isfinite(a) || !std::isfinite(b) || !(a + b >= 0))
+        throw InvalidGeometry("traced shape has a NaN, infinite or negative extent");
+    }
+  }
   static void check_point(const Point2& p, const char* what) {
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]))
       throw InvalidGeometry(std::string(what) + " has a non-finite coordinate");

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "loci/index/detail/scratch.hpp"
+
 namespace loci::detail {
 
 struct KeyedIndex {
@@ -21,7 +23,8 @@ struct KeyedIndex {
 // Sorts v by bits [first_bit, first_bit + bits) of key_of(element) (first_bit + bits <= 64;
 // the last digit also reads the bits just above them, which callers leave at 0), using `tmp` as the
 // second buffer (kept by a caller that sorts every tick, so that its memory is not faulted in
-// again). One pass counts every digit; each digit then costs one scatter pass.
+// again). One pass counts every digit; each digit then costs one scatter pass. Nothing is
+// allocated when `tmp` is large enough already.
 template <class T, class A, class KeyOf>
 void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of,
                 std::vector<T, A>& tmp) {
@@ -31,7 +34,9 @@ void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of,
   bits = std::min(bits, 64 - first_bit);  // no shift reaches 64
   const int passes = std::min((bits + kDigit - 1) / kDigit, kMaxPasses);
   if (v.size() < 2 || passes <= 0) return;
-  std::vector<std::array<std::size_t, kBuckets>> count(static_cast<std::size_t>(passes));
+  Scratch<std::array<std::size_t, kBuckets>> lease;  // the digit counts, leased per thread
+  auto& count = *lease;
+  count.assign(static_cast<std::size_t>(passes), {});
   for (const auto& x : v) {
     const std::uint64_t k = key_of(x);
     for (int p = 0; p < passes; ++p)

@@ -44,8 +44,13 @@ requires(Ends::dimension == 2) class SegmentEndpoints {
   }
 
   std::span<const Segment<2>> segments() const { return segs_; }
-  // Throws std::out_of_range for an id that is not a segment's.
-  const Segment<2>& segment(Id id) const { return segs_.at(std::size_t(id)); }
+  // Throws InvalidArgument for an id the structure does not hold.
+  const Segment<2>& segment(Id id) const {
+    if (id >= segs_.size())
+      throw InvalidArgument("no segment with id " + std::to_string(id) + " (ids run from 0 to " +
+                            std::to_string(segs_.size()) + " - 1)");
+    return segs_[std::size_t(id)];
+  }
   std::size_t memory_bytes() const {
     return segs_.size() * sizeof(Segment<2>) + ends_.memory_bytes();
   }

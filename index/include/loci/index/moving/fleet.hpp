@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "loci/index/detail/scratch.hpp"
 #include "loci/index/moving/conflicts.hpp"
 #include "loci/index/moving/moving_index.hpp"
 
@@ -111,13 +112,16 @@ class Fleet {
     detail::check_nearest_count(k);
     QueryStats st;
     st.nodes_visited = 1;
-    std::vector<std::pair<Id, const Motion<D>*>> live;
+    detail::Scratch<std::pair<Id, const Motion<D>*>> live_lease;
+    detail::Scratch<std::pair<double, std::size_t>> out_lease;
+    auto& live = *live_lease;
+    auto& out = *out_lease;
     for (const auto& [id, h] : history_)
       if (const Motion<D>* m = in_force(h, s)) live.push_back({id, m});
     st.entries_tested = live.size();
-    const auto out = detail::k_smallest(live.size(), k, [&](std::size_t i) {
-      return squared_distance(position(*live[i].second, s), q);
-    });
+    detail::k_smallest(
+        live.size(), k,
+        [&](std::size_t i) { return squared_distance(position(*live[i].second, s), q); }, out);
     for (const auto& [d2, i] : out) {
       ++st.results;
       detail::check_nearest_distance(d2);

@@ -31,11 +31,11 @@
 // one template parameter.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <concepts>
 #include <cstddef>
 #include <limits>
-#include <queue>
 #include <utility>
 #include <vector>
 
@@ -85,24 +85,25 @@ inline void check_nearest_distance(double d) {
         "1e150 at the time asked)");
 }
 
-// The k smallest of the squared distances d2(i), i < n, nearest first, as (d2, i): the
-// nearest-n of the scans.
+// The k smallest of the squared distances d2(i), i < n, into `best` nearest first, as (d2, i):
+// the nearest-n of the scans (`best` is the caller's, leased scratch: nothing allocated per
+// call in steady state).
 template <class D2>
-std::vector<std::pair<double, std::size_t>> k_smallest(std::size_t n, std::size_t k, D2&& d2) {
-  std::priority_queue<std::pair<double, std::size_t>> best;  // the k best so far, worst on top
+void k_smallest(std::size_t n, std::size_t k, D2&& d2,
+                std::vector<std::pair<double, std::size_t>>& best) {
+  best.clear();  // a max-heap of the k best so far, worst on top
   for (std::size_t i = 0; i < n && k > 0; ++i) {
     const double d = d2(i);
     if (best.size() < k) {
-      best.push({d, i});
-    } else if (d < best.top().first) {
-      best.pop();
-      best.push({d, i});
+      best.push_back({d, i});
+      std::push_heap(best.begin(), best.end());
+    } else if (d < best.front().first) {
+      std::pop_heap(best.begin(), best.end());
+      best.back() = {d, i};
+      std::push_heap(best.begin(), best.end());
     }
   }
-  std::vector<std::pair<double, std::size_t>> out(best.size());
-  for (std::size_t j = out.size(); j-- > 0; best.pop())
-    out[j] = best.top();
-  return out;
+  std::sort_heap(best.begin(), best.end());
 }
 }  // namespace detail
 

@@ -142,15 +142,20 @@ class MovingScan {
     QueryStats st;
     st.nodes_visited = 1;
     st.entries_tested = ids_.size();
-    const auto out = detail::k_smallest(ids_.size(), k, [&](std::size_t i) {
-      const double dt = s - t_[i];
-      double dd = 0;
-      for (int a = 0; a < D; ++a) {
-        const double d = p_[a][i] + v_[a][i] * dt - q[a];
-        dd += d * d;
-      }
-      return dd;
-    });
+    detail::Scratch<std::pair<double, std::size_t>> lease;
+    auto& out = *lease;
+    detail::k_smallest(
+        ids_.size(), k,
+        [&](std::size_t i) {
+          const double dt = s - t_[i];
+          double dd = 0;
+          for (int a = 0; a < D; ++a) {
+            const double d = p_[a][i] + v_[a][i] * dt - q[a];
+            dd += d * d;
+          }
+          return dd;
+        },
+        out);
     for (const auto& [dd, i] : out) {
       ++st.results;
       detail::check_nearest_distance(dd);
