@@ -592,7 +592,7 @@ struct FeatureDescent {
       const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
       const int used = int(std::min<std::size_t>(PackedRTree2::node_size, tree.size() - first));
       const PackedRTree2::Block& leaf = tree.leaf(node.first);
-      double box2[PackedRTree2::node_size];
+      double box2[PackedRTree2::Block::kSlots];
       leaf.squared_distances(p, box2);
       const std::int64_t fid = features.fid_of(node.feature);
       const std::uint32_t* ids = features.leaf_items(node.first);

@@ -1,7 +1,8 @@
 // Moving every structure, as a C++ user does (std::move, std::swap, a growing std::vector):
 // the target answers as the source did, and the source is left empty, valid and usable, as
-// if default-constructed. Each structure is filled from fixed-seed data with erasures (free
-// lists, holes) so that a field left behind by a move shows.
+// if default-constructed (one built with parameters keeps them). Each structure is filled
+// from fixed-seed data with erasures (free lists, holes) so that a field left behind by a
+// move shows.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -332,6 +333,45 @@ TYPED_TEST(MovedFrom, AGrowingVectorMovesThemIntact) {
     EXPECT_EQ(C::answer(v[i]), held[i]);
     EXPECT_NO_THROW(v[i].validate());
   }
+}
+
+// A structure built with parameters keeps them when moved from (as a derived type's own
+// default would expect): it is empty, not reset to the defaults.
+TEST(MovedFrom, ParametersStayWithTheSource) {
+  KdTree2 kd(KdSplit::sliding_midpoint);
+  kd.insert({1, 2}, 1);
+  KdTree2 kd2 = std::move(kd);
+  EXPECT_EQ(kd.split(), KdSplit::sliding_midpoint);
+  EXPECT_EQ(kd2.split(), KdSplit::sliding_midpoint);
+  PrQuadtree2 quad(5, 20);
+  quad.insert({1, 2}, 1);
+  PrQuadtree2 quad2(2, 30);
+  quad2 = std::move(quad);
+  EXPECT_EQ(quad.bucket(), 5u);
+  EXPECT_EQ(quad.max_depth(), 20);
+  EXPECT_EQ(quad2.bucket(), 5u);
+  EXPECT_TRUE(quad.empty());
+  MovingGridParams<2> params;
+  params.horizon = 7;
+  params.bands = 2;
+  MovingGrid<2> grid(params);
+  grid.insert(1, Motion2{0, {1, 1}, {1, 0}});
+  MovingGrid<2> grid2 = std::move(grid);
+  EXPECT_EQ(grid.params().horizon, 7);
+  EXPECT_EQ(grid.params().bands, 2);
+  EXPECT_EQ(grid2.params().bands, 2);
+  TprParams<2> tpr;
+  tpr.horizon = 9;
+  TprTree<2> tree(tpr);
+  TprTree<2> tree2 = std::move(tree);
+  EXPECT_EQ(tree.params().horizon, 9);
+  EXPECT_EQ(tree2.params().horizon, 9);
+  Fleet<TprTree<2>> fleet(TprTree<2>{tpr});
+  fleet.report(1, Motion2{0, {1, 1}, {1, 0}});
+  Fleet<TprTree<2>> fleet2 = std::move(fleet);
+  EXPECT_TRUE(fleet.empty());
+  EXPECT_EQ(fleet.index().params().horizon, 9);
+  EXPECT_EQ(fleet2.size(), 1u);
 }
 
 // The conflict monitor has no default: a moved-from one keeps its parameters and holds nothing.

@@ -185,6 +185,47 @@ TEST(BrowseEdges, EmptyTreesReportNothingAndBadPointsThrow) {
   EXPECT_THROW(quad.browse(nan, count), InvalidGeometry);
 }
 
+// Beyond 1e150 squared distances overflow: a nearest-n answer whose distance would be infinite
+// is refused (it used to come back at distance inf, in no order: the farther of two points far
+// away could be named the nearest), while answers whose distances fit are unaffected.
+template <class Tree>
+void expect_overflow_refused(const Tree& tree) {
+  EXPECT_THROW(tree.nearest({0, 0}, 4), InvalidArgument);
+  const auto near = tree.nearest({0, 0}, 2);
+  ASSERT_EQ(near.size(), 2u);
+  EXPECT_EQ(near[0].id, 0u);
+  EXPECT_EQ(near[1].id, 1u);
+  // Browsing hands the overflowed ones on last, at infinity, for the visitor to judge.
+  std::vector<double> seen;
+  tree.browse({0, 0}, [&](Id, const Box<2>&, double d) { return seen.push_back(d), true; });
+  ASSERT_EQ(seen.size(), 4u);
+  EXPECT_EQ(seen[0], std::sqrt(2.0));
+  EXPECT_EQ(seen[1], 3.0);
+  EXPECT_TRUE(std::isinf(seen[2]) && std::isinf(seen[3]));
+}
+
+TEST(BrowseEdges, DistancesThatOverflowAreRefused) {
+  const std::vector<Point<2>> pts = {{1, 1}, {3, 0}, {2e200, 0}, {1e200, 0}};
+  std::vector<Box<2>> boxes;
+  for (const auto& p : pts)
+    boxes.push_back({p, p});
+  RStarTree2 rstar;
+  RTree2 rtree;
+  KdTree2 kd;
+  PrQuadtree2 quad;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    rstar.insert(boxes[i], Id(i));
+    rtree.insert(boxes[i], Id(i));
+    kd.insert(pts[i], Id(i));
+    quad.insert(pts[i], Id(i));
+  }
+  expect_overflow_refused(rstar);
+  expect_overflow_refused(rtree);
+  expect_overflow_refused(kd);
+  expect_overflow_refused(quad);
+  expect_overflow_refused(PackedRTree2::build(boxes));
+}
+
 // After erasures and re-insertions the browse still sees exactly the live entries.
 TEST(BrowseEdges, DynamicTreesAfterChurn) {
   auto boxes = make_boxes<2>(Shape::clustered, 2000, 47);

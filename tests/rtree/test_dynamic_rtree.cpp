@@ -20,7 +20,9 @@ class DynamicRTreeTest : public ::testing::Test {};
 
 using Trees = ::testing::Types<RTree<2, LinearSplit>, RTree<2, QuadraticSplit>, RStarTree<2>,
                                RTree<3, LinearSplit>, RTree<3, QuadraticSplit>, RStarTree<3>,
-                               RTree<2, QuadraticSplit, 4>, RStarTree<2, 4>, RStarTree<2, 8>>;
+                               RTree<2, QuadraticSplit, 4>, RStarTree<2, 4>, RStarTree<2, 8>,
+                               // odd capacities: the node's box arrays carry a padding slot
+                               RTree<2, LinearSplit, 7>, RStarTree<2, 5>, RStarTree<3, 63>>;
 TYPED_TEST_SUITE(DynamicRTreeTest, Trees);
 
 namespace {

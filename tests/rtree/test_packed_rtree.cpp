@@ -87,6 +87,11 @@ TEST(PackedRTree, BruteForceSmallNodes) {
 TEST(PackedRTree, BruteForceWideNodes) {
   check_all_shapes<2, 32>();
 }
+// An odd node size: each block carries a padding slot that must stay empty.
+TEST(PackedRTree, BruteForceOddNodes) {
+  check_all_shapes<2, 5>();
+  check_all_shapes<3, 13>();
+}
 
 TEST(PackedRTree, ManyLevels) {
   const auto boxes = make_boxes<2>(Shape::uniform, 20000, 5);

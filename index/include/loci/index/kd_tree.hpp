@@ -66,8 +66,8 @@ class KdTree {
   explicit KdTree(KdSplit split) : split_(split) {}
   KdTree(const KdTree&) = default;
   KdTree& operator=(const KdTree&) = default;
-  // Moving leaves `other` empty, as if default-constructed.
-  KdTree(KdTree&& other) noexcept : KdTree() { swap(other); }
+  // Moving leaves `other` empty, keeping its parameters.
+  KdTree(KdTree&& other) noexcept : KdTree(other.split_) { swap(other); }
   KdTree& operator=(KdTree&& other) noexcept {
     KdTree(std::move(other)).swap(*this);
     return *this;

@@ -323,6 +323,9 @@ PackedRTree<D, NodeSize>::PackedRTree(std::span<const Box<D>> boxes, Packing pac
 
   const std::size_t slots = level_blocks(0) * NodeSize;
   own_blocks_.reset(new Block[total_blocks()]);
+  if constexpr (Block::kSlots != NodeSize)  // an odd size: the padding slot stays empty
+    for (std::size_t b = 0; b < total_blocks(); ++b)
+      own_blocks_[b].clear();
   own_items_.reset(new std::uint32_t[slots]);
   std::uint32_t* order = own_items_.get();
   if (packing == Packing::hilbert)
@@ -583,11 +586,12 @@ QueryStats PackedRTree<D, NodeSize>::ordered(Key&& key, Visit&& visit) const {
     for (int i = 0; i < used; ++i) {
       const double k = key(node.box(i));
       if (!(k < kInf)) continue;
-      // The walk orders by its first field and hands back its square root.
+      // The walk orders by its first field (the key itself: no square to overflow); the
+      // report below asks key() again rather than take the walk's square root of it.
       if (level == 0)
-        sink.push_entry(k * k, base + i, Id(item_index(base + i)));
+        sink.push_entry(k, base + i, Id(item_index(base + i)));
       else
-        sink.push_subtree(k * k, (std::uint64_t(level - 1) << 32) | (base + i));
+        sink.push_subtree(k, (std::uint64_t(level - 1) << 32) | (base + i));
     }
     return std::size_t(used);
   };
@@ -608,7 +612,7 @@ QueryStats PackedRTree<D, NodeSize>::walk_nearest(const Point<D>& p, Visit& visi
     const std::size_t b = std::size_t(ref & 0xffffffffu);
     const std::size_t base = b * NodeSize;
     const int used = int(std::min<std::size_t>(NodeSize, this->level(level).entries - base));
-    double d2[NodeSize];
+    double d2[Block::kSlots];
     block(level, b).squared_distances(p, d2);
     if constexpr (!kAll) {
       // Entries the caller does not keep are pushed as nothing: each kept one separately.
@@ -654,6 +658,9 @@ void PackedRTree<D, NodeSize>::validate() const {
   for (int l = 0; l < levels(); ++l) {
     for (std::size_t b = 0; b < level_blocks(l); ++b) {
       const Block& node = block(l, b);
+      for (int i = NodeSize; i < Block::kSlots; ++i)
+        if (!(node.box(i) == Box<D>::empty()))
+          fail("padding slot is not empty at level " + std::to_string(l));
       for (int i = 0; i < NodeSize; ++i) {
         const std::size_t e = b * NodeSize + i;
         const Box<D> box = node.box(i);

@@ -81,8 +81,10 @@ class PrQuadtree {
   }
   PrQuadtree(const PrQuadtree&) = default;
   PrQuadtree& operator=(const PrQuadtree&) = default;
-  // Moving leaves `other` empty, as if default-constructed.
-  PrQuadtree(PrQuadtree&& other) noexcept : PrQuadtree() { swap(other); }
+  // Moving leaves `other` empty, keeping its parameters.
+  PrQuadtree(PrQuadtree&& other) noexcept : PrQuadtree(other.bucket_, other.max_depth_) {
+    swap(other);
+  }
   PrQuadtree& operator=(PrQuadtree&& other) noexcept {
     PrQuadtree(std::move(other)).swap(*this);
     return *this;

@@ -70,8 +70,8 @@ class DynamicAabbTree {
   }
   DynamicAabbTree(const DynamicAabbTree&) = default;
   DynamicAabbTree& operator=(const DynamicAabbTree&) = default;
-  // Moving leaves `other` empty, as if default-constructed.
-  DynamicAabbTree(DynamicAabbTree&& other) noexcept : DynamicAabbTree() { swap(other); }
+  // Moving leaves `other` empty, keeping its parameters.
+  DynamicAabbTree(DynamicAabbTree&& other) noexcept : DynamicAabbTree(other.opt_) { swap(other); }
   DynamicAabbTree& operator=(DynamicAabbTree&& other) noexcept {
     DynamicAabbTree(std::move(other)).swap(*this);
     return *this;

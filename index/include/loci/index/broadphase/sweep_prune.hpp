@@ -55,11 +55,11 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
-#include <utility>
 #endif
 
 #include "loci/geom/box.hpp"
@@ -114,8 +114,10 @@ class BasicSweepPrune {
   explicit BasicSweepPrune(std::size_t striped_from = kStripedFrom) : striped_from_(striped_from) {}
   BasicSweepPrune(const BasicSweepPrune&) = default;
   BasicSweepPrune& operator=(const BasicSweepPrune&) = default;
-  // Moving leaves `other` empty, as if default-constructed.
-  BasicSweepPrune(BasicSweepPrune&& other) noexcept : BasicSweepPrune() { swap(other); }
+  // Moving leaves `other` empty, keeping its parameters.
+  BasicSweepPrune(BasicSweepPrune&& other) noexcept : BasicSweepPrune(other.striped_from_) {
+    swap(other);
+  }
   BasicSweepPrune& operator=(BasicSweepPrune&& other) noexcept {
     BasicSweepPrune(std::move(other)).swap(*this);
     return *this;

@@ -63,8 +63,8 @@ class UniformGrid {
   }
   UniformGrid(const UniformGrid&) = default;
   UniformGrid& operator=(const UniformGrid&) = default;
-  // Moving leaves `other` empty, as if default-constructed.
-  UniformGrid(UniformGrid&& other) noexcept : UniformGrid() { swap(other); }
+  // Moving leaves `other` empty, keeping its parameters.
+  UniformGrid(UniformGrid&& other) noexcept : UniformGrid(other.fixed_cell_) { swap(other); }
   UniformGrid& operator=(UniformGrid&& other) noexcept {
     UniformGrid(std::move(other)).swap(*this);
     return *this;

@@ -27,10 +27,23 @@
 
 #include <vector>
 
+#include "loci/geom/error.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/query.hpp"
 
 namespace loci::detail {
+
+// Squared distances overflow beyond about 1e154 (coordinates beyond 1e150 are refused by the
+// layers, SQL and moving indexes for that reason). While the distances ranked stay finite the
+// order is exact (an overflowed one is farther than every finite one), so only an answer
+// whose own distance overflowed is refused, rather than reported at infinity in no order.
+// browse() hands such entries on last, at distance infinity, for its visitor to judge.
+inline void check_answer_distance(double d2) {
+  if (!(d2 < INFINITY))
+    throw InvalidArgument(
+        "nearest: an answer lies too far for its distance to fit a double (coordinates beyond "
+        "1e150)");
+}
 
 struct QueueItem {
   double d2;
@@ -177,6 +190,7 @@ QueryStats best_first(std::uint64_t root_ref, std::size_t k, Expand&& expand, Vi
     stats.entries_tested += expand(top.ref, sink);
   }
   sink.finish();
+  if (!best.empty()) check_answer_distance(best.back().d2);  // the farthest, before any answer
   for (const QueueItem& e : best) {
     ++stats.results;
     if (!visit(e.id, e.ref, std::sqrt(e.d2))) break;

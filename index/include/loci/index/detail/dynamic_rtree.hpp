@@ -454,7 +454,7 @@ template <class Visit, class Walk>
 QueryStats DynamicRTree<D, M, P>::walk_nearest(const Point<D>& p, Visit& visit, Walk&& walk) const {
   auto expand = [&](std::uint64_t ref, auto& sink) -> std::size_t {
     const Node& nd = node(std::uint32_t(ref));
-    double d2[M];
+    double d2[decltype(nd.boxes)::kSlots];
     nd.boxes.squared_distances(p, d2);
     if (nd.level == 0)
       sink.push_entries(

@@ -3,7 +3,9 @@
 // lo[axis][i] and hi[axis][i] hold child i's box, so testing a window against all N children
 // is 2*D comparisons over contiguous doubles, which the compiler turns into a few vector
 // instructions. Unused slots hold the empty box (+inf, -inf), which fails every intersection
-// test, so the loops run over all N slots without a count. Shared by every R-tree variant.
+// test, so the loops run over all N slots without a count. An odd N is padded with one slot
+// that is always empty, so that the loops take two slots a step. Shared by every R-tree
+// variant.
 #pragma once
 
 #include <algorithm>
@@ -23,14 +25,16 @@ namespace loci::detail {
 template <int D, int N>
 struct SoaBoxes {
   static_assert(N >= 2 && N <= 64, "node fan-out must be in [2, 64]");
-  using Mask = std::conditional_t<(N <= 32), std::uint32_t, std::uint64_t>;
+  // Slots stored: N, rounded up to even.
+  static constexpr int kSlots = (N + 1) / 2 * 2;
+  using Mask = std::conditional_t<(kSlots <= 32), std::uint32_t, std::uint64_t>;
 
-  double lo[D][N];
-  double hi[D][N];
+  double lo[D][kSlots];
+  double hi[D][kSlots];
 
   void clear() {
     for (int a = 0; a < D; ++a)
-      for (int i = 0; i < N; ++i) {
+      for (int i = 0; i < kSlots; ++i) {
         lo[a][i] = std::numeric_limits<double>::infinity();
         hi[a][i] = -std::numeric_limits<double>::infinity();
       }
@@ -99,7 +103,8 @@ struct SoaBoxes {
                 w);
   }
 
-  // out[i] = squared distance from p to child i, for all N slots (empty slots give +inf).
+  // out[i] = squared distance from p to child i, for all kSlots slots (empty ones give +inf):
+  // `out` holds kSlots doubles.
   // At most one of lo - p and p - hi is positive, so their clamped sum is the gap on an axis.
   void squared_distances(const Point<D>& p, double* out) const {
 #if defined(__SSE2__)
@@ -107,7 +112,7 @@ struct SoaBoxes {
     __m128d pv[D];
     for (int a = 0; a < D; ++a)
       pv[a] = _mm_set1_pd(p[a]);
-    for (int i = 0; i < N; i += 2) {
+    for (int i = 0; i < kSlots; i += 2) {
       __m128d sum = zero;
       for (int a = 0; a < D; ++a) {
         const __m128d below = _mm_max_pd(_mm_sub_pd(_mm_loadu_pd(&lo[a][i]), pv[a]), zero);
@@ -118,7 +123,7 @@ struct SoaBoxes {
       _mm_storeu_pd(out + i, sum);
     }
 #else
-    for (int i = 0; i < N; ++i)
+    for (int i = 0; i < kSlots; ++i)
       out[i] = squared_distance(i, p);
 #endif
   }
@@ -177,12 +182,12 @@ struct SoaBoxes {
 
   template <class Test>
   Mask mask(Test test, const Box<D>& w) const {
-    static_assert(N % kLanes == 0);
+    static_assert(kSlots % kLanes == 0);
     decltype(splat(0.0)) wmin[D], wmax[D];
     for (int a = 0; a < D; ++a)
       wmin[a] = splat(w.min[a]), wmax[a] = splat(w.max[a]);
     Mask m = 0;
-    for (int i = 0; i < N; i += kLanes) {
+    for (int i = 0; i < kSlots; i += kLanes) {
       auto acc = test(load(&lo[0][i]), load(&hi[0][i]), wmin[0], wmax[0]);
       for (int a = 1; a < D; ++a)
         acc = both(acc, test(load(&lo[a][i]), load(&hi[a][i]), wmin[a], wmax[a]));

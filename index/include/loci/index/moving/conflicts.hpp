@@ -41,11 +41,11 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
-#include <utility>
 #endif
 
 #include "loci/geom/motion.hpp"

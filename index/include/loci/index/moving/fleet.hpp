@@ -43,8 +43,11 @@ class Fleet {
   explicit Fleet(Index index = Index{}) : index_(std::move(index)) {}
   Fleet(const Fleet&) = default;
   Fleet& operator=(const Fleet&) = default;
-  // Moving leaves `other` empty, as if default-constructed.
-  Fleet(Fleet&& other) noexcept : Fleet() { swap(other); }
+  // Moving leaves `other` empty, its index with its parameters.
+  Fleet(Fleet&& other) noexcept
+      : index_(std::move(other.index_)),
+        history_(std::exchange(other.history_, {})),
+        reports_(std::exchange(other.reports_, 0)) {}
   Fleet& operator=(Fleet&& other) noexcept {
     Fleet(std::move(other)).swap(*this);
     return *this;

@@ -91,8 +91,8 @@ class MovingGrid {
   }
   MovingGrid(const MovingGrid&) = default;
   MovingGrid& operator=(const MovingGrid&) = default;
-  // Moving leaves `other` empty, as if default-constructed.
-  MovingGrid(MovingGrid&& other) noexcept : MovingGrid() { swap(other); }
+  // Moving leaves `other` empty, keeping its parameters.
+  MovingGrid(MovingGrid&& other) noexcept : MovingGrid(other.params_) { swap(other); }
   MovingGrid& operator=(MovingGrid&& other) noexcept {
     MovingGrid(std::move(other)).swap(*this);
     return *this;

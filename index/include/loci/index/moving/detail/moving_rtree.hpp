@@ -33,11 +33,11 @@
 #include <queue>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
-#include <utility>
 #endif
 
 #include "loci/index/broadphase/detail/proxy_table.hpp"
@@ -69,8 +69,8 @@ class MovingRTree {
   explicit MovingRTree(const Params& params = {}) : params_(params) { Policy::check(params); }
   MovingRTree(const MovingRTree&) = default;
   MovingRTree& operator=(const MovingRTree&) = default;
-  // Moving leaves `other` empty, as if default-constructed.
-  MovingRTree(MovingRTree&& other) noexcept : MovingRTree() { swap(other); }
+  // Moving leaves `other` empty, keeping its parameters.
+  MovingRTree(MovingRTree&& other) noexcept : MovingRTree(other.params_) { swap(other); }
   MovingRTree& operator=(MovingRTree&& other) noexcept {
     MovingRTree(std::move(other)).swap(*this);
     return *this;
