@@ -6,7 +6,6 @@
 #include <cstddef>
 #include <cstdlib>
 #include <new>
-#include <random>
 #include <typeinfo>
 #include <vector>
 
@@ -30,6 +29,7 @@
 #include "loci/index/rtree.hpp"
 #include "loci/index/segment_tree.hpp"
 #include "loci/index/segment_window_tree.hpp"
+#include "support/random_data.hpp"
 
 namespace {
 thread_local std::size_t g_allocations = 0;
@@ -71,14 +71,7 @@ std::size_t allocations(F&& f) {
 }
 
 std::vector<Box2> boxes(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> at(0, 1000), side(0, 20);
-  std::vector<Box2> out(n);
-  for (auto& b : out) {
-    const Point2 p{at(rng), at(rng)};
-    b = {p, {p[0] + side(rng), p[1] + side(rng)}};
-  }
-  return out;
+  return test::make_boxes<2>(test::Shape::uniform, static_cast<std::size_t>(n), seed);
 }
 
 const Box2 kWindow{{200, 200}, {500, 600}};

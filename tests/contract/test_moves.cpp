@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <random>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -34,6 +33,7 @@
 #include "loci/index/rtree.hpp"
 #include "loci/index/segment_tree.hpp"
 #include "loci/index/segment_window_tree.hpp"
+#include "support/random_data.hpp"
 
 namespace loci {
 namespace {
@@ -42,14 +42,7 @@ constexpr int kCount = 300;
 const Box2 kAll{{-1e6, -1e6}, {1e6, 1e6}};
 
 std::vector<Box2> boxes(unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> at(0, 1000), side(0, 30);
-  std::vector<Box2> out(kCount);
-  for (auto& b : out) {
-    const Point2 p{at(rng), at(rng)};
-    b = {p, {p[0] + side(rng), p[1] + side(rng)}};
-  }
-  return out;
+  return test::make_boxes<2>(test::Shape::uniform, kCount, seed);
 }
 std::vector<Point2> points(unsigned seed) {
   std::vector<Point2> out;
