@@ -498,7 +498,10 @@ void PreparedGeometry::build(std::size_t cells) {
   for (;;) {
     nx_ = ny_ = 1;
     if (w > 0 && h > 0) {
-      const double nx = std::clamp(std::round(std::sqrt(double(cells) * w / h)), 1.0, 65536.0);
+      // At most `cells` columns: a flat envelope would otherwise get more cells than asked
+      // (one cell: one column and one row, so that each edge is listed once).
+      const double nx = std::clamp(std::round(std::sqrt(double(cells) * w / h)), 1.0,
+                                   std::min(65536.0, double(cells)));
       nx_ = std::uint32_t(nx);
       ny_ = std::uint32_t(std::clamp(std::round(double(cells) / nx), 1.0, 65536.0));
     } else if (w > 0) {
@@ -527,8 +530,8 @@ void PreparedGeometry::build(std::size_t cells) {
         for (std::uint32_t c = c0; c <= c1; ++c)
           ++cell_start_[std::size_t(r) * nx_ + c + 1];
     }
-    if (too_many && cells > 1) {
-      cells /= 4;
+    if (too_many) {  // never with one cell, which lists each edge once
+      cells = std::max<std::size_t>(cells / 4, 1);
       continue;
     }
     for (std::size_t k = 0; k < n; ++k)

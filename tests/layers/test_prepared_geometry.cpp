@@ -148,6 +148,30 @@ TEST(PreparedGeometry, FlatEnvelopes) {
   expect_same(point, rng, 0, 8, "point");
 }
 
+TEST(PreparedGeometry, FlatEnvelopesWithFewEdges) {
+  // Two or three long edges across a flat envelope: the grid asked for one cell once got a
+  // column per unit of the aspect ratio, each edge listed in most of them, and the coarsening
+  // that follows stopped at one cell asked with the counts half made: a write past the lists.
+  FlatGeometry sliver, vee;
+  add_ring(sliver, {{0, 0}, {1000, 1}, {0, 1}}, 0);
+  sliver.polygons = 1;
+  vee.points = {{0, 0}, {1000, 1}, {0, 0.5}};
+  vee.parts.push_back({0, 3, PartKind::line, 0});
+  for (const FlatGeometry* g : {&sliver, &vee}) {
+    const PreparedGeometry prepared(*g);
+    std::size_t counts[3] = {0, 0, 0};
+    for (double x = -1; x <= 1001; x += 0.5)
+      for (const double y : {-0.5, 0.0, 0.0005, 0.25, 0.5, 0.75, 1.0, 1.5}) {
+        const Location want = brute(*g, {x, y});
+        ++counts[int(want)];
+        ASSERT_EQ(prepared.locate({x, y}), want) << x << "," << y;
+      }
+    EXPECT_GT(counts[int(Location::boundary)], 0u);
+    EXPECT_GT(counts[int(Location::outside)], 0u);
+    if (g->polygons > 0) EXPECT_GT(counts[int(Location::inside)], 0u);
+  }
+}
+
 TEST(PreparedGeometry, PairTestsAgreeWithPointTests) {
   // meets and covers on prepared geometries against lattice-point evidence on squares whose
   // corners are integers (for such shapes lattice and half-lattice points decide the answers).
