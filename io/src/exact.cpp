@@ -330,7 +330,8 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
         ++k;
       continue;
     }
-    if (!each_piece(on_b, k, i, [&](double t) { return pa.meets(point_at(s, t)); })) return false;
+    if (!each_piece(on_b, k, i, [&](double t) { return pa.locate_at(s, t) != Location::outside; }))
+      return false;
   }
   if (!areas) return true;
   // No point of a's polygons' boundary lies strictly inside b's polygons: a vertex there, or a
@@ -347,15 +348,7 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
         ++k;
       continue;
     }
-    // The middle is rounded: it decides only when it lies inside b farther from b's boundary
-    // than the rounding (b's edge running within a hair of a's, the piece may lie outside b).
-    const double hair =
-        1e-13 * (std::fabs(e.a[0]) + std::fabs(e.a[1]) + std::fabs(e.b[0]) + std::fabs(e.b[1])) +
-        1e-300;
-    if (!each_piece(on_a, k, j, [&](double t) {
-          const Point2 m = point_at(e, t);
-          return pb.locate(m) != Location::inside || pb.near_boundary(m, hair);
-        }))
+    if (!each_piece(on_a, k, j, [&](double t) { return pb.locate_at(e, t) != Location::inside; }))
       return false;
   }
   // So the inside of each polygon of b lies wholly inside a or wholly outside it (say, a's hole
@@ -474,6 +467,53 @@ bool PreparedGeometry::near_boundary(const Point2& p, double delta) const {
       }
     }
   return false;
+}
+
+Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
+  const Point2 m = point_at(s, t);
+  const double hair = point_at_rounding(s);
+  if (t == 0 || t == 1 || !near_boundary(m, hair)) return locate(m);
+  // The real point p lies within `hair` of m in x and y, and g passes that near: p is located
+  // by the parity of the ring edges its rightward ray crosses, each decided exactly. An edge
+  // on p or crossing that ray meets p's row at or right of p, so it is listed in a cell of the
+  // rows m's y +- hair falls in, from m's x - hair rightwards.
+  std::vector<std::uint32_t> near;
+  for (std::uint32_t r = row(m[1] - hair), r1 = row(m[1] + hair); r <= r1; ++r) {
+    const std::size_t row_start = std::size_t(r) * nx_;
+    near.insert(near.end(), cell_edges_.begin() + cell_start_[row_start + col(m[0] - hair)],
+                cell_edges_.begin() + cell_start_[row_start + nx_]);
+  }
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  const std::vector<Point2>& pts = g_->points;
+  // The sign of v minus p's coordinate on `axis`, exactly; the rounded point decides when v
+  // lies farther from it than the rounding.
+  auto above = [&](int axis, double v) {
+    if (v > m[axis] + hair) return 1;
+    if (v < m[axis] - hair) return -1;
+    return -compare_coordinate_at(s, t, axis, v);
+  };
+  bool odd = false;
+  for (const std::uint32_t k : near) {
+    const Edge& e = edges_[k];
+    const Point2& a = pts[e.first];
+    if (e.kind == kPoint) {
+      if (above(0, a[0]) == 0 && above(1, a[1]) == 0) return Location::boundary;
+      continue;
+    }
+    const Point2& b = pts[e.first + 1];
+    const int ya = above(1, a[1]), yb = above(1, b[1]);
+    if ((ya > 0 && yb > 0) || (ya < 0 && yb < 0)) continue;  // wholly above or below p
+    const int x0 = above(0, std::min(a[0], b[0])), x1 = above(0, std::max(a[0], b[0]));
+    if (x1 < 0) continue;  // wholly left of p
+    const Orientation o = orientation_at(a, b, s, t);
+    if (o == Orientation::collinear && x0 <= 0) return Location::boundary;
+    // Half-open in y, as ray_crosses: the crossing is right of p when p is left of the edge
+    // directed upwards.
+    if (e.kind == kRing && (ya > 0) != (yb > 0))
+      odd ^= o == (a[1] < b[1] ? Orientation::counterclockwise : Orientation::clockwise);
+  }
+  return odd ? Location::inside : Location::outside;
 }
 
 std::uint32_t PreparedGeometry::col(double x) const {

@@ -126,6 +126,18 @@ inline Point<2> point_at(const Segment<2>& s, double t) {
   return {s.a[0] + t * (s.b[0] - s.a[0]), s.a[1] + t * (s.b[1] - s.a[1])};
 }
 
+// Exact tests on the real point s.a + t (s.b - s.a) rather than on its rounding by point_at:
+// the sign of its coordinate `axis` minus v, and the orientation of a, b and it. For a point
+// inside a segment that other geometry passes within rounding of (a piece between the
+// crossings of two nearly collinear edges), where the rounded point may lie on the wrong side.
+int compare_coordinate_at(const Segment<2>& s, double t, int axis, double v);
+Orientation orientation_at(const Point<2>& a, const Point<2>& b, const Segment<2>& s, double t);
+// A bound on the distance in x and in y between point_at(s, t), t in [0, 1], and the real point.
+inline double point_at_rounding(const Segment<2>& s) {
+  return 1e-15 * (std::fabs(s.a[0]) + std::fabs(s.a[1]) + std::fabs(s.b[0]) + std::fabs(s.b[1])) +
+         1e-300;
+}
+
 namespace detail {
 // The exact squared distance from p to s, rounded to a double (0 only when p lies on s).
 double squared_distance_exact(const Point<2>& p, const Segment<2>& s);

@@ -80,8 +80,11 @@ std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry&
 // of a's polygons may lie strictly inside them (a vertex, or the middle of a piece of a ring
 // edge cut by b's edges: a hole or notch of a inside b); then the inside of each polygon of b
 // lies wholly in a or wholly outside (a hole of a filled exactly by b), and one point strictly
-// inside it decides. The vertex tests are exact; the middles of pieces and the inside point are
-// rounded, which can matter only for pieces or polygons thinner than the rounding.
+// inside it decides. The vertex tests are exact, and so are the middles of pieces: the real
+// point, not its rounding, where the other geometry passes within rounding of it (b's edge
+// running a hair inside a's, the rounded middle may lie outside). The cut parameters and the
+// inside point are rounded, which can matter only for pieces or polygons thinner than the
+// rounding.
 bool covers(const FlatGeometry& a, const FlatGeometry& b);
 
 // Where a point lies with respect to a geometry: outside it, on its boundary (a point, an
@@ -109,6 +112,9 @@ class PreparedGeometry {
   bool meets(const Point2& p) const { return locate(p) != Location::outside; }
   // True when an edge or point of g comes within delta of p in x and in y (exact).
   bool near_boundary(const Point2& p, double delta) const;
+  // Where the real point s.a + t (s.b - s.a) lies (not its rounding by point_at), exactly:
+  // the rounded point decides unless g passes within rounding of it.
+  Location locate_at(const Segment2& s, double t) const;
   std::size_t memory_bytes() const;
 
  private:
