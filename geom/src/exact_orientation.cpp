@@ -8,6 +8,7 @@
 // exact as long as no product underflows; for inputs small enough to risk it, CGAL's exact
 // kernel decides instead.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
 
 #include <array>
 #include <cmath>
@@ -95,6 +96,19 @@ Orientation orientation_exact(double ax, double ay, double bx, double by, double
   }
   if (m == 0) return Orientation::collinear;
   return e[m - 1] > 0 ? Orientation::counterclockwise : Orientation::clockwise;
+}
+
+Orientation crossing_orientation_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c,
+                                       const Point<2>& d, const Point<2>& p, const Point<2>& q) {
+  using Q = CGAL::Exact_rational;
+  // (Q is returned by value: gmpxx's expression templates would outlive their operands.)
+  const auto det = [](const Point<2>& u, const Point<2>& w, const Point<2>& x) -> Q {
+    return (Q(w[0]) - Q(u[0])) * (Q(x[1]) - Q(u[1])) - (Q(w[1]) - Q(u[1])) * (Q(x[0]) - Q(u[0]));
+  };
+  const Q oa = det(c, d, a), ob = det(c, d, b), pa = det(p, q, a), pb = det(p, q, b);
+  const Q num = oa * pb - ob * pa, den = oa - ob;
+  const int s = int(CGAL::sign(num)) * int(CGAL::sign(den));
+  return static_cast<Orientation>(s);
 }
 
 }  // namespace loci::detail

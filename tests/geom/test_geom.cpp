@@ -135,6 +135,59 @@ TEST(Orientation, ExactAtEveryScale) {
   EXPECT_GT(collinear, 1000);
 }
 
+// The side of a line on which the crossing of a segment with another line lies, the crossing
+// never computed: against rationals, with the line through the crossing rounded (the hard
+// case), at every scale, and exactly on it where three lines of an integer grid meet.
+TEST(Orientation, CrossingMatchesExact) {
+  const auto exact = [](const Point2& a, const Point2& b, const Point2& c, const Point2& d,
+                        const Point2& p, const Point2& q) {
+    const auto det = [](const Point2& u, const Point2& w, const Point2& x) -> mpq_class {
+      return (mpq_class(w[0]) - u[0]) * (mpq_class(x[1]) - u[1]) -
+             (mpq_class(w[1]) - u[1]) * (mpq_class(x[0]) - u[0]);
+    };
+    const mpq_class oa = det(c, d, a), ob = det(c, d, b), pa = det(p, q, a), pb = det(p, q, b);
+    const mpq_class num = oa * pb - ob * pa, den = oa - ob;
+    return sgn(num) * sgn(den);
+  };
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uniform_int_distribution<int> ulps(-2, 2);
+  int on = 0;
+  // Made at unit scale and scaled by powers of two (exactly), down to where products
+  // underflow.
+  for (const int e : {-990, -20, 0, 20, 460}) {
+    for (int i = 0; i < 3000; ++i) {
+      Point2 a{u(rng), u(rng)}, b{u(rng), u(rng)}, c{u(rng), u(rng)}, d{u(rng), u(rng)};
+      const int sa = sign(orientation(c, d, a)), sb = sign(orientation(c, d, b));
+      if (sa * sb >= 0) continue;
+      // p-q through the rounded crossing (or a few ulps off it).
+      const double oa = (d[0] - c[0]) * (a[1] - c[1]) - (d[1] - c[1]) * (a[0] - c[0]);
+      const double ob = (d[0] - c[0]) * (b[1] - c[1]) - (d[1] - c[1]) * (b[0] - c[0]);
+      const double t = oa / (oa - ob);
+      Point2 p{a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])}, q{u(rng), u(rng)};
+      for (int k = ulps(rng); k != 0; k += k > 0 ? -1 : 1)
+        p[k & 1] = std::nextafter(p[k & 1], k > 0 ? 1e300 : -1e300);
+      for (Point2* v : {&a, &b, &c, &d, &p, &q})
+        *v = Point2{std::ldexp((*v)[0], e), std::ldexp((*v)[1], e)};
+      ASSERT_EQ(sign(crossing_orientation(a, b, c, d, p, q)), exact(a, b, c, d, p, q))
+          << e << " " << i;
+      ASSERT_EQ(sign(crossing_orientation(a, b, c, d, q, p)), exact(a, b, c, d, q, p))
+          << e << " " << i;
+    }
+  }
+  // Integer grid: a-b, c-d and p-q often meet at one point.
+  std::uniform_int_distribution<int> g(0, 6);
+  for (int i = 0; i < 20000; ++i) {
+    const auto pt = [&] { return Point2{double(g(rng)), double(g(rng))}; };
+    const Point2 a = pt(), b = pt(), c = pt(), d = pt(), p = pt(), q = pt();
+    if (sign(orientation(c, d, a)) * sign(orientation(c, d, b)) >= 0) continue;
+    const int want = exact(a, b, c, d, p, q);
+    on += want == 0;
+    ASSERT_EQ(sign(crossing_orientation(a, b, c, d, p, q)), want) << i;
+  }
+  EXPECT_GT(on, 100);
+}
+
 TEST(Segment, BoxIntersectionIsExact2D) {
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> u(0, 10);

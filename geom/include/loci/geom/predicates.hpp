@@ -19,6 +19,9 @@ enum class Orientation : int { clockwise = -1, collinear = 0, counterclockwise =
 namespace detail {
 // Decided exactly; called only when the floating filter cannot decide.
 Orientation orientation_exact(double ax, double ay, double bx, double by, double cx, double cy);
+// Decided exactly in rationals; called only when the floating filter cannot decide.
+Orientation crossing_orientation_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c,
+                                       const Point<2>& d, const Point<2>& p, const Point<2>& q);
 }  // namespace detail
 
 inline Orientation orientation(const Point<2>& a, const Point<2>& b, const Point<2>& c) {
@@ -32,6 +35,37 @@ inline Orientation orientation(const Point<2>& a, const Point<2>& b, const Point
   if (det > bound) return Orientation::counterclockwise;
   if (-det > bound) return Orientation::clockwise;
   return detail::orientation_exact(a[0], a[1], b[0], b[1], c[0], c[1]);
+}
+
+// orientation(p, q, x) for x the crossing of the segment a-b with the line through c and d,
+// without computing x (which a double may not hold): a and b must lie strictly on either side
+// of that line. Exact for every input of finite doubles, filtered as orientation is.
+inline Orientation crossing_orientation(const Point<2>& a, const Point<2>& b, const Point<2>& c,
+                                        const Point<2>& d, const Point<2>& p, const Point<2>& q) {
+  // With oa, ob the orientations of a and b against c-d and pa, pb against p-q (each a
+  // determinant), x = a + t (b - a) for t = oa / (oa - ob), and orientation(p, q, x) has the
+  // sign of (oa pb - ob pa) / (oa - ob), oa - ob having the sign of oa.
+  struct Det {
+    double v, m;  // the rounded determinant and |left| + |right|
+  };
+  const auto det = [](const Point<2>& u, const Point<2>& w, const Point<2>& x) {
+    const double left = (w[0] - u[0]) * (x[1] - u[1]);
+    const double right = (w[1] - u[1]) * (x[0] - u[0]);
+    return Det{left - right, std::fabs(left) + std::fabs(right)};
+  };
+  const Det oa = det(c, d, a), ob = det(c, d, b), pa = det(p, q, a), pb = det(p, q, b);
+  const double num = oa.v * pb.v - ob.v * pa.v;
+  // Each determinant is off by at most 3.4e-16 of its m (orientation's bound), the products
+  // and their difference round once each: the numerator is off by less than 1e-15 of
+  // oa.m pb.m + ob.m pa.m. Below 2^-900 underflow may have lost terms, and the sign of oa
+  // must be sure: otherwise decided exactly.
+  const double bound = 2e-15 * (oa.m * pb.m + ob.m * pa.m);
+  if (bound > 0x1p-900 && std::fabs(oa.v) > 3.3306690738754716e-16 * oa.m) {
+    const int s = oa.v > 0 ? 1 : -1;
+    if (num > bound) return static_cast<Orientation>(s);
+    if (-num > bound) return static_cast<Orientation>(-s);
+  }
+  return detail::crossing_orientation_exact(a, b, c, d, p, q);
 }
 
 inline int sign(Orientation o) {

@@ -14,21 +14,25 @@
 // (an autopartition); its normal points out of the solid ("front", f(x) = n.x - d > 0). The
 // splitter is the best of a few candidates by (3 x edges cut + imbalance). Edges are kept as
 // pieces [s0, s1] of their original edge, and the side of an edge is decided by the exact
-// orientation predicate (geom/predicates.hpp) on the original end points, so that pieces
-// never drift across a line through rounding. Collinear edges facing the same way lie on the
-// node's plane and are done; collinear edges facing the other way (a border shared by two
-// polygons) go to the front side. A side left without edges is a leaf, solid or empty as a
-// whole since no boundary crosses it. Behind the splitter it is solid (the splitter's own
-// polygon covers it). In front it is empty unless another polygon covers the splitter's
-// piece, which happens where polygons overlap (neighbouring countries in real data do, by
-// rounding): the middle of the piece is located by crossing parity against the other
-// polygons (edges bucketed in bands of y), just in front of the line: a polygon with an edge
-// along the line there covers the front when that edge faces the other way (a border of three
-// edges or more, of a duplicated polygon or an island filling a hole, of which the edges that
-// cancel pair off), and a polygon with a vertex there makes another point of the piece be
-// tried. Deciding from the piece rather than from a point inside the cell keeps thin cells
-// right; a front cell of no thickness (the splitter on its own border) is empty. Polygons may
-// overlap and share borders.
+// orientation predicate (geom/predicates.hpp) on the original end points; an end of a piece
+// that a line cut is that crossing, whose side is decided exactly too (crossing_orientation),
+// so that pieces never drift across a line through rounding (where three lines meet, as they
+// do on integer grids, rounded fractions left slivers across). Collinear edges facing the
+// same way lie on the node's plane and are done; collinear edges facing the other way (a
+// border shared by two polygons) go to the front side. A side left without edges is a leaf,
+// solid or empty as a whole since no boundary crosses it. Behind the splitter it is solid
+// (the splitter's own polygon covers it). In front it is empty unless another polygon covers
+// it, which happens where polygons overlap (neighbouring countries in real data do, by
+// rounding). A cell with room is decided at a point well inside it, located by crossing
+// parity against all the polygons (edges bucketed in bands of y). A thinner one is decided
+// from the splitter's piece: its middle is located against the other polygons just in front
+// of the line: a polygon with an edge along the line there (told by the edge's end points,
+// exactly, not by the rounded middle) covers the front when that edge faces the other way (a
+// border of three edges or more, of a duplicated polygon or an island filling a hole, of
+// which the edges that cancel pair off), and a polygon with a vertex there makes another
+// point of the piece be tried. Deciding from the piece keeps thin cells right; a front cell
+// of no thickness (the splitter on its own border) is empty. Polygons may overlap and share
+// borders.
 //
 // Plane shifting. An object occupies x + K (K a convex shape around its reference point x).
 // It meets a convex solid cell C exactly when x lies in C + (-K), which is contained in the
@@ -397,7 +401,8 @@ struct BspEdge {
 // edges (decided exactly, half-open in y), the edges bucketed in horizontal bands. A polygon
 // with the point inside one of its edges that lies on the splitter's line covers the front
 // there when that edge faces the other way (a shared border whose edges did not all cancel: a
-// duplicated polygon, an island filling a hole), and not when it faces the same way. A
+// duplicated polygon, an island filling a hole), and not when it faces the same way; such an
+// edge is told by its end points, exactly, the point (rounded) by its place along the line. A
 // polygon with the point on its boundary otherwise (at a vertex) leaves the answer
 // undecided, unless another polygon covers the point: the caller then tries another point of
 // the piece.
@@ -431,23 +436,33 @@ class BspPointLocator {
       return along_x ? (to[0] > from[0]) == (splitter.b[0] > splitter.a[0])
                      : (to[1] > from[1]) == (splitter.b[1] > splitter.a[1]);
     };
+    // Where p lies along the splitter's line (its coordinate on the dominant axis).
+    const int axis = along_x ? 0 : 1;
     for (const std::uint32_t k : bands_.at(p[1])) {
       const BspEdge& e = edges_[k];
       if (e.polygon == except) continue;
       const Point2& lo = e.a[1] < e.b[1] ? e.a : e.b;
       const Point2& hi = e.a[1] < e.b[1] ? e.b : e.a;
       if (p[1] < lo[1] || p[1] > hi[1]) continue;
+      // An edge on the splitter's line is told by its end points, exactly, and p's place along
+      // it: p, a point of the line rounded, may lie off the line by an ulp and on either side
+      // of the edge. Just in front of the line it is never crossed.
+      if (orientation(splitter.a, splitter.b, e.a) == Orientation::collinear &&
+          orientation(splitter.a, splitter.b, e.b) == Orientation::collinear) {
+        const double u = p[axis], ua = e.a[axis], ub = e.b[axis];
+        if (u < std::min(ua, ub) || u > std::max(ua, ub)) continue;
+        touch(e.polygon);
+        parity_[e.polygon] |= 2;  // on its boundary
+        // Inside the edge, facing the other way: the polygon (on the edge's left) lies in
+        // front of the splitter there.
+        if (u != ua && u != ub) parity_[e.polygon] |= forward(e.a, e.b) ? 16 : 8;
+        continue;
+      }
       const Orientation o = orientation(lo, hi, p);
       if (o == Orientation::collinear) {
         if (std::min(lo[0], hi[0]) <= p[0] && p[0] <= std::max(lo[0], hi[0])) {
           touch(e.polygon);
           parity_[e.polygon] |= 2;  // on its boundary
-          // Inside an edge on the splitter's line facing the other way: the polygon (on the
-          // edge's left) lies in front of the splitter there.
-          if (p != e.a && p != e.b &&
-              orientation(splitter.a, splitter.b, e.a) == Orientation::collinear &&
-              orientation(splitter.a, splitter.b, e.b) == Orientation::collinear)
-            parity_[e.polygon] |= forward(e.a, e.b) ? 16 : 8;
         }
         continue;
       }
@@ -466,16 +481,46 @@ class BspPointLocator {
     return any ? Cover::yes : undecided ? Cover::undecided : Cover::no;
   }
 
+  // Whether p lies inside any of the polygons, by crossing parity against all their edges;
+  // undecided when p lies on one.
+  Cover inside_any(const Point2& p) {
+    bool on = false, any = false;
+    touched_.clear();
+    for (const std::uint32_t k : bands_.at(p[1])) {
+      const BspEdge& e = edges_[k];
+      const Point2& lo = e.a[1] < e.b[1] ? e.a : e.b;
+      const Point2& hi = e.a[1] < e.b[1] ? e.b : e.a;
+      if (p[1] < lo[1] || p[1] > hi[1]) continue;
+      const Orientation o = orientation(lo, hi, p);
+      if (o == Orientation::collinear) {
+        on = on || (std::min(lo[0], hi[0]) <= p[0] && p[0] <= std::max(lo[0], hi[0]));
+        continue;
+      }
+      if (p[1] == hi[1] || o != Orientation::counterclockwise) continue;
+      if (!parity_[e.polygon]) touched_.push_back(e.polygon);
+      parity_[e.polygon] = (parity_[e.polygon] ^ 1) | 4;
+    }
+    for (const std::uint32_t q : touched_) {
+      any = any || parity_[q] == 5;
+      parity_[q] = 0;
+    }
+    return on ? Cover::undecided : any ? Cover::yes : Cover::no;
+  }
+
  private:
   const std::vector<BspEdge>& edges_;
   std::vector<std::uint8_t> parity_;
   std::vector<std::uint32_t> touched_;
   YBands bands_;
 };
-// A piece [s0, s1] of an edge (points a + s (b - a)), what is left of it inside a cell.
+// A piece [s0, s1] of an edge (points a + s (b - a)), what is left of it inside a cell. Each
+// end is the edge's own end point or the edge's crossing with the line of edge c0 (c1), which
+// cut it: s0 and s1 are rounded, the ends are known exactly.
 struct BspPiece {
+  static constexpr std::uint32_t kOwnEnd = ~std::uint32_t{0};
   std::uint32_t edge;
   double s0, s1;
+  std::uint32_t c0 = kOwnEnd, c1 = kOwnEnd;
 };
 // A vertex of a convex cell (counter-clockwise) and the outward normal of the cell's side
 // from it to the next vertex.
@@ -631,6 +676,13 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
   // Side of a piece against the line of edge l: +1 behind (solid side), -1 in front, decided
   // on the original end points by the exact orientation predicate.
   auto side_of = [&](const BspEdge& l, const Point2& p) { return sign(orientation(l.a, l.b, p)); };
+  // The same for an end of a piece of edge e: `own` for the edge's own end point, else the
+  // side of e's crossing with the line of edge `cut`.
+  auto end_side = [&](const BspEdge& l, const BspEdge& e, int own, std::uint32_t cut) {
+    if (cut == BspPiece::kOwnEnd) return own;
+    const BspEdge& m = edges[cut];
+    return sign(crossing_orientation(e.a, e.b, m.a, m.b, l.a, l.b));
+  };
 
   struct Work {
     std::int32_t parent;  // -1: the root
@@ -746,18 +798,23 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
       } else if (sa <= 0 && sb <= 0) {
         front.push_back(q);
       } else {
-        const double fa = l.nx * e.a[0] + l.ny * e.a[1] - l.d;
-        const double fb = l.nx * e.b[0] + l.ny * e.b[1] - l.d;
-        const double sc = std::clamp(fa / (fa - fb), 0.0, 1.0);
-        std::vector<BspPiece>& a_side = sa > 0 ? back : front;
-        std::vector<BspPiece>& b_side = sa > 0 ? front : back;
-        if (q.s1 <= sc) {
-          a_side.push_back(q);
-        } else if (q.s0 >= sc) {
-          b_side.push_back(q);
+        // The edge crosses the line: the sides of the piece's ends, exactly (an end cut by a
+        // line through the crossing lies on the line), not by comparing rounded fractions,
+        // which would leave slivers of the piece across the line where three lines meet.
+        const int t0 = end_side(l, e, sa, q.c0);
+        const int t1 = end_side(l, e, sb, q.c1);
+        if (t0 >= 0 && t1 >= 0) {
+          back.push_back(q);
+        } else if (t0 <= 0 && t1 <= 0) {
+          front.push_back(q);
         } else {
-          a_side.push_back({q.edge, q.s0, sc});
-          b_side.push_back({q.edge, sc, q.s1});
+          const double fa = l.nx * e.a[0] + l.ny * e.a[1] - l.d;
+          const double fb = l.nx * e.b[0] + l.ny * e.b[1] - l.d;
+          // (Both ends within rounding of the line: fa / (fa - fb) may be NaN.)
+          const double r = fa / (fa - fb);
+          const double sc = r > q.s0 ? std::min(r, q.s1) : q.s0;
+          (t0 > 0 ? back : front).push_back({q.edge, q.s0, sc, q.c0, li});
+          (t0 > 0 ? front : back).push_back({q.edge, sc, q.s1, li, q.c1});
         }
       }
     }
@@ -779,15 +836,28 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
         thickness = std::max(thickness, l.nx * v.p[0] + l.ny * v.p[1] - l.d);
         scale = std::max({scale, std::abs(v.p[0]), std::abs(v.p[1])});
       }
-      // The piece's middle first; where it lies on another polygon's vertex, points of the
-      // piece at golden-ratio fractions (still undecided: not covered).
       bool covered = false;
       if (thickness > 1e-12 * scale) {
         using Cover = detail::BspPointLocator::Cover;
-        Cover c = locator.inside_other(piece_mid, l);
+        // Where the cell has room, a point well inside it decides, located against all the
+        // polygons: the mean of its corners, if it lies inside every side by 1e-12 of the
+        // magnitudes (the sides carry the rounding of the clipping only, far less). No
+        // boundary crosses the cell, and none passes near that point.
+        Cover c = Cover::undecided;
+        Point2 centre{0, 0};
+        for (const detail::BspCellVertex& v : front_cell)
+          centre = Point2{centre[0] + v.p[0], centre[1] + v.p[1]};
+        const auto corners = static_cast<double>(front_cell.size());
+        centre = Point2{centre[0] / corners, centre[1] / corners};
+        double inside = std::numeric_limits<double>::infinity();
+        for (const detail::BspCellVertex& v : front_cell)
+          inside = std::min(inside, v.n[0] * (v.p[0] - centre[0]) + v.n[1] * (v.p[1] - centre[1]));
+        if (inside > 1e-12 * scale) c = locator.inside_any(centre);
+        // Else the piece's middle; where it lies on another polygon's vertex, points of the
+        // piece at golden-ratio fractions (still undecided: not covered).
+        if (c == Cover::undecided) c = locator.inside_other(piece_mid, l);
         const double s0 = splitter.s0, s1 = splitter.s1;
-        // (A sliver of a piece, left by rounding where another line crosses the splitter, has
-        // points beyond the cell: no other point of it is tried.)
+        // (A piece too short for its fractions to fall apart: no other point of it is tried.)
         for (const double f : {0.3819660112501051, 0.6180339887498949, 0.2360679774997897,
                                0.7639320225002103, 0.1458980337503155, 0.8541019662496845}) {
           if (c != Cover::undecided || !(s1 - s0 > 1e-9)) break;
