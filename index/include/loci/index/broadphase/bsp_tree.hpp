@@ -25,14 +25,28 @@
 // it, which happens where polygons overlap (neighbouring countries in real data do, by
 // rounding). A cell with room is decided at a point well inside it, located by crossing
 // parity against all the polygons (edges bucketed in bands of y). A thinner one is decided
-// from the splitter's piece: its middle is located against the other polygons just in front
-// of the line: a polygon with an edge along the line there (told by the edge's end points,
-// exactly, not by the rounded middle) covers the front when that edge faces the other way (a
-// border of three edges or more, of a duplicated polygon or an island filling a hole, of
-// which the edges that cancel pair off), and a polygon with a vertex there makes another
-// point of the piece be tried. Deciding from the piece keeps thin cells right; a front cell
-// of no thickness (the splitter on its own border) is empty. Polygons may overlap and share
-// borders.
+// from the splitter's piece, located against the other polygons just in front of the line at
+// the real point just past the piece's start (its crossing with the line that cut it there,
+// or the edge's end), exactly: no rounded point, which may fall on the wrong side of the
+// nearly collinear edges that bound a thin cell, and no point inside the piece, which may be
+// too short to hold a double. A polygon with an edge along the line there (told by the edge's
+// end points) covers the front when that edge faces the other way (a border of three edges or
+// more, of a duplicated polygon or an island filling a hole, of which the edges that cancel
+// pair off). Deciding from the piece keeps thin cells right; a front cell of no area (the
+// splitter on its own border) is empty. Polygons may overlap and share borders. A ring's
+// orientation is the sign of its area or, for a sliver whose rounded area may have the wrong
+// sign, the exact turn at its lowest leftmost vertex.
+//
+// Cells. The cell of a node, the root box clipped by the planes on its path, is a convex
+// polygon whose corners are crossings of the edges' lines (and the box's sides); which
+// corners lie on which side of a splitter is decided exactly (crossing_orientation on the
+// lines' end points, filtered by the corner rounded), and each new corner is the crossing of
+// two lines computed afresh to within 2e-15 of the magnitudes (in rationals where floating
+// point cannot promise that). Rounding therefore never loses a cell nor moves its corners
+// along its sides: where two nearly opposite lines meet (edges of two polygons along one line
+// through a shared vertex, parted by rounding), the solid cell between them, a spike an ulp
+// wide, keeps its tip, which is bevelled as any corner (its turn, near pi, taken as the
+// convex cell's turn whatever the sign the rounded normals give).
 //
 // Plane shifting. An object occupies x + K (K a convex shape around its reference point x).
 // It meets a convex solid cell C exactly when x lies in C + (-K), which is contained in the
@@ -79,6 +93,7 @@
 #include <numbers>
 #include <span>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -86,6 +101,8 @@
 #include "loci/geom/error.hpp"
 #include "loci/geom/point.hpp"
 #include "loci/geom/predicates.hpp"
+#include "loci/geom/segment.hpp"
+#include "loci/geom/segment_intersection.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/detail/y_bands.hpp"
 #include "loci/index/query.hpp"
@@ -396,16 +413,134 @@ struct BspEdge {
   std::uint32_t polygon;
 };
 
+// The crossing of the line through s0, s1 with the line through l0, l1 (not parallel), with a
+// bound on its distance from the exact crossing: a shared end point exactly, else in floating
+// point, within 2e-15 of the magnitudes (the orientations that place it along a line are
+// evaluated in double-double, so that nearly parallel lines do not lose it), else, for lines
+// parallel to some 1e-16, in rationals and rounded.
+inline std::pair<Point2, double> bsp_crossing(const Point2& s0, const Point2& s1, const Point2& l0,
+                                              const Point2& l1) {
+  if (s0 == l0 || s0 == l1) return {s0, 0.0};
+  if (s1 == l0 || s1 == l1) return {s1, 0.0};
+  constexpr double eps = 0x1p-53;
+  struct Pair {
+    double hi, lo;
+  };
+  const auto two_diff = [](double a, double b) {
+    const double x = a - b, bv = a - x, av = x + bv;
+    return Pair{x, (a - av) + (bv - b)};
+  };
+  const auto two_sum = [](double a, double b) {
+    const double x = a + b, bv = x - a, av = x - bv;
+    return Pair{x, (a - av) + (b - bv)};
+  };
+  // The orientation of x against u-w as hi + lo, off by at most 1e-30 m (m = |left| +
+  // |right|): the differences split exactly, the main products' rounding recovered by fma.
+  struct Det {
+    double hi, lo, m;
+  };
+  const auto det = [&](const Point2& u, const Point2& w, const Point2& x) {
+    const Pair dx = two_diff(w[0], u[0]), dy = two_diff(w[1], u[1]);
+    const Pair ex = two_diff(x[0], u[0]), ey = two_diff(x[1], u[1]);
+    const double left = dx.hi * ey.hi, right = dy.hi * ex.hi;
+    const double left_lo =
+        std::fma(dx.hi, ey.hi, -left) + (dx.hi * ey.lo + dx.lo * ey.hi + dx.lo * ey.lo);
+    const double right_lo =
+        std::fma(dy.hi, ex.hi, -right) + (dy.hi * ex.lo + dy.lo * ex.hi + dy.lo * ex.lo);
+    const Pair d = two_sum(left, -right);
+    return Det{d.hi, d.lo + (left_lo - right_lo), std::fabs(left) + std::fabs(right)};
+  };
+  const double mag =
+      std::max({std::fabs(s0[0]), std::fabs(s0[1]), std::fabs(s1[0]), std::fabs(s1[1]),
+                std::fabs(l0[0]), std::fabs(l0[1]), std::fabs(l1[0]), std::fabs(l1[1])});
+  // x = a + u (b - a), u = oa / (oa - ob) for oa, ob the orientations of a, b against c-d;
+  // with the bound on the distance from the real crossing (infinite when oa - ob is not sure
+  // to be far from 0).
+  const auto along = [&](const Point2& a, const Point2& b, const Point2& c, const Point2& d) {
+    const Det oa = det(c, d, a), ob = det(c, d, b);
+    const Pair dh = two_sum(oa.hi, -ob.hi);
+    const double dlo = dh.lo + (oa.lo - ob.lo);
+    const double den = dh.hi + dlo, num = oa.hi + oa.lo;
+    const double eden = 1e-30 * (oa.m + ob.m) +
+                        2 * eps * (std::fabs(oa.lo) + std::fabs(ob.lo) + std::fabs(dh.lo)) +
+                        eps * std::fabs(den);
+    if (!(std::fabs(den) > 2 * eden))
+      return std::pair{Point2{}, std::numeric_limits<double>::infinity()};
+    const double u = num / den;
+    const double enum_ = 1e-30 * oa.m + eps * std::fabs(num);
+    const double du = (enum_ + std::fabs(u) * eden) / (std::fabs(den) - eden) + eps * std::fabs(u);
+    const Point2 e{b[0] - a[0], b[1] - a[1]};
+    const Point2 x{a[0] + u * e[0], a[1] + u * e[1]};
+    const double len = std::fabs(e[0]) + std::fabs(e[1]);
+    return std::pair{x, 1.01 * (du * len + 3 * eps * std::fabs(u) * len +
+                                eps * (std::fabs(x[0]) + std::fabs(x[1])))};
+  };
+  const auto good = [&](const std::pair<Point2, double>& r) {
+    return r.second <= 2e-15 * std::max({mag, std::fabs(r.first[0]), std::fabs(r.first[1])});
+  };
+  // (Below 1e-100 the products of differences may lose digits to underflow.)
+  if (mag > 1e-100) {
+    if (auto r = along(s0, s1, l0, l1); good(r)) return r;
+    if (auto r = along(l0, l1, s0, s1); good(r)) return r;
+  }
+  const Point2 x = crossing_point(Segment<2>{s0, s1}, Segment<2>{l0, l1});
+  return {x, 1.01 * eps * (std::fabs(x[0]) + std::fabs(x[1]))};
+}
+
+// The point of a piece of an edge l just past its start (the edge's end a, or the edge's
+// crossing with the line of edge m), towards b: the tests below are those on the real point
+// start + e (b - a) for e > 0 small enough, exact. The start, a double or a crossing, is
+// tested exactly (filtered by its rounding x, within err of it); where it lies on the line or
+// the coordinate tested, the direction of the edge decides.
+struct BspPieceStart {
+  const BspEdge& l;
+  const BspEdge* m;  // null: the start is l.a
+  Point2 x;
+  double err;
+
+  BspPieceStart(const BspEdge& edge, const BspEdge* cut) : l(edge), m(cut), x(edge.a), err(0) {
+    if (m) std::tie(x, err) = bsp_crossing(l.a, l.b, m->a, m->b);
+  }
+  // The sign of orientation(p, q, point).
+  int orient(const Point2& p, const Point2& q) const {
+    const double dx = q[0] - p[0], dy = q[1] - p[1];
+    const double left = dx * (x[1] - p[1]), right = dy * (x[0] - p[0]);
+    const double det = left - right;
+    const double bound = 3.3306690738754716e-16 * (std::fabs(left) + std::fabs(right)) +
+                         1.01 * err * (std::fabs(dx) + std::fabs(dy));
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+    const int s =
+        sign(m ? crossing_orientation(l.a, l.b, m->a, m->b, p, q) : orientation(p, q, l.a));
+    // On the line p-q, which l crosses there (or runs along: 0): towards b.
+    return s != 0 ? s : sign(orientation(p, q, l.b));
+  }
+  // The sign of the point's coordinate on `axis` minus v.
+  int coord(int axis, double v) const {
+    if (x[axis] - v > err) return 1;
+    if (v - x[axis] > err) return -1;
+    int s = 0;
+    if (!m)
+      s = (l.a[axis] > v) - (l.a[axis] < v);
+    else if (axis == 1)  // against the line y = v
+      s = sign(crossing_orientation(l.a, l.b, m->a, m->b, Point2{0, v}, Point2{1, v}));
+    else  // against the line x = v, upwards: left of it is x < v
+      s = -sign(crossing_orientation(l.a, l.b, m->a, m->b, Point2{v, 0}, Point2{v, 1}));
+    return s != 0 ? s : (l.b[axis] > l.a[axis]) - (l.b[axis] < l.a[axis]);
+  }
+};
+
 // Whether a point of a splitter's line lies, just in front of that line, inside any of the
 // polygons but the splitter's: by crossing parity of the ray towards +x against each polygon's
-// edges (decided exactly, half-open in y), the edges bucketed in horizontal bands. A polygon
-// with the point inside one of its edges that lies on the splitter's line covers the front
-// there when that edge faces the other way (a shared border whose edges did not all cancel: a
-// duplicated polygon, an island filling a hole), and not when it faces the same way; such an
-// edge is told by its end points, exactly, the point (rounded) by its place along the line. A
-// polygon with the point on its boundary otherwise (at a vertex) leaves the answer
-// undecided, unless another polygon covers the point: the caller then tries another point of
-// the piece.
+// edges (half-open in y), the edges bucketed in horizontal bands. The point is the real point
+// of a piece of the splitter's edge just past its start (BspPieceStart), not a point rounded,
+// which may lie on the wrong side of other geometry passing within rounding of it (across a
+// thin cell between two nearly collinear edges), nor the middle of a piece too short to hold
+// a double; each test is exact. A polygon with the point inside one of its edges that lies on
+// the splitter's line covers the front there when that edge faces the other way (a shared
+// border whose edges did not all cancel: a duplicated polygon, an island filling a hole), and
+// not when it faces the same way; such an edge is told by its end points, exactly, and the
+// point's place along the line.
 class BspPointLocator {
  public:
   BspPointLocator(const std::vector<BspEdge>& edges, std::uint32_t polygons, const Box2& bounds)
@@ -420,14 +555,16 @@ class BspPointLocator {
             bounds.min[1], bounds.max[1], std::clamp<std::size_t>(edges.size() / 8, 1, 1 << 14)) {}
 
   enum class Cover { no, yes, undecided };
-  // p lies on the line of `splitter` (a, b), whose front is to the right of a -> b.
-  Cover inside_other(const Point2& p, const BspEdge& splitter) {
+  // The splitter's front is to the right of a -> b.
+  Cover inside_other(const BspEdge& splitter, const BspPieceStart& at) {
     const std::uint32_t except = splitter.polygon;
     bool any = false;
     touched_.clear();
     auto touch = [&](std::uint32_t q) {
       if (!parity_[q]) touched_.push_back(q);
     };
+    // The sign of v minus the point's coordinate on `axis`.
+    const auto above = [&](int axis, double v) { return -at.coord(axis, v); };
     // Along the splitter's line, whether a direction runs the splitter's way (its dominant
     // axis: exact signs of differences).
     const bool along_x =
@@ -436,37 +573,46 @@ class BspPointLocator {
       return along_x ? (to[0] > from[0]) == (splitter.b[0] > splitter.a[0])
                      : (to[1] > from[1]) == (splitter.b[1] > splitter.a[1]);
     };
-    // Where p lies along the splitter's line (its coordinate on the dominant axis).
+    // Where the point lies along the splitter's line (its coordinate on the dominant axis).
     const int axis = along_x ? 0 : 1;
-    for (const std::uint32_t k : bands_.at(p[1])) {
+    // The edges whose range in y may hold the point's y (once each).
+    const double y0 = at.x[1] - at.err, y1 = at.x[1] + at.err;
+    std::span<const std::uint32_t> near = bands_.at(y0, y1);
+    if (bands_.band_of(y0) != bands_.band_of(y1)) {
+      near_.assign(near.begin(), near.end());
+      std::sort(near_.begin(), near_.end());
+      near_.erase(std::unique(near_.begin(), near_.end()), near_.end());
+      near = near_;
+    }
+    for (const std::uint32_t k : near) {
       const BspEdge& e = edges_[k];
       if (e.polygon == except) continue;
       const Point2& lo = e.a[1] < e.b[1] ? e.a : e.b;
       const Point2& hi = e.a[1] < e.b[1] ? e.b : e.a;
-      if (p[1] < lo[1] || p[1] > hi[1]) continue;
-      // An edge on the splitter's line is told by its end points, exactly, and p's place along
-      // it: p, a point of the line rounded, may lie off the line by an ulp and on either side
-      // of the edge. Just in front of the line it is never crossed.
+      const int ylo = above(1, lo[1]), yhi = above(1, hi[1]);
+      if (ylo > 0 || yhi < 0) continue;
+      // An edge on the splitter's line is told by its end points, exactly, and the point's
+      // place along it. Just in front of the line it is never crossed.
       if (orientation(splitter.a, splitter.b, e.a) == Orientation::collinear &&
           orientation(splitter.a, splitter.b, e.b) == Orientation::collinear) {
-        const double u = p[axis], ua = e.a[axis], ub = e.b[axis];
-        if (u < std::min(ua, ub) || u > std::max(ua, ub)) continue;
+        const int ua = above(axis, e.a[axis]), ub = above(axis, e.b[axis]);
+        if ((ua > 0 && ub > 0) || (ua < 0 && ub < 0)) continue;
         touch(e.polygon);
         parity_[e.polygon] |= 2;  // on its boundary
         // Inside the edge, facing the other way: the polygon (on the edge's left) lies in
         // front of the splitter there.
-        if (u != ua && u != ub) parity_[e.polygon] |= forward(e.a, e.b) ? 16 : 8;
+        if (ua != 0 && ub != 0) parity_[e.polygon] |= forward(e.a, e.b) ? 16 : 8;
         continue;
       }
-      const Orientation o = orientation(lo, hi, p);
-      if (o == Orientation::collinear) {
-        if (std::min(lo[0], hi[0]) <= p[0] && p[0] <= std::max(lo[0], hi[0])) {
+      const int o = at.orient(lo, hi);
+      if (o == 0) {
+        if (above(0, std::min(lo[0], hi[0])) <= 0 && above(0, std::max(lo[0], hi[0])) >= 0) {
           touch(e.polygon);
           parity_[e.polygon] |= 2;  // on its boundary
         }
         continue;
       }
-      if (p[1] == hi[1] || o != Orientation::counterclockwise) continue;
+      if (yhi == 0 || o < 0) continue;
       touch(e.polygon);
       parity_[e.polygon] ^= 1;
       parity_[e.polygon] |= 4;  // touched
@@ -510,7 +656,7 @@ class BspPointLocator {
  private:
   const std::vector<BspEdge>& edges_;
   std::vector<std::uint8_t> parity_;
-  std::vector<std::uint32_t> touched_;
+  std::vector<std::uint32_t> touched_, near_;
   YBands bands_;
 };
 // A piece [s0, s1] of an edge (points a + s (b - a)), what is left of it inside a cell. Each
@@ -522,13 +668,44 @@ struct BspPiece {
   double s0, s1;
   std::uint32_t c0 = kOwnEnd, c1 = kOwnEnd;
 };
-// A vertex of a convex cell (counter-clockwise) and the outward normal of the cell's side
-// from it to the next vertex.
+// The lines that bound cells, each through two exact points: those of the edges (by index),
+// then the four sides of the root box (counter-clockwise from its lower side).
+struct BspLines {
+  const std::vector<BspEdge>& edges;
+  std::array<Point2, 4> corner;  // the root box's, counter-clockwise from its lower left
+  bool box(std::uint32_t i) const { return i >= edges.size(); }
+  const Point2& a(std::uint32_t i) const { return box(i) ? corner[i - edges.size()] : edges[i].a; }
+  const Point2& b(std::uint32_t i) const {
+    return box(i) ? corner[(i - edges.size() + 1) % 4] : edges[i].b;
+  }
+};
+
+// A vertex of a convex cell (counter-clockwise) and the cell's side from it to the next
+// vertex. The vertex is the crossing of the line of the side before it with that of its side
+// (BspLines); p is that crossing rounded, within err of it (0: exact).
 struct BspCellVertex {
   Point2 p;
-  Point2 n;
-  bool box;  // the side lies on the root box, not on a plane of the tree
+  double err;
+  Point2 n;            // the side's outward normal (its plane's)
+  std::uint32_t in;    // the line of the side before the vertex
+  std::uint32_t side;  // the line of the side from it
 };
+
+// The side of the line of edge li a cell vertex lies on: +1 in front (n.p > d), -1 behind, 0
+// on it, decided exactly. The rounded plane decides unless the vertex lies within its rounding
+// (the plane's, some 1e-15 of the magnitudes, and the vertex's err) of it.
+inline int bsp_vertex_side(const BspCellVertex& v, const BspLines& lines, std::uint32_t li) {
+  const BspEdge& l = lines.edges[li];
+  const double f = l.nx * v.p[0] + l.ny * v.p[1] - l.d;
+  const double bound = v.err + 1e-14 * (std::fabs(v.p[0]) + std::fabs(v.p[1]) + std::fabs(l.a[0]) +
+                                        std::fabs(l.a[1]));
+  if (f > bound) return 1;
+  if (f < -bound) return -1;
+  // Front is to the right of a -> b.
+  if (v.err == 0) return -sign(orientation(l.a, l.b, v.p));
+  return -sign(detail::crossing_orientation_exact(lines.a(v.in), lines.b(v.in), lines.a(v.side),
+                                                  lines.b(v.side), l.a, l.b));
+}
 
 inline double bsp_signed_area(const std::vector<Point2>& r) {
   double a = 0;
@@ -555,31 +732,65 @@ inline std::vector<Point2> bsp_ring(const std::vector<Point2>& in, bool ccw,
   if (r.size() < 3) throw InvalidGeometry(what + " has fewer than three distinct vertices");
   const double area = bsp_signed_area(r);
   if (!(area != 0)) throw InvalidGeometry(what + " has no area");
-  if ((area > 0) != ccw) std::reverse(r.begin(), r.end());
+  // The sign of the rounded area, unless rounding may have decided it (a sliver, such as three
+  // nearly collinear points): then the turn at the lowest of the leftmost vertices, exactly.
+  double mag = 0;
+  for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+    const Point2& p = r[i];
+    const Point2& q = r[(i + 1) % n];
+    mag += std::fabs(p[0] * q[1]) + std::fabs(q[0] * p[1]);
+  }
+  bool counterclockwise = area > 0;
+  if (std::fabs(area) <= static_cast<double>(r.size() + 2) * 1.2e-16 * mag) {
+    const auto low = static_cast<std::size_t>(
+        std::min_element(r.begin(), r.end(),
+                         [](const Point2& p, const Point2& q) {
+                           return p[0] < q[0] || (p[0] == q[0] && p[1] < q[1]);
+                         }) -
+        r.begin());
+    const int turn =
+        sign(orientation(r[(low + r.size() - 1) % r.size()], r[low], r[(low + 1) % r.size()]));
+    if (turn != 0) counterclockwise = turn > 0;
+  }
+  if (counterclockwise != ccw) std::reverse(r.begin(), r.end());
   return r;
 }
 
-// The part of a convex cell where s (n.p - d) <= 0, its new side facing s n.
-inline std::vector<BspCellVertex> bsp_clip_cell(const std::vector<BspCellVertex>& cell, double nx,
-                                                double ny, double d, double s) {
+// The part of a convex cell behind the line of edge l (s = 1) or in front of it (s = -1), its
+// new side on that line facing s n. Which vertices lie on which side is decided exactly
+// (bsp_vertex_side), so that nearly opposite lines (the edges of a thin spike meeting at a
+// vertex) leave the cell they bound, however thin, rather than rounding it away or moving its
+// corners along the lines; each new corner is the crossing of a side's line with l, computed
+// to within 2e-15 of the magnitudes (bsp_crossing), not from corners computed before.
+inline std::vector<BspCellVertex> bsp_clip_cell(const std::vector<BspCellVertex>& cell,
+                                                const BspLines& lines, std::uint32_t li, int s) {
   std::vector<BspCellVertex> out;
   const std::size_t m = cell.size();
   if (m == 0) return out;
   out.reserve(m + 1);
-  const Point2 side{s * nx, s * ny};
-  auto f = [&](const Point2& p) { return s * (nx * p[0] + ny * p[1] - d); };
+  const BspEdge& l = lines.edges[li];
+  const Point2 side{s * l.nx, s * l.ny};
+  // The side of each vertex (s times bsp_vertex_side: > 0 clipped away), of P and of Q.
+  const int first = s * bsp_vertex_side(cell[0], lines, li);
+  int wq = first;
   for (std::size_t i = 0; i < m; ++i) {
     const BspCellVertex& P = cell[i];
-    const BspCellVertex& Q = cell[(i + 1) % m];
-    const double fp = f(P.p), fq = f(Q.p);
-    if (fp <= 0) out.push_back(P);
-    if ((fp <= 0) != (fq <= 0)) {
-      const double u = fp / (fp - fq);
-      const Point2 x{P.p[0] + u * (Q.p[0] - P.p[0]), P.p[1] + u * (Q.p[1] - P.p[1])};
-      if (fp <= 0)
-        out.push_back({x, side, false});  // leaving: the new side starts here
-      else
-        out.push_back({x, P.n, P.box});  // entering: the rest of side P-Q
+    const int wp = wq;
+    wq = i + 1 < m ? s * bsp_vertex_side(cell[i + 1], lines, li) : first;
+    if (wp <= 0) {
+      out.push_back(P);
+      // Leaving from a vertex on the line: its side is the line from here.
+      if (wp == 0 && wq > 0) {
+        out.back().n = side;
+        out.back().side = li;
+      }
+    }
+    if (wp * wq < 0) {
+      const auto [x, err] = bsp_crossing(lines.a(P.side), lines.b(P.side), l.a, l.b);
+      if (wp < 0)  // leaving: the new side starts here
+        out.push_back({x, err, side, P.side, li});
+      else  // entering: the rest of side P-Q
+        out.push_back({x, err, P.n, li, P.side});
     }
   }
   if (out.size() < 3) out.clear();
@@ -668,10 +879,15 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
       std::max(bounds.max[0] - bounds.min[0], bounds.max[1] - bounds.min[1]) + 1.0;
   const double x0 = bounds.min[0] - margin, x1 = bounds.max[0] + margin;
   const double y0 = bounds.min[1] - margin, y1 = bounds.max[1] + margin;
-  std::vector<BspCellVertex> root_cell{{{x0, y0}, {0, -1}, true},
-                                       {{x1, y0}, {1, 0}, true},
-                                       {{x1, y1}, {0, 1}, true},
-                                       {{x0, y1}, {-1, 0}, true}};
+  const detail::BspLines lines{edges,
+                               {Point2{x0, y0}, Point2{x1, y0}, Point2{x1, y1}, Point2{x0, y1}}};
+  std::vector<BspCellVertex> root_cell;
+  {
+    const std::array<Point2, 4> normal{Point2{0, -1}, Point2{1, 0}, Point2{0, 1}, Point2{-1, 0}};
+    const auto box = static_cast<std::uint32_t>(edges.size());
+    for (std::uint32_t i = 0; i < 4; ++i)
+      root_cell.push_back({lines.corner[i], 0.0, normal[i], box + (i + 3) % 4, box + i});
+  }
 
   // Side of a piece against the line of edge l: +1 behind (solid side), -1 in front, decided
   // on the original end points by the exact orientation predicate.
@@ -720,9 +936,12 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
     for (std::size_t i = 0; i < m; ++i) {
       const BspCellVertex& prev = cell[(i + m - 1) % m];
       const BspCellVertex& cur = cell[i];
-      if (prev.box || cur.box) continue;
+      if (lines.box(prev.side) || lines.box(cur.side)) continue;
       const Point2 a = prev.n, b = cur.n;
-      const double turn = std::atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1]);
+      // The cell is convex: the normals turn counter-clockwise by less than pi at each corner
+      // (a turn near pi, at the tip of a spike, may round to either sign of the cross product).
+      const double turn =
+          std::atan2(std::fabs(a[0] * b[1] - a[1] * b[0]), a[0] * b[0] + a[1] * b[1]);
       if (!(turn > alpha)) continue;
       const int parts = static_cast<int>(std::ceil(turn / alpha * (1 - 1e-12)));
       const double start = std::atan2(a[1], a[0]);
@@ -781,8 +1000,6 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
     const BspPiece splitter = pieces[best];
     const std::uint32_t li = splitter.edge;
     const BspEdge& l = edges[li];
-    const double mid = (splitter.s0 + splitter.s1) / 2;
-    const Point2 piece_mid{l.a[0] + mid * (l.b[0] - l.a[0]), l.a[1] + mid * (l.b[1] - l.a[1])};
 
     std::vector<BspPiece> back, front;
     for (const BspPiece& q : pieces) {
@@ -824,20 +1041,19 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
     const auto k = static_cast<std::int32_t>(tree.nodes_.size());
     tree.nodes_.push_back({l.nx, l.ny, l.d, kEmpty, kEmpty});
     set_child(w.parent, w.front, k);
-    std::vector<BspCellVertex> back_cell = detail::bsp_clip_cell(w.cell, l.nx, l.ny, l.d, 1);
-    std::vector<BspCellVertex> front_cell = detail::bsp_clip_cell(w.cell, l.nx, l.ny, l.d, -1);
+    std::vector<BspCellVertex> back_cell = detail::bsp_clip_cell(w.cell, lines, li, 1);
+    std::vector<BspCellVertex> front_cell = detail::bsp_clip_cell(w.cell, lines, li, -1);
     if (front.empty()) {
-      // Empty unless another polygon covers the splitter's piece. A front cell of no thickness
-      // (the splitter on the cell's own border, a shared border seen from the other side; its
-      // corners off the line by the rounding of the clipping only) stays empty, so that it
-      // claims no point of the line beyond the polygons.
-      double thickness = 0, scale = 0;
-      for (const detail::BspCellVertex& v : front_cell) {
-        thickness = std::max(thickness, l.nx * v.p[0] + l.ny * v.p[1] - l.d);
+      // Empty unless another polygon covers the splitter's piece. A front cell of no area (the
+      // splitter on the cell's own border, a shared border seen from the other side: clipped
+      // away exactly) stays empty, so that it claims no point of the line beyond the polygons;
+      // a thin one, however thin, is decided as any other (it may be all there is of a
+      // polygon, a sliver between two nearly collinear edges).
+      double scale = 0;
+      for (const detail::BspCellVertex& v : front_cell)
         scale = std::max({scale, std::abs(v.p[0]), std::abs(v.p[1])});
-      }
       bool covered = false;
-      if (thickness > 1e-12 * scale) {
+      if (!front_cell.empty()) {
         using Cover = detail::BspPointLocator::Cover;
         // Where the cell has room, a point well inside it decides, located against all the
         // polygons: the mean of its corners, if it lies inside every side by 1e-12 of the
@@ -853,18 +1069,12 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
         for (const detail::BspCellVertex& v : front_cell)
           inside = std::min(inside, v.n[0] * (v.p[0] - centre[0]) + v.n[1] * (v.p[1] - centre[1]));
         if (inside > 1e-12 * scale) c = locator.inside_any(centre);
-        // Else the piece's middle; where it lies on another polygon's vertex, points of the
-        // piece at golden-ratio fractions (still undecided: not covered).
-        if (c == Cover::undecided) c = locator.inside_other(piece_mid, l);
-        const double s0 = splitter.s0, s1 = splitter.s1;
-        // (A piece too short for its fractions to fall apart: no other point of it is tried.)
-        for (const double f : {0.3819660112501051, 0.6180339887498949, 0.2360679774997897,
-                               0.7639320225002103, 0.1458980337503155, 0.8541019662496845}) {
-          if (c != Cover::undecided || !(s1 - s0 > 1e-9)) break;
-          const double u = s0 + f * (s1 - s0);
-          c = locator.inside_other({l.a[0] + u * (l.b[0] - l.a[0]), l.a[1] + u * (l.b[1] - l.a[1])},
-                                   l);
-        }
+        // Else the piece: the real point of it just past its start (not a point rounded,
+        // which may fall outside a thin cell; BspPieceStart), exactly.
+        if (c == Cover::undecided)
+          c = locator.inside_other(
+              l, detail::BspPieceStart(
+                     l, splitter.c0 == BspPiece::kOwnEnd ? nullptr : &edges[splitter.c0]));
         covered = c == Cover::yes;
       }
       std::int32_t leaf = kEmpty;

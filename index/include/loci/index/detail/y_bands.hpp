@@ -47,6 +47,15 @@ class YBands {
     return {items_.data() + start_[b], items_.data() + start_[b + 1]};
   }
 
+  // The items whose range may meet [lo, hi], lo <= hi: the listings of the bands from lo's to
+  // hi's, in which an item spanning several of them appears in each.
+  std::span<const std::uint32_t> at(double lo, double hi) const {
+    if (start_.size() < 2) return {};
+    return {items_.data() + start_[band(lo)], items_.data() + start_[band(hi) + 1]};
+  }
+  // The band holding y.
+  std::size_t band_of(double y) const { return start_.size() < 2 ? 0 : band(y); }
+
   std::size_t memory_bytes() const {
     return (start_.capacity() + items_.capacity()) * sizeof(std::uint32_t);
   }
