@@ -477,14 +477,6 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
   // by the parity of the ring edges its rightward ray crosses, each decided exactly. An edge
   // on p or crossing that ray meets p's row at or right of p, so it is listed in a cell of the
   // rows m's y +- hair falls in, from m's x - hair rightwards.
-  std::vector<std::uint32_t> near;
-  for (std::uint32_t r = row(m[1] - hair), r1 = row(m[1] + hair); r <= r1; ++r) {
-    const std::size_t row_start = std::size_t(r) * nx_;
-    near.insert(near.end(), cell_edges_.begin() + cell_start_[row_start + col(m[0] - hair)],
-                cell_edges_.begin() + cell_start_[row_start + nx_]);
-  }
-  std::sort(near.begin(), near.end());
-  near.erase(std::unique(near.begin(), near.end()), near.end());
   const std::vector<Point2>& pts = g_->points;
   // The sign of v minus p's coordinate on `axis`, exactly; the rounded point decides when v
   // lies farther from it than the rounding.
@@ -494,25 +486,56 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
     return -compare_coordinate_at(s, t, axis, v);
   };
   bool odd = false;
-  for (const std::uint32_t k : near) {
+  // Whether p lies on edge k (then true), else its effect on the parity.
+  auto on_edge = [&](std::uint32_t k) {
     const Edge& e = edges_[k];
     const Point2& a = pts[e.first];
-    if (e.kind == kPoint) {
-      if (above(0, a[0]) == 0 && above(1, a[1]) == 0) return Location::boundary;
-      continue;
-    }
+    if (e.kind == kPoint) return above(0, a[0]) == 0 && above(1, a[1]) == 0;
     const Point2& b = pts[e.first + 1];
     const int ya = above(1, a[1]), yb = above(1, b[1]);
-    if ((ya > 0 && yb > 0) || (ya < 0 && yb < 0)) continue;  // wholly above or below p
+    if ((ya > 0 && yb > 0) || (ya < 0 && yb < 0)) return false;  // wholly above or below p
     const int x0 = above(0, std::min(a[0], b[0])), x1 = above(0, std::max(a[0], b[0]));
-    if (x1 < 0) continue;  // wholly left of p
+    if (x1 < 0) return false;  // wholly left of p
     const Orientation o = orientation_at(a, b, s, t);
-    if (o == Orientation::collinear && x0 <= 0) return Location::boundary;
+    if (o == Orientation::collinear && x0 <= 0) return true;
     // Half-open in y, as ray_crosses: the crossing is right of p when p is left of the edge
     // directed upwards.
     if (e.kind == kRing && (ya > 0) != (yb > 0))
       odd ^= o == (a[1] < b[1] ? Orientation::counterclockwise : Orientation::clockwise);
+    return false;
+  };
+  const std::uint32_t r0 = row(m[1] - hair), r1 = row(m[1] + hair);
+  const std::uint32_t c0 = col(m[0] - hair), c1 = col(m[0] + hair);
+  if (r0 == r1 && c0 == c1) {
+    // p lies in m's cell: as locate, the edges right of it by their end values at most p's y
+    // (those within rounding of m's y compared exactly), the cell's own edges each exactly.
+    const std::size_t cell = std::size_t(r0) * nx_ + c0;
+    const double* v0 = values_.data() + value_start_[cell];
+    const double* v1 = values_.data() + value_start_[cell + 1];
+    const double* v = std::lower_bound(v0, v1, m[1] - hair);
+    std::size_t at_most = v - v0;
+    for (; v != v1 && *v <= m[1] + hair; ++v)
+      at_most += above(1, *v) <= 0;
+    odd = (base_[cell] ^ at_most) & 1;
+    for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i)
+      if (on_edge(cell_edges_[i])) return Location::boundary;
+    return odd ? Location::inside : Location::outside;
   }
+  // Else every edge listed in those rows from c0 rightwards.
+  for (std::uint32_t r = r0; r <= r1; ++r)
+    for (std::uint32_t c = c0; c < nx_; ++c) {
+      const std::size_t cell = std::size_t(r) * nx_ + c;
+      for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
+        const Edge& e = edges_[cell_edges_[i]];
+        const Point2& a = pts[e.first];
+        const Point2& b = e.kind == kPoint ? a : pts[e.first + 1];
+        // Each edge once: in the first of the cells scanned that lists it.
+        if (std::max(row(std::min(a[1], b[1])), r0) != r ||
+            std::max(col(std::min(a[0], b[0])), c0) != c)
+          continue;
+        if (on_edge(cell_edges_[i])) return Location::boundary;
+      }
+    }
   return odd ? Location::inside : Location::outside;
 }
 

@@ -188,6 +188,44 @@ TEST(Orientation, CrossingMatchesExact) {
   EXPECT_GT(on, 100);
 }
 
+TEST(Segment, TestsOnPointAtMatchExact) {
+  // compare_coordinate_at and orientation_at on s.a + t (s.b - s.a) against rationals; on a
+  // small grid, where the segment often runs along the line a-b or has an end on it, or has
+  // both ends at v (each decided without rationals), and on random doubles with a-b through
+  // the rounded point.
+  const auto at = [](const Segment2& s, double t, int axis) -> mpq_class {
+    return mpq_class(s.a[axis]) + mpq_class(t) * (mpq_class(s.b[axis]) - s.a[axis]);
+  };
+  std::mt19937_64 rng(23);
+  std::uniform_int_distribution<int> g(0, 4);
+  std::uniform_real_distribution<double> u(-1, 1), ut(0, 1);
+  const auto grid = [&] { return Point2{double(g(rng)), double(g(rng))}; };
+  int along = 0, end_on = 0, flat = 0;
+  for (int i = 0; i < 40000; ++i) {
+    const bool on_grid = i % 2 == 0;
+    const Segment2 s = on_grid ? Segment2{grid(), grid()} : Segment2{{u(rng), u(rng)}, {u(rng), u(rng)}};
+    const double t = i % 7 == 0 ? double(i % 3) / 2 : ut(rng);
+    const Point2 m = point_at(s, t);
+    const Point2 a = on_grid ? grid() : Point2{u(rng), u(rng)};
+    const Point2 b = on_grid ? grid() : m;
+    const mpq_class px = at(s, t, 0), py = at(s, t, 1);
+    const mpq_class det = (mpq_class(b[0]) - a[0]) * (py - a[1]) - (mpq_class(b[1]) - a[1]) * (px - a[0]);
+    const int want = sgn(det);
+    const Orientation oa = orientation(a, b, s.a), ob = orientation(a, b, s.b);
+    along += oa == Orientation::collinear && ob == Orientation::collinear;
+    end_on += (oa == Orientation::collinear) != (ob == Orientation::collinear);
+    ASSERT_EQ(sign(orientation_at(a, b, s, t)), want) << i;
+    for (int axis = 0; axis < 2; ++axis) {
+      const double v = on_grid ? double(g(rng)) : m[axis];
+      flat += s.a[axis] == v && s.b[axis] == v;
+      ASSERT_EQ(compare_coordinate_at(s, t, axis, v), cmp(at(s, t, axis), v) > 0 ? 1 : cmp(at(s, t, axis), v) < 0 ? -1 : 0) << i;
+    }
+  }
+  EXPECT_GT(along, 500);
+  EXPECT_GT(end_on, 2000);
+  EXPECT_GT(flat, 500);
+}
+
 TEST(Segment, BoxIntersectionIsExact2D) {
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> u(0, 10);

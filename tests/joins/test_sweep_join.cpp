@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -78,6 +79,41 @@ TEST(SweepJoinEdges, TouchingCountsAndNegativeCoordinatesSort) {
   Pairs got;
   self_join(boxes, [&](Id i, Id j) { return got.push_back({i, j}), true; });
   EXPECT_EQ(sorted(got), (Pairs{{0, 1}, {1, 2}, {3, 4}}));
+}
+
+// Linework along one axis: the segments of a north-south line all share one x, so a sweep
+// along x compares every pair; the sweep runs along the axis where the boxes overlap less.
+// Wide flat boxes and tall thin ones, against brute force, with the pairs scanned counted.
+TEST(SweepJoinEdges, SweepsAlongTheAxisOfLessOverlap) {
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> u(0, 100);
+  for (const int axis : {0, 1}) {
+    const auto box = [&](double along, double across, double length, double width) {
+      Box<2> b{{along, across}, {along + length, across + width}};
+      if (axis == 1) {
+        std::swap(b.min[0], b.min[1]);
+        std::swap(b.max[0], b.max[1]);
+      }
+      return b;
+    };
+    // A line of 4,000 segments at one coordinate across, and a second one crossing it.
+    std::vector<Box<2>> line, other;
+    for (int k = 0; k < 4000; ++k)
+      line.push_back(box(k * 0.025, 50, 0.025, 0));
+    for (int k = 0; k < 3000; ++k)
+      other.push_back(box(u(rng), u(rng), 0.5, 0.01));
+    Pairs got;
+    const QueryStats s = self_join(line, [&](Id i, Id j) { return got.push_back({i, j}), true; });
+    EXPECT_EQ(sorted(got), brute_self_pairs(line)) << axis;
+    EXPECT_LT(s.entries_tested, 3 * line.size()) << axis;
+    got.clear();
+    const QueryStats t = join(line, other, [&](Id i, Id j) { return got.push_back({i, j}), true; });
+    EXPECT_EQ(sorted(got), brute_join_pairs(line, other)) << axis;
+    EXPECT_LT(t.entries_tested, 60 * (line.size() + other.size())) << axis;
+    got.clear();
+    join(other, other, [&](Id i, Id j) { return got.push_back({i, j}), true; });
+    EXPECT_EQ(sorted(got), brute_join_pairs(other, other)) << axis;
+  }
 }
 
 }  // namespace

@@ -77,6 +77,18 @@ void expect_same(const FlatGeometry& g, std::mt19937_64& rng, double lo, double 
     check(v);
     check({v[0] + 0.5, v[1]});
   }
+  // locate_at on segments between lattice points at sixteenths, where point_at is exact and
+  // often falls on edges and vertices (its exact path) or on the cells' borders.
+  std::uniform_int_distribution<int> grid_at{int(lo), int(hi)}, sixteenth(1, 15);
+  for (int k = 0; k < 3000; ++k) {
+    const Segment2 s{{double(grid_at(rng)), double(grid_at(rng))},
+                     {double(grid_at(rng)), double(grid_at(rng))}};
+    const double t = sixteenth(rng) / 16.0;
+    const Location want = brute(g, point_at(s, t));
+    ++counts[int(want)];
+    ASSERT_EQ(prepared.locate_at(s, t), want) << what << " at " << t << " of " << s.a[0] << ","
+                                              << s.a[1] << " " << s.b[0] << "," << s.b[1];
+  }
   if (g.polygons > 0) {
     EXPECT_GT(counts[int(Location::inside)], 0u) << what;
     EXPECT_GT(counts[int(Location::boundary)], 0u) << what;
@@ -171,6 +183,110 @@ TEST(PreparedGeometry, FlatEnvelopesWithFewEdges) {
     EXPECT_GT(counts[int(Location::boundary)], 0u);
     EXPECT_GT(counts[int(Location::outside)], 0u);
     if (g->polygons > 0) EXPECT_GT(counts[int(Location::inside)], 0u);
+  }
+}
+
+TEST(PreparedGeometry, LocateAtAHairFromEdges) {
+  // Rings with integer vertices moved by up to two units in the last place, and exact points
+  // (sixteenths along segments between lattice points) on the lattice's lines: such a point
+  // lies within rounding of the moved edges but rarely on them, so that locate_at decides it by
+  // its exact tests (in its cell or along its rows), not by a boundary.
+  std::mt19937_64 rng(39);
+  std::uniform_int_distribution<int> ulps(-2, 2), sixteenth(1, 15);
+  const auto nudge = [&](double v) {
+    for (int k = ulps(rng); k != 0; k += k > 0 ? -1 : 1)
+      v = std::nextafter(v, k > 0 ? 1e300 : -1e300);
+    return v;
+  };
+  std::size_t counts[3] = {0, 0, 0};
+  for (int trial = 0; trial < 8; ++trial) {
+    FlatGeometry g;
+    for (int k = 0; k < 1 + trial % 3; ++k) {
+      const Point2 c{double(20 + 25 * k), double(20 + 10 * (k % 2))};
+      for (const double r : {18.0, 5.0}) {
+        std::vector<Point2> ring = star(rng, c, r, 8 + 8 * (trial % 4));
+        for (Point2& v : ring)
+          v = {nudge(v[0]), nudge(v[1])};
+        add_ring(g, ring, std::uint32_t(k));
+      }
+    }
+    g.polygons = std::uint32_t(1 + trial % 3);
+    const PreparedGeometry prepared(g);
+    std::uniform_int_distribution<int> grid_at{0, 80};
+    for (int k = 0; k < 20000; ++k) {
+      // Along a row or a column of the lattice, or slanted.
+      const Point2 a{double(grid_at(rng)), double(grid_at(rng))};
+      const Point2 b = k % 3 == 0   ? Point2{double(grid_at(rng)), a[1]}
+                       : k % 3 == 1 ? Point2{a[0], double(grid_at(rng))}
+                                    : Point2{double(grid_at(rng)), double(grid_at(rng))};
+      const Segment2 s{a, b};
+      const double t = sixteenth(rng) / 16.0;
+      const Point2 p = point_at(s, t);
+      if (!prepared.near_boundary(p, point_at_rounding(s))) continue;
+      const Location want = brute(g, p);
+      ++counts[int(want)];
+      ASSERT_EQ(prepared.locate_at(s, t), want)
+          << trial << " at " << t << " of " << a[0] << "," << a[1] << " " << b[0] << "," << b[1];
+    }
+  }
+  EXPECT_GT(counts[int(Location::inside)], 200u);
+  EXPECT_GT(counts[int(Location::outside)], 200u);
+}
+
+TEST(PreparedGeometry, CoversAlongLongCollinearLines) {
+  // A line of 100,000 collinear edges (horizontal, then vertical) and a polygon whose side is
+  // made of them: b lying along that linework is cut into pieces at a's vertices, each located
+  // at its middle within rounding of the edges, which the grid answers from the middle's cell
+  // (scanning the whole row to its right for each made this quadratic: minutes).
+  constexpr int n = 100000;
+  for (const int axis : {0, 1}) {
+    const auto at = [&](double along, double across) {
+      return axis == 0 ? Point2{along, across} : Point2{across, along};
+    };
+    FlatGeometry line;
+    for (int k = 0; k <= n; ++k)
+      line.points.push_back(at(k, 0.7));
+    line.parts.push_back({0, std::uint32_t(line.points.size()), PartKind::line, 0});
+    // b: a line with a vertex between each two of a's, then one leaving the line by an ulp.
+    FlatGeometry on, off;
+    for (int k = 0; k < n; ++k)
+      on.points.push_back(at(k + 0.5, 0.7));
+    off.points = {at(0.5, 0.7), at(n - 0.5, std::nextafter(0.7, 1.0))};
+    on.parts.push_back({0, std::uint32_t(on.points.size()), PartKind::line, 0});
+    off.parts.push_back({0, 2, PartKind::line, 0});
+    const PreparedGeometry pl(line), pon(on), poff(off);
+    EXPECT_TRUE(covers(pl, pon)) << axis;
+    EXPECT_FALSE(covers(pl, poff)) << axis;
+    // A polygon with that linework as a side, and a triangle on it.
+    FlatGeometry square = line, triangle;
+    square.parts.clear();
+    square.points.push_back(at(n, n));
+    square.points.push_back(at(0, n));
+    square.points.push_back(at(0, 0.7));
+    square.parts.push_back({0, std::uint32_t(square.points.size()), PartKind::ring, 0});
+    square.polygons = 1;
+    add_ring(triangle, {at(0.5, 0.7), at(n - 0.5, 0.7), at(n / 2.0, 9)}, 0);
+    triangle.polygons = 1;
+    EXPECT_TRUE(covers(PreparedGeometry(square), PreparedGeometry(triangle))) << axis;
+    // A polygon whose side zigzags between that side and an ulp inside: the middle of each of
+    // its edges lies a hair inside a, within rounding of a's side.
+    FlatGeometry zigzag;
+    std::vector<Point2> ring;
+    for (int k = 0; k < n; ++k)
+      ring.push_back(at(k + 0.5, k % 2 ? std::nextafter(0.7, 1.0) : 0.7));
+    ring.push_back(at(n / 2.0, 9));
+    add_ring(zigzag, ring, 0);
+    zigzag.polygons = 1;
+    EXPECT_TRUE(covers(PreparedGeometry(square), PreparedGeometry(zigzag))) << axis;
+    ring[1] = at(1.5, std::nextafter(0.7, 0.0));
+    FlatGeometry out;
+    add_ring(out, ring, 0);
+    out.polygons = 1;
+    EXPECT_FALSE(covers(PreparedGeometry(square), PreparedGeometry(out))) << axis;
+    FlatGeometry below;
+    add_ring(below, {at(0.5, 0.7), at(n / 2.0, -9), at(n - 0.5, 0.7)}, 0);
+    below.polygons = 1;
+    EXPECT_FALSE(covers(PreparedGeometry(square), PreparedGeometry(below))) << axis;
   }
 }
 
