@@ -731,9 +731,10 @@ inline std::vector<Point2> bsp_ring(const std::vector<Point2>& in, bool ccw,
     r.pop_back();
   if (r.size() < 3) throw InvalidGeometry(what + " has fewer than three distinct vertices");
   const double area = bsp_signed_area(r);
-  if (!(area != 0)) throw InvalidGeometry(what + " has no area");
+  if (std::isnan(area)) throw InvalidGeometry(what + " has no area");
   // The sign of the rounded area, unless rounding may have decided it (a sliver, such as three
-  // nearly collinear points): then the turn at the lowest of the leftmost vertices, exactly.
+  // nearly collinear points, whose area may even round to 0): then the turn at the lowest of
+  // the leftmost vertices, exactly; a ring with neither has no area.
   double mag = 0;
   for (std::size_t i = 0, n = r.size(); i < n; ++i) {
     const Point2& p = r[i];
@@ -750,7 +751,10 @@ inline std::vector<Point2> bsp_ring(const std::vector<Point2>& in, bool ccw,
         r.begin());
     const int turn =
         sign(orientation(r[(low + r.size() - 1) % r.size()], r[low], r[(low + 1) % r.size()]));
-    if (turn != 0) counterclockwise = turn > 0;
+    if (turn != 0)
+      counterclockwise = turn > 0;
+    else if (area == 0)
+      throw InvalidGeometry(what + " has no area");
   }
   if (counterclockwise != ccw) std::reverse(r.begin(), r.end());
   return r;
