@@ -462,6 +462,50 @@ TEST(BspTree, SliverTrianglesOfScaledCollinearPoints) {
     EXPECT_TRUE(tree.overlaps({i * 0.5 * 0.37, (12 - i * 0.5) * 0.37}, BspCircle{0.0037})) << i;
 }
 
+// A layer scaled by a power of two is the same layer: its tree answers alike at the scaled
+// points, down to coordinates near 1e-301, where areas underflow to 0 (such layers were
+// refused as having no area) and products of differences lose digits.
+TEST(BspTree, LayersScaledTowardsUnderflowAnswerAlike) {
+  int compared = 0;
+  for (std::uint64_t seed = 1; seed < 60; ++seed) {
+    std::mt19937_64 rng(seed);
+    const auto pick = [&](int lo, int hi) {
+      return std::uniform_int_distribution<int>(lo, hi)(rng);
+    };
+    std::vector<BspPolygon> polys;
+    const int n = pick(1, 6);
+    while (static_cast<int>(polys.size()) < n) {
+      std::vector<Point2> t;
+      for (int i = 0; i < 3; ++i)
+        t.push_back({pick(0, 10) * 0.1, pick(0, 10) * 0.1});
+      if (orientation(t[0], t[1], t[2]) == Orientation::collinear) continue;
+      polys.push_back({std::move(t), {}});
+    }
+    const BspTree base = BspTree::build(polys);
+    for (const int e : {-660, -1000}) {
+      const auto scaled = [e](const Point2& p) {
+        return Point2{std::ldexp(p[0], e), std::ldexp(p[1], e)};
+      };
+      std::vector<BspPolygon> small = polys;
+      for (BspPolygon& p : small)
+        for (Point2& v : p.outer)
+          v = scaled(v);
+      const BspTree tree = BspTree::build(small);
+      tree.validate();
+      for (int xi = -1; xi <= 21; ++xi)
+        for (int yi = -1; yi <= 21; ++yi) {
+          const Point2 p{xi * 0.05, yi * 0.05};
+          ++compared;
+          ASSERT_EQ(tree.solid(scaled(p)), base.solid(p)) << seed << " 2^" << e;
+          ASSERT_EQ(tree.overlaps(scaled(p), BspCircle{std::ldexp(0.01, e)}),
+                    base.overlaps(p, BspCircle{0.01}))
+              << seed << " 2^" << e;
+        }
+    }
+  }
+  EXPECT_GT(compared, 50000);
+}
+
 TEST(BspTree, VerticesAndBordersCountAsSolid) {
   const auto polys = random_layer(4);
   const BspTree tree = BspTree::build(polys);
