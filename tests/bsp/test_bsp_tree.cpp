@@ -506,6 +506,39 @@ TEST(BspTree, LayersScaledTowardsUnderflowAnswerAlike) {
   EXPECT_GT(compared, 50000);
 }
 
+// The origin as a vertex of a triangle or a point of its edge: the rounding of the planes
+// there is that of the layer's coordinates, while the query and the planes' offsets are near
+// 0; one triangle in six read its vertex at the origin as not solid.
+TEST(BspTree, BoundaryPointsAtTheOrigin) {
+  std::mt19937_64 rng(43);
+  std::uniform_real_distribution<double> u(-100, 100);
+  std::uniform_int_distribution<int> g(1, 50);
+  int built = 0;
+  for (int k = 0; k < 3000; ++k) {
+    std::vector<Point2> t;
+    if (k % 2) {
+      t = {{0, 0}, {u(rng), u(rng)}, {u(rng), u(rng)}};
+    } else {  // the origin inside the edge from -m p to q p
+      const double px = g(rng), py = g(rng) - 25, m = g(rng), q = g(rng);
+      t = {{-px * m, -py * m}, {px * q, py * q}, {u(rng), u(rng)}};
+    }
+    std::rotate(t.begin(), t.begin() + k % 3, t.end());
+    if (orientation(t[0], t[1], t[2]) == Orientation::collinear) continue;
+    const std::vector<BspPolygon> polys{{t, {}}};
+    const BspTree tree = BspTree::build(polys);
+    ++built;
+    ASSERT_TRUE(tree.solid({0, 0})) << k;
+    // Just outside, by 1e-9 along the edges' outward normal at the origin's side.
+    const Point2 c{(t[0][0] + t[1][0] + t[2][0]) / 3, (t[0][1] + t[1][1] + t[2][1]) / 3};
+    const double len = std::hypot(c[0], c[1]);
+    const Point2 out{-c[0] / len * 1e-9, -c[1] / len * 1e-9};
+    if (!in_solid(polys, out) && dist_to_edges(polys, out) > 1e-10) {
+      ASSERT_FALSE(tree.solid(out)) << k;
+    }
+  }
+  EXPECT_GT(built, 2900);
+}
+
 TEST(BspTree, VerticesAndBordersCountAsSolid) {
   const auto polys = random_layer(4);
   const BspTree tree = BspTree::build(polys);

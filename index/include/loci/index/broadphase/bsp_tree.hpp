@@ -77,8 +77,9 @@
 // With the default alpha = 30 degrees that disc is 3.5% larger than R (for a circle, than
 // its radius); the paper's games used 90-95 degrees (41% and more). Arithmetic is double
 // precision: the times carry the rounding of a few operations on the coordinates, and every
-// cell is grown by 1e-14 of the magnitudes involved, so that a point of the boundary (a
-// vertex, a point of a slanted edge, whose planes are rounded) touches, as it does exactly.
+// cell is grown by 1e-14 of the magnitudes involved (the query's and the layer's), so that a
+// point of the boundary (a vertex, a point of a slanted edge, whose planes are rounded)
+// touches, as it does exactly.
 //
 // Layout: nodes in one flat array (plane and two children, 32 bytes), children encoded as
 // node indices or the two leaf codes. Built once, immutable: all queries are const and may
@@ -206,10 +207,12 @@ class BspTree {
     if (root_ == kEmpty) return out;
     const Point2 delta{to[0] - from[0], to[1] - from[1]};
     // Planes carry rounding (unit normals, bevels through computed corners): every cell is
-    // grown by 1e-14 of the magnitudes involved, so that a point on the boundary (a vertex, a
-    // point of a slanted edge) counts as touching, as it does exactly.
-    const double scale =
-        std::max({std::fabs(from[0]), std::fabs(from[1]), std::fabs(to[0]), std::fabs(to[1])});
+    // grown by 1e-14 of the magnitudes involved (the move's, the plane's offset and the
+    // layer's coordinates, whose rounding moves a plane near the origin too), so that a point
+    // on the boundary (a vertex, a point of a slanted edge) counts as touching, as it does
+    // exactly.
+    const double scale = reach_ + std::max({std::fabs(from[0]), std::fabs(from[1]),
+                                            std::fabs(to[0]), std::fabs(to[1])});
     double best = std::numeric_limits<double>::infinity();
     Point2 best_normal{};
     bool best_plane = false;
@@ -395,6 +398,7 @@ class BspTree {
     std::swap(bevels_, other.bevels_);
     std::swap(solid_leaves_, other.solid_leaves_);
     std::swap(depth_, other.depth_);
+    std::swap(reach_, other.reach_);
   }
   std::vector<Node> nodes_;
   std::int32_t root_ = kEmpty;
@@ -402,6 +406,7 @@ class BspTree {
   std::size_t bevels_ = 0;
   std::size_t solid_leaves_ = 0;
   std::size_t depth_ = 0;
+  double reach_ = 0;  // the largest magnitude of the layer's coordinates
 };
 
 namespace detail {
@@ -876,6 +881,8 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
   BspTree tree;
   tree.edges_ = edges.size();
   if (edges.empty()) return tree;
+  tree.reach_ = std::max({std::fabs(bounds.min[0]), std::fabs(bounds.min[1]),
+                          std::fabs(bounds.max[0]), std::fabs(bounds.max[1])});
   detail::BspPointLocator locator(all_edges, polygon, bounds);
 
   // The root cell: the layer's bounds with a wide margin (solid cells never reach it).
