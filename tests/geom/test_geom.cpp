@@ -203,13 +203,15 @@ TEST(Segment, TestsOnPointAtMatchExact) {
   int along = 0, end_on = 0, flat = 0;
   for (int i = 0; i < 40000; ++i) {
     const bool on_grid = i % 2 == 0;
-    const Segment2 s = on_grid ? Segment2{grid(), grid()} : Segment2{{u(rng), u(rng)}, {u(rng), u(rng)}};
+    const Segment2 s =
+        on_grid ? Segment2{grid(), grid()} : Segment2{{u(rng), u(rng)}, {u(rng), u(rng)}};
     const double t = i % 7 == 0 ? double(i % 3) / 2 : ut(rng);
     const Point2 m = point_at(s, t);
     const Point2 a = on_grid ? grid() : Point2{u(rng), u(rng)};
     const Point2 b = on_grid ? grid() : m;
     const mpq_class px = at(s, t, 0), py = at(s, t, 1);
-    const mpq_class det = (mpq_class(b[0]) - a[0]) * (py - a[1]) - (mpq_class(b[1]) - a[1]) * (px - a[0]);
+    const mpq_class det =
+        (mpq_class(b[0]) - a[0]) * (py - a[1]) - (mpq_class(b[1]) - a[1]) * (px - a[0]);
     const int want = sgn(det);
     const Orientation oa = orientation(a, b, s.a), ob = orientation(a, b, s.b);
     along += oa == Orientation::collinear && ob == Orientation::collinear;
@@ -218,7 +220,10 @@ TEST(Segment, TestsOnPointAtMatchExact) {
     for (int axis = 0; axis < 2; ++axis) {
       const double v = on_grid ? double(g(rng)) : m[axis];
       flat += s.a[axis] == v && s.b[axis] == v;
-      ASSERT_EQ(compare_coordinate_at(s, t, axis, v), cmp(at(s, t, axis), v) > 0 ? 1 : cmp(at(s, t, axis), v) < 0 ? -1 : 0) << i;
+      ASSERT_EQ(compare_coordinate_at(s, t, axis, v), cmp(at(s, t, axis), v) > 0   ? 1
+                                                      : cmp(at(s, t, axis), v) < 0 ? -1
+                                                                                   : 0)
+          << i;
     }
   }
   EXPECT_GT(along, 500);
