@@ -20,29 +20,6 @@ namespace loci::detail {
 
 namespace {
 
-struct Pair {
-  double hi, lo;  // hi + lo exactly
-};
-
-Pair two_diff(double a, double b) {
-  const double x = a - b;
-  const double bv = a - x;
-  const double av = x + bv;
-  return {x, (a - av) + (bv - b)};
-}
-
-Pair two_sum(double a, double b) {
-  const double x = a + b;
-  const double bv = x - a;
-  const double av = x - bv;
-  return {x, (a - av) + (b - bv)};
-}
-
-Pair two_product(double a, double b) {
-  const double x = a * b;
-  return {x, std::fma(a, b, -x)};
-}
-
 Orientation cgal_orientation(double ax, double ay, double bx, double by, double cx, double cy) {
   using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
   using P = Kernel::Point_2;

@@ -17,6 +17,28 @@ namespace loci {
 enum class Orientation : int { clockwise = -1, collinear = 0, counterclockwise = 1 };
 
 namespace detail {
+// Error-free transformations (Shewchuk's TwoDiff, TwoSum and TwoProduct): the rounded result
+// and its rounding error, whose sum is the exact result.
+struct Pair {
+  double hi, lo;  // hi + lo exactly
+};
+inline Pair two_diff(double a, double b) {
+  const double x = a - b;
+  const double bv = a - x;
+  const double av = x + bv;
+  return {x, (a - av) + (bv - b)};
+}
+inline Pair two_sum(double a, double b) {
+  const double x = a + b;
+  const double bv = x - a;
+  const double av = x - bv;
+  return {x, (a - av) + (b - bv)};
+}
+inline Pair two_product(double a, double b) {
+  const double x = a * b;
+  return {x, std::fma(a, b, -x)};
+}
+
 // Decided exactly; called only when the floating filter cannot decide.
 Orientation orientation_exact(double ax, double ay, double bx, double by, double cx, double cy);
 // Decided exactly in rationals; called only when the floating filter cannot decide.

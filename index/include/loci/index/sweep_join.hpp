@@ -69,10 +69,10 @@ struct SweepBoxes {
 
 // The axis to sweep along: x, unless the sweep along y would compare far fewer pairs. A box
 // compares the boxes starting within its range on the sweep axis; on a sample of the boxes
-// (an eighth, from 64 to 512 of them) that count is taken exactly per axis, by binary search
-// in the sample's sorted starts: a small fixed cost beside the sort. Linework along one axis
-// (a meridian's segments all at one x, a polygon's long straight side) makes the sweep across
-// it quadratic, and along it short.
+// (every eighth box or sparser, at most 512) that count is taken exactly per axis, by binary
+// search in the sample's sorted starts: a small fixed cost beside the sort. Linework along one
+// axis (a meridian's segments all at one x, a polygon's long straight side) makes the sweep
+// across it quadratic, and along it short.
 inline int sweep_axis(std::span<const Box<2>> a, std::span<const Box<2>> b) {
   const std::size_t n = a.size() + b.size();
   if (n < 256) return 0;

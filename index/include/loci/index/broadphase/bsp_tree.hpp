@@ -428,17 +428,6 @@ inline std::pair<Point2, double> bsp_crossing(const Point2& s0, const Point2& s1
   if (s0 == l0 || s0 == l1) return {s0, 0.0};
   if (s1 == l0 || s1 == l1) return {s1, 0.0};
   constexpr double eps = 0x1p-53;
-  struct Pair {
-    double hi, lo;
-  };
-  const auto two_diff = [](double a, double b) {
-    const double x = a - b, bv = a - x, av = x + bv;
-    return Pair{x, (a - av) + (bv - b)};
-  };
-  const auto two_sum = [](double a, double b) {
-    const double x = a + b, bv = x - a, av = x - bv;
-    return Pair{x, (a - av) + (b - bv)};
-  };
   // The orientation of x against u-w as hi + lo, off by at most 1e-30 m (m = |left| +
   // |right|): the differences split exactly, the main products' rounding recovered by fma.
   struct Det {
