@@ -261,11 +261,16 @@ LayerSummary summarize_layer(const std::string& path, const std::string& layer,
     ++s.feature_count;
     ticker.tick(double(s.feature_count));
     const OGRGeometry* g = feature->GetGeometryRef();
-    if (!g || g->IsEmpty()) {
+    if (!g) {
       ++types["(none)"];
       continue;
     }
-    ++types[OGRGeometryTypeToName(wkbFlatten(g->getGeometryType()))];
+    const std::string type = OGRGeometryTypeToName(wkbFlatten(g->getGeometryType()));
+    if (g->IsEmpty()) {  // a geometry without points (POINT EMPTY): counted apart, no extent
+      ++types[type + " (empty)"];
+      continue;
+    }
+    ++types[type];
     OGREnvelope e;
     g->getEnvelope(&e);
     s.extent.expand(Box2{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}});

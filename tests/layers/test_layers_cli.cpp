@@ -593,6 +593,24 @@ TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
   fs::remove(two + ".loci");
 }
 
+// A feature without a geometry and one whose geometry has no points are told apart, and
+// neither widens the extent.
+TEST_F(LayersCli, InfoTellsEmptyGeometriesFromMissingOnes) {
+  const std::string csv = path("empties.csv");
+  {
+    std::ofstream(csv) << "id,wkt\n1,POINT EMPTY\n2,\n3,POINT (1 2)\n4,LINESTRING EMPTY\n"
+                          "5,POINT (3 4)\n";
+  }
+  const CliRun r = run_loci("info " + csv);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("features:  5\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("geometry:  (none) x1 Line String (empty) x1 Point x2 Point (empty) x1\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("extent:    1,2,3,4\n"), std::string::npos) << r.out;
+  // A shapefile's null shapes are "(none)" on both of its paths (see test_shapefile_boxes).
+}
+
 TEST_F(LayersCli, HelpDocumentsEveryCommand) {
   const CliRun top = run_loci("--help");
   EXPECT_EQ(top.status, 0);

@@ -76,7 +76,9 @@ struct LayerSummary {
   std::string layer_name;
   std::vector<std::string> layer_names;  // every layer of the dataset
   std::int64_t feature_count = 0;
-  std::vector<std::pair<std::string, std::int64_t>> geometry_types;  // name, count
+  // GDAL's type names and counts, in name order: "(none)" counts features without a geometry,
+  // "Point (empty)" and the like geometries without points; neither widens the extent.
+  std::vector<std::pair<std::string, std::int64_t>> geometry_types;
   Box2 extent = Box2::empty();
   std::string crs;  // a short name of the layer's coordinate system, or empty
   std::vector<std::pair<std::string, std::string>> fields;  // name, type
