@@ -143,10 +143,21 @@ int run_index(const Args& a) {
   o.per = lo.per;
   o.progress = progress_bar(a, "indexing");
   const IndexReport r = index_layer(o);
-  if (!a.has("--quiet"))
-    std::fprintf(stderr, "loci: indexed %zu %s of layer '%s' into %s (%llu bytes, %.2f s)\n",
-                 r.items, r.per == Per::segment ? "segments" : "features", r.layer_name.c_str(),
-                 r.path.c_str(), static_cast<unsigned long long>(r.bytes), r.seconds);
+  if (!a.has("--quiet")) {
+    const auto count = [](std::uint64_t n, const char* noun) {
+      return std::to_string(n) + ' ' + noun + (n == 1 ? "" : "s");
+    };
+    std::string what = r.per == Per::segment
+                           ? count(r.items, "segment") + " of " + count(r.features, "feature")
+                           : count(r.items, "feature");
+    // Features without points are left out of every index: say how many, or they go unseen.
+    std::string skipped;
+    if (r.without_geometry > 0)
+      skipped = "; skipped " + count(r.without_geometry, "feature") + " without a geometry";
+    std::fprintf(stderr, "loci: indexed %s of layer '%s' into %s (%llu bytes, %.2f s)%s\n",
+                 what.c_str(), r.layer_name.c_str(), r.path.c_str(),
+                 static_cast<unsigned long long>(r.bytes), r.seconds, skipped.c_str());
+  }
   return 0;
 }
 

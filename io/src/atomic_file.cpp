@@ -258,9 +258,17 @@ void AtomicDataset::commit() {
   }
   std::sort(names.begin(), names.end());
   const fs::path target = path_;
-  const std::string main_name = target.filename().string();
-  if (std::find(names.begin(), names.end(), main_name) == names.end())
-    throw Error("cannot write " + path_ + " (the driver wrote no file of that name)");
+  std::string main_name = target.filename().string();
+  if (std::find(names.begin(), names.end(), main_name) == names.end()) {
+    // The shapefile driver writes X.shp for X.SHP: its file goes to the name asked for (the
+    // companions keep the driver's names, which readers look for in either case).
+    const auto same_but_case = std::find_if(names.begin(), names.end(), [&](const std::string& n) {
+      return n.size() == main_name.size() && EQUAL(n.c_str(), main_name.c_str());
+    });
+    if (same_but_case == names.end())
+      throw Error("cannot write " + path_ + " (the driver wrote no file of that name)");
+    main_name = *same_but_case;
+  }
   std::error_code ec;
   const fs::file_status st = fs::status(target, ec);
   const bool device = fs::is_character_file(st) || fs::is_fifo(st) || fs::is_socket(st);
@@ -286,7 +294,7 @@ void AtomicDataset::commit() {
          fs::directory_iterator(target.parent_path().empty() ? "." : target.parent_path(), ec)) {
       const std::string n = e.path().filename().string();
       const std::string x = extension_after(n, stem);
-      if (!x.empty() && shapefile_companion(x) &&
+      if (!x.empty() && shapefile_companion(x) && n != target.filename().string() &&
           std::find(names.begin(), names.end(), n) == names.end())
         fs::remove(e.path(), ec);
     }

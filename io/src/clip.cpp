@@ -33,7 +33,7 @@ bool polygonal(const OGRGeometry& g) {
 }
 
 // The window as one valid polygonal geometry: the rectangle, the WKT, or the union of the
-// window layer's polygons.
+// window layer's polygons; a rectangle of no width or height is a line or a point.
 std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o) {
   std::unique_ptr<OGRGeometry> w;
   if (!o.window_wkt.empty()) {
@@ -57,7 +57,7 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o) {
     OGRMultiPolygon all;
     for (auto& f : *wl.layer) {
       const OGRGeometry* g = f->GetGeometryRef();
-      if (!g || g->IsEmpty()) continue;
+      if (detail::without_points(g, detail::where(o.window_layer, f->GetFID()))) continue;
       if (!polygonal(*g))
         throw InvalidGeometry(detail::where(o.window_layer, f->GetFID()) +
                               " is not a polygon; a window layer holds polygons");
@@ -76,6 +76,16 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o) {
   } else {
     const Box2& b = o.window;
     check_box(b, "bbox");
+    // A window of no width or height is the segment or the point it is: as a collapsed
+    // polygon, GEOS would cut nothing from lines crossing it, which query reports.
+    if (b.min[0] == b.max[0] && b.min[1] == b.max[1])
+      return std::make_unique<OGRPoint>(b.min[0], b.min[1]);
+    if (b.min[0] == b.max[0] || b.min[1] == b.max[1]) {
+      auto line = std::make_unique<OGRLineString>();
+      line->addPoint(b.min[0], b.min[1]);
+      line->addPoint(b.max[0], b.max[1]);
+      return line;
+    }
     auto poly = std::make_unique<OGRPolygon>();
     OGRLinearRing ring;
     ring.addPoint(b.min[0], b.min[1]);
@@ -303,20 +313,38 @@ ClipResult clip_layer(const ClipOptions& options) {
     OGRLayer* layer = ds->CreateLayer(src.layer->GetName(), src.layer->GetSpatialRef(), type,
                                       csv ? const_cast<char**>(as_wkt) : nullptr);
     if (!layer) throw Error("cannot write " + options.out_path + ": " + CPLGetLastErrorMsg());
+    // Values are copied by position (`fields[i]`: the output field of source field i, -1 for
+    // none), not by name: drivers rename fields as they create them (a shapefile cuts names to
+    // ten characters, GML replaces spaces), and formats that compare names without case hold
+    // Name and NAME once; a name the output already has gets a number, as ogr2ogr does.
     const OGRFeatureDefn* defn = src.layer->GetLayerDefn();
+    const bool csv_source = std::strcmp(src.dataset->GetDriver()->GetDescription(), "CSV") == 0;
+    std::vector<int> fields(std::size_t(defn->GetFieldCount()), -1);
     for (int i = 0; i < defn->GetFieldCount(); ++i) {
       OGRFieldDefn fd(defn->GetFieldDefn(i));
-      // A CSV source shows its geometry column as a field too: the cut geometry replaces it.
-      if (csv && EQUAL(fd.GetNameRef(), "WKT")) continue;
-      if (layer->CreateField(&fd) != OGRERR_NONE)
-        throw Error("cannot write " + options.out_path + ": field " + fd.GetNameRef());
+      // A CSV source shows its geometry column as a field too: a CSV output's WKT replaces it.
+      if (csv && csv_source && EQUAL(fd.GetNameRef(), "WKT")) continue;
+      const std::string name = fd.GetNameRef();
+      std::string unique = name;
+      for (int k = 2; layer->GetLayerDefn()->GetFieldIndex(unique.c_str()) >= 0 ||
+                      (csv && EQUAL(unique.c_str(), "WKT"));
+           ++k)
+        unique = name + std::to_string(k);
+      fd.SetName(unique.c_str());
+      const int before = layer->GetLayerDefn()->GetFieldCount();
+      if (layer->CreateField(&fd) != OGRERR_NONE ||
+          layer->GetLayerDefn()->GetFieldCount() != before + 1)
+        throw Error("cannot write " + options.out_path + ": field " + name);
+      fields[std::size_t(i)] = before;
     }
     for (Piece& p : pieces) {
       std::unique_ptr<OGRGeometry> piece = std::move(p.geometry);
       if (wkbFlatten(type) != wkbUnknown)
         piece.reset(OGRGeometryFactory::forceTo(piece.release(), type));
       OGRFeature o(layer->GetLayerDefn());
-      o.SetFrom(p.feature.get());
+      if (o.SetFrom(p.feature.get(), fields.data(), TRUE) != OGRERR_NONE)
+        throw Error("cannot write " + options.out_path + ": the fields of feature " +
+                    std::to_string(p.feature->GetFID()));
       o.SetGeometryDirectly(piece.release());
       if (layer->CreateFeature(&o) != OGRERR_NONE)
         throw Error("cannot write " + options.out_path + ": feature " +

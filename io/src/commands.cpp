@@ -257,6 +257,8 @@ IndexReport index_layer(const IndexOptions& options) {
   r.layer_name = items.layer_name;
   r.per = items.per;
   r.items = items.records.size();
+  r.features = items.features;
+  r.without_geometry = items.without_geometry;
   r.bytes = Sidecar::open(r.path).info().file_size;
   r.seconds = seconds_since(t0);
   return r;

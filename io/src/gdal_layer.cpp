@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <utility>
@@ -126,7 +127,7 @@ void add_points(const OGRGeometry* g, FlatGeometry& out, const std::string& what
   const auto type = wkbFlatten(g->getGeometryType());
   if (type == wkbPoint) {
     const OGRPoint* p = g->toPoint();
-    if (p->IsEmpty()) return;
+    if (without_points(p, what)) return;
     const Point2 q{p->getX(), p->getY()};
     check_layer_point(q, what);
     const auto at = std::uint32_t(out.points.size());
@@ -147,9 +148,37 @@ void for_each_curve(const OGRGeometry* g,
   walk(linear ? linear.get() : g, polygons, f);
 }
 
+std::string geojson_crs_member(const std::string& path, const std::string& layer) {
+  const OpenLayer ol = open_layer(path, layer);
+  const OGRSpatialReference* srs = ol.layer->GetSpatialRef();
+  if (!srs) return "";
+  const char* auth = srs->GetAuthorityName(nullptr);
+  const char* code = srs->GetAuthorityCode(nullptr);
+  if (!auth || !code) return "";
+  if ((EQUAL(auth, "EPSG") && EQUAL(code, "4326")) || (EQUAL(auth, "OGC") && EQUAL(code, "CRS84")))
+    return "";
+  return std::string("\"crs\":{\"type\":\"name\",\"properties\":{\"name\":\"urn:ogc:def:crs:") +
+         auth + "::" + code + "\"}},";
+}
+
+bool without_points(const OGRGeometry* g, const std::string& what) {
+  if (!g) return true;
+  if (!g->IsEmpty()) return false;
+  const auto type = wkbFlatten(g->getGeometryType());
+  if (type == wkbPoint) {
+    const OGRPoint* p = g->toPoint();
+    if (std::isnan(p->getX()) || std::isnan(p->getY()))
+      throw InvalidGeometry(what + " has a NaN or infinite coordinate");
+  } else if (OGR_GT_IsSubClassOf(type, wkbGeometryCollection)) {
+    for (const auto* part : *g->toGeometryCollection())
+      without_points(part, what);
+  }
+  return true;
+}
+
 FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
   FlatGeometry out;
-  if (!g || g->IsEmpty()) return out;
+  if (without_points(g, what)) return out;
   const auto linear = linear_copy(g);
   if (linear) g = linear.get();
   add_points(g, out, what);

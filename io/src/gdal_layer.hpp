@@ -33,6 +33,17 @@ bool fast_random_read(GDALDataset& ds);
 // +-kMaxCoordinate (1e150), which loci's distance arithmetic cannot carry.
 void check_layer_point(const Point2& p, const std::string& what);
 
+// The "crs" member (with its trailing comma) a GeoJSON text written by hand gives coordinates
+// of the layer's system, as GDAL's GeoJSON writer names it: empty for WGS 84 longitudes and
+// latitudes (GeoJSON's own), for a layer without a system, or one without an authority code.
+std::string geojson_crs_member(const std::string& path, const std::string& layer);
+
+// Whether a feature's geometry has no points to index (none, or an empty one), to be skipped.
+// GDAL reads a point with a NaN coordinate (GeoJSON's NaN, `[NaN, 3]`) as an empty point that
+// keeps its NaN: that one is bad input, and throws InvalidGeometry naming `what` like any other
+// NaN coordinate, also inside an empty collection.
+bool without_points(const OGRGeometry* g, const std::string& what);
+
 // Calls f(curve, is_ring, polygon) for every line string and ring of g, in reading order;
 // `polygon` counts the polygons met so far (rings of one polygon share it).
 void for_each_curve(const OGRGeometry* g,

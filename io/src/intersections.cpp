@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <span>
 
+#include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/large_alloc.hpp"
 #include "loci/index/segment_intersections.hpp"
@@ -56,8 +57,8 @@ std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
 std::vector<IntersectionRow> intersection_rows(const Linework& left, const Linework* other,
                                                bool pairs_only, unsigned jobs) {
   // Each thread keeps its own rows, sorted and made unique on that thread, then merged.
-  using Rows = detail::LargeVector<IntersectionRow>;
-  const unsigned threads = detail::thread_count(jobs);
+  using Rows = loci::detail::LargeVector<IntersectionRow>;
+  const unsigned threads = loci::detail::thread_count(jobs);
   std::vector<Rows> parts(threads);
   auto add = [&parts, pairs_only](unsigned k, std::int64_t a, std::int64_t b,
                                   const SegmentIntersection& x) {
@@ -89,7 +90,7 @@ std::vector<IntersectionRow> intersection_rows(const Linework& left, const Linew
                                      };
                                    });
   }
-  detail::for_rows(threads, threads, [&](std::uint32_t k, unsigned) {
+  loci::detail::for_rows(threads, threads, [&](std::uint32_t k, unsigned) {
     std::sort(parts[k].begin(), parts[k].end());
     parts[k].erase(std::unique(parts[k].begin(), parts[k].end()), parts[k].end());
     return true;
@@ -122,7 +123,9 @@ std::size_t write_intersections(const IntersectionsOptions& o, std::FILE* fallba
                      r.p[1]);
     }
   } else {
-    std::fputs("{\"type\":\"FeatureCollection\",\"features\":[", f);
+    // The points are in the (first) layer's coordinates: a reader must know which.
+    const std::string crs = detail::geojson_crs_member(o.layer_path, o.layer_name);
+    std::fprintf(f, "{\"type\":\"FeatureCollection\",%s\"features\":[", crs.c_str());
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const auto& r = rows[k];
       std::fprintf(f, "%s\n{\"type\":\"Feature\",\"properties\":{\"fid_a\":%lld,\"fid_b\":%lld},",

@@ -52,7 +52,7 @@ std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::st
   const detail::ReadCheck read_check(path);
   for (auto& feature : *ol.layer) {
     const OGRGeometry* g = feature->GetGeometryRef();
-    if (!g || g->IsEmpty()) continue;
+    if (detail::without_points(g, where(path, feature->GetFID()))) continue;
     OGREnvelope e;
     g->getEnvelope(&e);
     const Box<2> box{{e.MinX, e.MinY}, {e.MaxX, e.MaxY}};
@@ -133,7 +133,9 @@ void read_layer_items(const std::string& path, const std::string& layer, const P
     ticker.tick(double(++seen));
     const OGRGeometry* g = feature->GetGeometryRef();
     const std::int64_t fid = feature->GetFID();
-    if (!g || g->IsEmpty()) {
+    if (detail::without_points(g, where(path, fid))) {
+      for (LayerItems* out : {by_feature, by_segment})
+        if (out) ++out->without_geometry;
       if (keep) by_feature->geometries.emplace(fid, FlatGeometry{});
       continue;
     }

@@ -384,7 +384,10 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
     const auto fid = std::int64_t(i);
     const RecordRead r = read_record(record + 8, length, file_type, path, fid);
     if (!r.ok) return false;
-    if (r.null) continue;
+    if (r.null) {
+      ++items.without_geometry;
+      continue;
+    }
     ++items.features;
     add(r, fid, record + 8, file_type);
   }

@@ -105,6 +105,49 @@ TEST_F(BadInput, NaNCoordinatesAreRefusedNamingTheFeature) {
   EXPECT_TRUE(temporaries().empty());
 }
 
+// GDAL reads a point with a NaN coordinate as an empty point that keeps the NaN (and drops it
+// from a multipoint's text): it is refused like any NaN, not skipped as an empty geometry.
+TEST_F(BadInput, NaNPointsGdalReadsAsEmptyAreRefusedToo) {
+  for (const char* geometry :
+       {R"({"type":"Point","coordinates":[NaN,3]})", R"({"type":"Point","coordinates":[3,NaN]})",
+        R"({"type":"MultiPoint","coordinates":[[1,1],[NaN,3]]})",
+        R"({"type":"GeometryCollection","geometries":[{"type":"Point","coordinates":[NaN,3]}]})"}) {
+    const std::string l =
+        write("nanpoint.geojson", std::string(R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1,1]}},
+{"type":"Feature","properties":{},"geometry":)") +
+                                      geometry + "}]}");
+    fs::remove(l + ".loci");
+    for (const std::string per : {" --per feature", " --per segment"}) {
+      const CliRun r = run_loci("index " + shell_quote(l) + per);
+      expect_one_line_error(r);
+      EXPECT_NE(r.err.find("feature 1 has a NaN"), std::string::npos) << geometry << r.err;
+      EXPECT_FALSE(fs::exists(l + ".loci"));
+    }
+    const CliRun join = run_loci("join " + shell_quote(l) + " " + shell_quote(l));
+    expect_one_line_error(join);
+  }
+}
+
+// Features without points are skipped by `loci index`, which says how many.
+TEST_F(BadInput, IndexCountsTheFeaturesItSkips) {
+  const std::string l = write("skips.csv", "id,wkt\n1,POINT EMPTY\n2,\n3,POINT (1 2)\n");
+  fs::remove(l + ".loci");
+  CliRun r = run_loci("index " + shell_quote(l) + " --per feature");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("indexed 1 feature of layer"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; skipped 2 features without a geometry\n"), std::string::npos) << r.err;
+  r = run_loci("index " + shell_quote(l) + " --per segment");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("indexed 1 segment of 1 feature of layer"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; skipped 2 features"), std::string::npos) << r.err;
+  const std::string full = write("full.csv", "id,wkt\n1,POINT (1 2)\n2,POINT (3 4)\n");
+  r = run_loci("index " + shell_quote(full));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("indexed 2 features of layer"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("skipped"), std::string::npos) << r.err;
+}
+
 TEST_F(BadInput, DevicesFifosAndLinksAreWrittenThroughNeverReplaced) {
   const std::string l = lines_layer();
   const std::string dev = path("null");

@@ -202,6 +202,27 @@ TEST(IntersectionsCli, HandCasesFormatsAndErrors) {
   ASSERT_EQ(gj.status, 0) << gj.err;
   const OgrFeatureSet pts = read_with_ogr((dir / "x.geojson").string());
   EXPECT_EQ(pts.fids.size(), 5u);
+  EXPECT_EQ(read_text((dir / "x.geojson").string()).find("\"crs\""), std::string::npos)
+      << "a layer in longitudes and latitudes needs no crs member";
+  // A layer in another system: the points say which (GDAL's readers take it from "crs").
+  const fs::path utm = dir / "utm.geojson";
+  std::ofstream(utm) << R"({"type":"FeatureCollection",
+"crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32632"}},"features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[500000,0],[500001,1]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[500000,1],[500001,0]]}}]})";
+  const fs::path utm_out = dir / "utm-x.geojson";
+  ASSERT_EQ(run_loci("intersections " + shell_quote(utm.string()) + " -f geojson -o " +
+                     shell_quote(utm_out.string()))
+                .status,
+            0);
+  {
+    GDALDatasetUniquePtr ds(GDALDataset::Open(utm_out.string().c_str(), GDAL_OF_VECTOR));
+    ASSERT_TRUE(ds);
+    const OGRSpatialReference* srs = ds->GetLayer(0)->GetSpatialRef();
+    ASSERT_TRUE(srs);
+    EXPECT_STREQ(srs->GetAuthorityCode(nullptr), "32632");
+    EXPECT_EQ(ds->GetLayer(0)->GetFeatureCount(), 1);
+  }
   const CliRun ids = run_loci("intersections " + shell_quote(p.string()) + " -f ids");
   EXPECT_EQ(ids.status, 1);
   EXPECT_NE(ids.err.find("loci: error:"), std::string::npos);

@@ -1044,6 +1044,75 @@ TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
   EXPECT_FALSE(fs::exists(path("w.geojson")));
 }
 
+// Attributes reach every output format by position, whatever the driver makes of their names
+// (a shapefile cuts them to ten characters, GML replaces spaces, names differing in case are one
+// name to most formats); an attribute named WKT survives a CSV output; an upper-case .SHP is
+// written under that name.
+TEST_F(LayersCli, ClipKeepsEveryAttributeWhateverTheDriverNamesIt) {
+  const std::string l = path("fields.geojson");
+  std::ofstream(l) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"population_total":123,"my field":7,"Name":"lower","NAME":"upper","WKT":"keep"},
+"geometry":{"type":"Point","coordinates":[1,1]}}]})";
+  for (const char* ext : {".shp", ".SHP", ".gpkg", ".csv", ".gml", ".geojson", ".fgb"}) {
+    const std::string out = path(std::string("fields-out") + ext);
+    const CliRun r = run_loci("clip " + l + " --bbox 0,0,5,5 -q -o " + out);
+    ASSERT_EQ(r.status, 0) << ext << ": " << r.err;
+    ASSERT_TRUE(fs::exists(out)) << ext;
+    GDALDatasetUniquePtr ds(GDALDataset::Open(out.c_str(), GDAL_OF_VECTOR));
+    ASSERT_TRUE(ds) << ext;
+    OGRLayer* layer = ds->GetLayer(0);
+    OGRFeatureUniquePtr f(layer->GetNextFeature());
+    ASSERT_TRUE(f) << ext;
+    // Every value once, in the order of the source's fields (a GML or CSV output may add its
+    // own fields first: gml_id, WKT).
+    std::vector<std::string> values;
+    for (int i = 0; i < f->GetFieldCount(); ++i) {
+      const std::string name = f->GetFieldDefnRef(i)->GetNameRef();
+      if (name == "gml_id" || (std::string(ext) == ".csv" && name == "WKT")) continue;
+      values.push_back(f->IsFieldSetAndNotNull(i) ? f->GetFieldAsString(i) : "(null)");
+    }
+    EXPECT_EQ(values, (std::vector<std::string>{"123", "7", "lower", "upper", "keep"})) << ext;
+    ASSERT_TRUE(f->GetGeometryRef()) << ext;
+    for (const auto& e : fs::directory_iterator(path("")))
+      if (e.path().stem() == "fields-out") fs::remove(e.path());
+  }
+}
+
+// A window of no width or height is the segment or point it is: clip cuts from every feature
+// query reports for it (a line crossing a zero-width window leaves a point).
+TEST_F(LayersCli, ClipToAWindowOfNoWidthOrHeight) {
+  const std::string l = path("flat.geojson");
+  std::ofstream(l) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"k":7},"geometry":{"type":"LineString","coordinates":[[0,5],[10,5]]}},
+{"type":"Feature","properties":{"k":8},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}}]})";
+  fs::remove(l + ".loci");
+  for (const char* box : {"5,0,5,10", "0,5,10,5", "5,5,5,5", "-5,3,20,3"}) {
+    const CliRun q = run_loci("query " + l + " --bbox " + box);
+    const std::string out = path("flat-out.geojson");
+    const CliRun r = run_loci("clip " + l + " --bbox " + box + " -q -o " + out);
+    ASSERT_EQ(r.status, 0) << box << ": " << r.err;
+    const OgrFeatureSet got = read_with_ogr(out);
+    EXPECT_EQ(got.geoms.size(), lines(q.out).size()) << box;
+    for (const auto& g : got.geoms) {
+      ASSERT_TRUE(g) << box;
+      OGRPoint at(5, 5);
+      if (std::string(box) != "-5,3,20,3") EXPECT_TRUE(g->Intersects(&at)) << box;
+      EXPECT_FALSE(g->IsEmpty()) << box;
+    }
+    fs::remove(out);
+  }
+  // The vertical window over the square leaves its whole width: the segment x = 5, y 0..10.
+  const std::string out = path("flat-out.geojson");
+  ASSERT_EQ(run_loci("clip " + l + " --bbox 5,0,5,10 -q -o " + out).status, 0);
+  const OgrFeatureSet got = read_with_ogr(out);
+  ASSERT_EQ(got.geoms.size(), 2u);
+  double length = 0;
+  for (const auto& g : got.geoms)
+    if (wkbFlatten(g->getGeometryType()) == wkbLineString)
+      length += g->toLineString()->get_Length();
+  EXPECT_DOUBLE_EQ(length, 10.0);
+}
+
 // A line or ring of one point, or a shapefile part of one point, is that point: the
 // per-segment index (read through GDAL, and straight from a shapefile's records) answers for
 // it as the feature's own geometry does.
@@ -1229,7 +1298,8 @@ TEST_F(LayersCli, IndexChoosesTheGranularity) {
                 fs::copy_options::overwrite_existing);
   CliRun r = run_loci("index " + sample);
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find(" segments of layer"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("indexed 18930 segments of 5 features of layer"), std::string::npos)
+      << r.err;
   std::string info = run_loci("info " + sample).out;
   EXPECT_NE(info.find("per segment (chosen by loci index: "), std::string::npos) << info;
   for (const char* ext : {".shp", ".shx", ".dbf"})  // a copy: other tests use polys.shp

@@ -61,6 +61,8 @@ struct IndexReport {
   std::string layer_name;
   Per per = Per::feature;
   std::size_t items = 0;
+  std::uint64_t features = 0;          // features indexed
+  std::uint64_t without_geometry = 0;  // features skipped: no geometry, or an empty one
   std::uint64_t bytes = 0;
   double seconds = 0;
 };

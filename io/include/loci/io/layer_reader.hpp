@@ -51,7 +51,8 @@ struct LayerItems {
   // With keep_geometries, per feature, for a text layer (one GDAL cannot read by FID in
   // place): every feature's flattened geometry, so that queries need not read it again.
   std::unordered_map<std::int64_t, FlatGeometry> geometries;
-  std::uint64_t features = 0;  // features with a geometry
+  std::uint64_t features = 0;          // features with a geometry
+  std::uint64_t without_geometry = 0;  // features skipped: no geometry, or an empty one
   // The hash fingerprint_of() gives the layer's files, when the reader had it from the bytes
   // it read (a shapefile read directly); else nothing, and the caller hashes them itself.
   std::optional<std::uint64_t> content_hash;
