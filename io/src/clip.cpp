@@ -310,8 +310,13 @@ ClipResult clip_layer(const ClipOptions& options) {
     // A CSV keeps the cut geometries as WKT (by default GDAL's CSV driver drops them).
     const bool csv = std::strcmp(driver->GetDescription(), "CSV") == 0;
     const char* as_wkt[] = {"GEOMETRY=AS_WKT", nullptr};
+    // A shapefile's .dbf is written in UTF-8 (with a .cpg saying so): GDAL's default,
+    // ISO-8859-1, turns every other character into '?'.
+    const char* utf8[] = {"ENCODING=UTF-8", nullptr};
     OGRLayer* layer = ds->CreateLayer(src.layer->GetName(), src.layer->GetSpatialRef(), type,
-                                      csv ? const_cast<char**>(as_wkt) : nullptr);
+                                      csv         ? const_cast<char**>(as_wkt)
+                                      : !mixed_ok ? const_cast<char**>(utf8)
+                                                  : nullptr);
     if (!layer) throw Error("cannot write " + options.out_path + ": " + CPLGetLastErrorMsg());
     // Values are copied by position (`fields[i]`: the output field of source field i, -1 for
     // none), not by name: drivers rename fields as they create them (a shapefile cuts names to

@@ -153,7 +153,16 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
     if (with_point) line += "," + number(a.at[0]) + "," + number(a.at[1]);
     for (int i = 0; i < defn->GetFieldCount(); ++i) {
       line += ',';
-      if (f->IsFieldSetAndNotNull(i)) line += csv_quoted(f->GetFieldAsString(i));
+      if (!f->IsFieldSetAndNotNull(i)) continue;
+      if (defn->GetFieldDefn(i)->GetType() == OFTReal) {
+        // Every digit that tells the value apart (GDAL's text keeps 15: 0.30000000000000004
+        // would read back as 0.3).
+        char buf[32];
+        const auto end = std::to_chars(buf, buf + sizeof buf, f->GetFieldAsDouble(i)).ptr;
+        line += csv_quoted(std::string(buf, end));
+      } else {
+        line += csv_quoted(f->GetFieldAsString(i));
+      }
     }
     std::fprintf(out, "%s\n", line.c_str());
   }

@@ -1051,7 +1051,7 @@ TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
 TEST_F(LayersCli, ClipKeepsEveryAttributeWhateverTheDriverNamesIt) {
   const std::string l = path("fields.geojson");
   std::ofstream(l) << R"({"type":"FeatureCollection","features":[
-{"type":"Feature","properties":{"population_total":123,"my field":7,"Name":"lower","NAME":"upper","WKT":"keep"},
+{"type":"Feature","properties":{"population_total":123,"my field":7,"Name":"lower","NAME":"upper","WKT":"keep","s":"中文 é"},
 "geometry":{"type":"Point","coordinates":[1,1]}}]})";
   for (const char* ext : {".shp", ".SHP", ".gpkg", ".csv", ".gml", ".geojson", ".fgb"}) {
     const std::string out = path(std::string("fields-out") + ext);
@@ -1071,11 +1071,24 @@ TEST_F(LayersCli, ClipKeepsEveryAttributeWhateverTheDriverNamesIt) {
       if (name == "gml_id" || (std::string(ext) == ".csv" && name == "WKT")) continue;
       values.push_back(f->IsFieldSetAndNotNull(i) ? f->GetFieldAsString(i) : "(null)");
     }
-    EXPECT_EQ(values, (std::vector<std::string>{"123", "7", "lower", "upper", "keep"})) << ext;
+    EXPECT_EQ(values, (std::vector<std::string>{"123", "7", "lower", "upper", "keep",
+                                                "\u4e2d\u6587 \u00e9"}))
+        << ext;
     ASSERT_TRUE(f->GetGeometryRef()) << ext;
     for (const auto& e : fs::directory_iterator(path("")))
       if (e.path().stem() == "fields-out") fs::remove(e.path());
   }
+}
+
+// A real attribute is written with every digit that tells it apart (GDAL's text keeps 15).
+TEST_F(LayersCli, CsvOutputKeepsRealAttributesExact) {
+  const std::string l = path("reals.geojson");
+  std::ofstream(l) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"r":0.30000000000000004,"t":0.1,"u":1e20,"i":3},"geometry":{"type":"Point","coordinates":[1,1]}}]})";
+  fs::remove(l + ".loci");
+  const CliRun r = run_loci("query " + l + " --bbox 0,0,5,5 -f csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "fid,r,t,u,i\n0,0.30000000000000004,0.1,1e+20,3\n");
 }
 
 // A window of no width or height is the segment or point it is: clip cuts from every feature
@@ -1202,7 +1215,7 @@ TEST_F(LayersCli, FieldsNamedLikeLociColumnsAreKept) {
   const CliRun again = run_loci("query " + out + " --nearest 0,0 -k 1 -f csv");
   EXPECT_EQ(again.out,
             "fid,distance,layer_fid_2,layer_distance_2,layer_fid,layer_distance,name\n"
-            "0,1.4142135623730951,0,1.4142135623731,A,7,x\n")
+            "0,1.4142135623730951,0,1.4142135623730951,A,7,x\n")
       << again.err;
 }
 
