@@ -34,7 +34,7 @@ bool polygonal(const OGRGeometry& g) {
 
 // The window as one valid polygonal geometry: the rectangle, the WKT, or the union of the
 // window layer's polygons; a rectangle of no width or height is a line or a point.
-std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o) {
+std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o, std::string& system) {
   std::unique_ptr<OGRGeometry> w;
   if (!o.window_wkt.empty()) {
     OGRGeometry* g = nullptr;
@@ -53,6 +53,7 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o) {
           "which unites them");
   } else if (!o.window_layer.empty()) {
     auto wl = detail::open_layer(o.window_layer, o.window_layer_name);
+    system = detail::system_of(*wl.layer);
     const detail::ReadCheck check(o.window_layer);
     OGRMultiPolygon all;
     for (auto& f : *wl.layer) {
@@ -207,7 +208,8 @@ std::unique_ptr<OGRGeometry> of_one_dimension(std::unique_ptr<OGRGeometry> piece
 ClipResult clip_layer(const ClipOptions& options) {
   if (!OGRGeometryFactory::haveGEOS()) throw Error("clipping needs GDAL built with GEOS");
   const bool rectangle = options.window_wkt.empty() && options.window_layer.empty();
-  const std::unique_ptr<OGRGeometry> window = window_of(options);
+  std::string window_system;  // the window layer's coordinate system
+  const std::unique_ptr<OGRGeometry> window = window_of(options, window_system);
   refuse_overwriting(options.out_path, options.load.layer_path);
   if (!options.window_layer.empty()) refuse_overwriting(options.out_path, options.window_layer);
   GDALDriver* driver = detail::driver_for(options.out_path);  // before any work
@@ -226,6 +228,9 @@ ClipResult clip_layer(const ClipOptions& options) {
   query.run(q, 1, false, answers);
 
   auto src = detail::open_layer(options.load.layer_path, index.layer_name());
+  if (!options.window_layer.empty())
+    detail::check_same_system(options.load.layer_path, detail::system_of(*src.layer),
+                              options.window_layer, window_system);
   OutputDataset out(options.out_path);
   ClipResult result;
   {

@@ -148,9 +148,53 @@ void for_each_curve(const OGRGeometry* g,
   walk(linear ? linear.get() : g, polygons, f);
 }
 
-std::string geojson_crs_member(const std::string& path, const std::string& layer) {
-  const OpenLayer ol = open_layer(path, layer);
-  const OGRSpatialReference* srs = ol.layer->GetSpatialRef();
+std::string system_of(const OGRLayer& layer) {
+  const OGRSpatialReference* srs = const_cast<OGRLayer&>(layer).GetSpatialRef();
+  if (!srs) return "";
+  char* wkt = nullptr;
+  const char* options[] = {"FORMAT=WKT2_2019", nullptr};
+  if (srs->exportToWkt(&wkt, options) != OGRERR_NONE) {
+    CPLFree(wkt);
+    return "";
+  }
+  std::string out = wkt ? wkt : "";
+  CPLFree(wkt);
+  return out;
+}
+
+namespace {
+
+std::unique_ptr<OGRSpatialReference> system_from(const std::string& wkt) {
+  if (wkt.empty()) return nullptr;
+  auto srs = std::make_unique<OGRSpatialReference>();
+  if (srs->importFromWkt(wkt.c_str()) != OGRERR_NONE) return nullptr;
+  return srs;
+}
+
+std::string system_name(const OGRSpatialReference& srs) {
+  const char* auth = srs.GetAuthorityName(nullptr);
+  const char* code = srs.GetAuthorityCode(nullptr);
+  if (auth && code) return std::string(auth) + ":" + code;
+  const char* name = srs.GetName();
+  return name ? name : "unnamed";
+}
+
+}  // namespace
+
+void check_same_system(const std::string& a, const std::string& a_system, const std::string& b,
+                       const std::string& b_system) {
+  const auto sa = system_from(a_system), sb = system_from(b_system);
+  if (!sa || !sb) return;
+  // Equal as systems: the same system described in two ways (a .prj's ESRI text, GeoJSON's
+  // EPSG code) and latitude-first or longitude-first axes count as the same.
+  const char* criteria[] = {"CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", nullptr};
+  if (sa->IsSame(sb.get(), criteria)) return;
+  throw Error(a + " and " + b + " are in different coordinate systems (" + system_name(*sa) + ", " +
+              system_name(*sb) + "); reproject one into the other's first (ogr2ogr -t_srs)");
+}
+
+std::string geojson_crs_member(const std::string& system) {
+  const auto srs = system_from(system);
   if (!srs) return "";
   const char* auth = srs->GetAuthorityName(nullptr);
   const char* code = srs->GetAuthorityCode(nullptr);

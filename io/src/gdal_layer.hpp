@@ -33,10 +33,19 @@ bool fast_random_read(GDALDataset& ds);
 // +-kMaxCoordinate (1e150), which loci's distance arithmetic cannot carry.
 void check_layer_point(const Point2& p, const std::string& what);
 
+// A layer's coordinate system as WKT, empty when it has none.
+std::string system_of(const OGRLayer& layer);
+
+// Throws loci::Error when two layers (files a and b, systems as system_of gives them) are in
+// different coordinate systems: their coordinates cannot be compared. A layer without a system
+// is taken to be in the other's.
+void check_same_system(const std::string& a, const std::string& a_system, const std::string& b,
+                       const std::string& b_system);
+
 // The "crs" member (with its trailing comma) a GeoJSON text written by hand gives coordinates
-// of the layer's system, as GDAL's GeoJSON writer names it: empty for WGS 84 longitudes and
-// latitudes (GeoJSON's own), for a layer without a system, or one without an authority code.
-std::string geojson_crs_member(const std::string& path, const std::string& layer);
+// in `system` (system_of's WKT), as GDAL's GeoJSON writer names it: empty for WGS 84
+// longitudes and latitudes (GeoJSON's own), for no system, or one without an authority code.
+std::string geojson_crs_member(const std::string& system);
 
 // Whether a feature's geometry has no points to index (none, or an empty one), to be skipped.
 // GDAL reads a point with a NaN coordinate (GeoJSON's NaN, `[NaN, 3]`) as an empty point that

@@ -44,13 +44,18 @@ Linework::Linework(const std::vector<SegmentRecord>& recs) {
   }
 }
 
-std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o) {
-  const Linework left(read_segments(o.layer_path, o.layer_name, o.progress));
+std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o,
+                                                std::string* system) {
+  std::string left_system;
+  const Linework left(read_segments(o.layer_path, o.layer_name, o.progress, &left_system));
+  if (system) *system = left_system;
   // The layer given twice (however its path is spelled) is the layer against itself.
   if (o.other_path.empty() ||
       (same_file(o.layer_path, o.other_path) && o.layer_name == o.other_name))
     return intersection_rows(left, nullptr, o.pairs_only, o.jobs);
-  const Linework right(read_segments(o.other_path, o.other_name, o.progress));
+  std::string right_system;
+  const Linework right(read_segments(o.other_path, o.other_name, o.progress, &right_system));
+  detail::check_same_system(o.layer_path, left_system, o.other_path, right_system);
   return intersection_rows(left, &right, o.pairs_only, o.jobs);
 }
 
@@ -110,7 +115,8 @@ std::size_t write_intersections(const IntersectionsOptions& o, std::FILE* fallba
     throw InvalidArgument("loci intersections writes csv or geojson, not ids");
   refuse_overwriting(o.out_path, o.layer_path);
   refuse_overwriting(o.out_path, o.other_path);
-  const std::vector<IntersectionRow> rows = find_intersections(o);
+  std::string system;
+  const std::vector<IntersectionRow> rows = find_intersections(o, &system);
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
   if (o.format == Format::csv) {
@@ -124,7 +130,7 @@ std::size_t write_intersections(const IntersectionsOptions& o, std::FILE* fallba
     }
   } else {
     // The points are in the (first) layer's coordinates: a reader must know which.
-    const std::string crs = detail::geojson_crs_member(o.layer_path, o.layer_name);
+    const std::string crs = detail::geojson_crs_member(system);
     std::fprintf(f, "{\"type\":\"FeatureCollection\",%s\"features\":[", crs.c_str());
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const auto& r = rows[k];

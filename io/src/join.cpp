@@ -30,6 +30,8 @@ const PreparedGeometry& JoinLayer::prepared(std::size_t i) const {
 JoinLayer read_join_layer(const std::string& path, const std::string& name) {
   JoinLayer out;
   auto ol = detail::open_layer(path, name);
+  out.path = path;
+  out.system = detail::system_of(*ol.layer);
   // A shapefile's polygons of many rings are built from its records (GDAL would sort their
   // rings all against all): GDAL then reads the features in order without geometry, and the
   // other geometries by FID through a second handle.
@@ -170,6 +172,7 @@ std::vector<JoinRow> join_layers(const JoinOptions& o) {
   const JoinLayer left = read_join_layer(o.left_path, o.left_name);
   if (self) return join_layers(left, nullptr, o.predicate, o.distance, o.progress);
   const JoinLayer right = read_join_layer(o.right_path, o.right_name);
+  detail::check_same_system(left.path, left.system, right.path, right.system);
   return join_layers(left, &right, o.predicate, o.distance, o.progress);
 }
 

@@ -16,8 +16,9 @@ using detail::open_layer;
 using detail::where;
 
 std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer,
-                                         const Progress& progress) {
+                                         const Progress& progress, std::string* system) {
   auto ol = open_layer(path, layer);
+  if (system) *system = detail::system_of(*ol.layer);
   std::vector<SegmentRecord> out;
   ProgressTicker ticker(progress, double(ol.layer->GetFeatureCount(FALSE)));
   std::size_t seen = 0;

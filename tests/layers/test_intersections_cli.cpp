@@ -223,6 +223,33 @@ TEST(IntersectionsCli, HandCasesFormatsAndErrors) {
     EXPECT_STREQ(srs->GetAuthorityCode(nullptr), "32632");
     EXPECT_EQ(ds->GetLayer(0)->GetFeatureCount(), 1);
   }
+  // Two layers in different systems are refused (their coordinates cannot be compared); the
+  // same system described in two ways (a shapefile's ESRI .prj, GeoJSON's default) is one.
+  const std::string hand = shell_quote(p.string()), other = shell_quote(utm.string());
+  const fs::path utm_window = dir / "utm-window.geojson";
+  std::ofstream(utm_window) << R"({"type":"FeatureCollection",
+"crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32632"}},"features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[0,0],[9,0],[9,9],[0,0]]]}}]})";
+  for (const std::string& cmd :
+       {"intersections " + hand + " " + other, "join " + hand + " " + other + " -p intersects",
+        "clip " + hand + " --window-layer " + shell_quote(utm_window.string()) + " -o " +
+            shell_quote((dir / "cw.geojson").string())}) {
+    const CliRun r = run_loci(cmd);
+    EXPECT_EQ(r.status, 1) << cmd;
+    EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_NE(r.err.find("are in different coordinate systems (EPSG:4326, EPSG:32632)"),
+              std::string::npos)
+        << cmd << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "cw.geojson"));
+  const fs::path shp = dir / "hand.shp";
+  ASSERT_EQ(std::system(("ogr2ogr -q " + shell_quote(shp.string()) + " " + hand +
+                         " -where \"OGR_GEOMETRY = 'LINESTRING'\"")
+                            .c_str()),
+            0);
+  const CliRun same = run_loci("join " + shell_quote(shp.string()) + " " + hand + " -p intersects");
+  EXPECT_EQ(same.status, 0) << same.err;
+  EXPECT_NE(same.out.find("\n0,0\n"), std::string::npos) << same.out;
   const CliRun ids = run_loci("intersections " + shell_quote(p.string()) + " -f ids");
   EXPECT_EQ(ids.status, 1);
   EXPECT_NE(ids.err.find("loci: error:"), std::string::npos);

@@ -76,8 +76,10 @@ std::vector<IntersectionRow> intersection_rows(const Linework& a, const Linework
                                                bool pairs_only, unsigned jobs = 0);
 
 // The rows described above (with pairs_only, one row per pair and p unset). Throws loci::Error
-// for a layer that cannot be read or holds a NaN or infinite coordinate.
-std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& options);
+// for a layer that cannot be read or holds a NaN or infinite coordinate, and for two layers in
+// different coordinate systems. `system`, when given, receives the (first) layer's as WKT.
+std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& options,
+                                                std::string* system = nullptr);
 
 // find_intersections, written as CSV (header `fid_a,fid_b,x,y`, or `fid_a,fid_b`) or as GeoJSON
 // points with both FIDs. Returns the number of rows. Throws InvalidArgument for -f ids.

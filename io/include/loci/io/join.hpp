@@ -66,6 +66,8 @@ struct JoinLayer {
   std::vector<std::int64_t> fids;
   std::vector<FlatGeometry> geoms;
   std::vector<Box2> boxes;
+  std::string path;    // the file read
+  std::string system;  // its coordinate system as WKT, empty when it has none
 
   JoinLayer() = default;
   JoinLayer(JoinLayer&&) noexcept;

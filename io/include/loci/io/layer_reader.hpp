@@ -37,9 +37,11 @@ struct FeatureRecord {
 };
 
 // Throws loci::Error when the path cannot be opened, the layer does not exist or has no
-// geometry column, or a coordinate is NaN or infinite (naming the feature).
+// geometry column, or a coordinate is NaN or infinite (naming the feature). `system`, when
+// given, receives the layer's coordinate system as WKT (empty when it has none).
 std::vector<SegmentRecord> read_segments(const std::string& path, const std::string& layer = {},
-                                         const Progress& progress = {});
+                                         const Progress& progress = {},
+                                         std::string* system = nullptr);
 std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::string& layer = {});
 
 struct LayerItems {
