@@ -294,9 +294,11 @@ void AtomicDataset::commit() {
          fs::directory_iterator(target.parent_path().empty() ? "." : target.parent_path(), ec)) {
       const std::string n = e.path().filename().string();
       const std::string x = extension_after(n, stem);
-      if (!x.empty() && shapefile_companion(x) && n != target.filename().string() &&
-          std::find(names.begin(), names.end(), n) == names.end())
-        fs::remove(e.path(), ec);
+      // The driver's name for the main file (x.shp for X.SHP) was written under the target's.
+      const bool written =
+          n == target.filename().string() ||
+          (n != main_name && std::find(names.begin(), names.end(), n) != names.end());
+      if (!x.empty() && shapefile_companion(x) && !written) fs::remove(e.path(), ec);
     }
   }
 }

@@ -13,6 +13,7 @@
 // windowing problem with a non-rectangular window: the index gives the features meeting the
 // window's envelope, the exact test of exact.hpp keeps those that meet the window itself, and
 // GEOS cuts them.
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -330,11 +331,20 @@ ClipResult clip_layer(const ClipOptions& options) {
     const OGRFeatureDefn* defn = src.layer->GetLayerDefn();
     const bool csv_source = std::strcmp(src.dataset->GetDriver()->GetDescription(), "CSV") == 0;
     std::vector<int> fields(std::size_t(defn->GetFieldCount()), -1);
+    // Fields the format gives every layer (KML's Name and Description) take the values of the
+    // source's fields of those names.
+    const int own = layer->GetLayerDefn()->GetFieldCount();
     for (int i = 0; i < defn->GetFieldCount(); ++i) {
       OGRFieldDefn fd(defn->GetFieldDefn(i));
       // A CSV source shows its geometry column as a field too: a CSV output's WKT replaces it.
       if (csv && csv_source && EQUAL(fd.GetNameRef(), "WKT")) continue;
       const std::string name = fd.GetNameRef();
+      const int given = layer->GetLayerDefn()->GetFieldIndex(name.c_str());
+      if (given >= 0 && given < own &&
+          std::find(fields.begin(), fields.end(), given) == fields.end()) {
+        fields[std::size_t(i)] = given;
+        continue;
+      }
       std::string unique = name;
       for (int k = 2; layer->GetLayerDefn()->GetFieldIndex(unique.c_str()) >= 0 ||
                       (csv && EQUAL(unique.c_str(), "WKT"));

@@ -9,9 +9,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <memory>
+#include <sstream>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
@@ -151,6 +155,11 @@ void for_each_curve(const OGRGeometry* g,
 std::string system_of(const OGRLayer& layer) {
   const OGRSpatialReference* srs = const_cast<OGRLayer&>(layer).GetSpatialRef();
   if (!srs) return "";
+  // A GeoPackage written from a layer without a system says "Undefined geographic SRS" (or
+  // Cartesian): no system.
+  const char* name = srs->GetName();
+  if (!srs->GetAuthorityCode(nullptr) && name && std::strncmp(name, "Undefined ", 10) == 0)
+    return "";
   char* wkt = nullptr;
   const char* options[] = {"FORMAT=WKT2_2019", nullptr};
   if (srs->exportToWkt(&wkt, options) != OGRERR_NONE) {
@@ -171,6 +180,28 @@ std::unique_ptr<OGRSpatialReference> system_from(const std::string& wkt) {
   return srs;
 }
 
+// The system as PROJ's +proj text without datum shifts or axis order, tokens sorted ("" when
+// it has none).
+std::string projection_text(const OGRSpatialReference& srs) {
+  char* text = nullptr;
+  if (srs.exportToProj4(&text) != OGRERR_NONE || !text) {
+    CPLFree(text);
+    return "";
+  }
+  std::istringstream in(text);
+  CPLFree(text);
+  std::vector<std::string> tokens;
+  for (std::string t; in >> t;)
+    if (t.rfind("+towgs84=", 0) != 0 && t.rfind("+axis=", 0) != 0 && t != "+no_defs" &&
+        t != "+type=crs")
+      tokens.push_back(t);
+  std::sort(tokens.begin(), tokens.end());
+  std::string out;
+  for (const auto& t : tokens)
+    out += t + ' ';
+  return out;
+}
+
 std::string system_name(const OGRSpatialReference& srs) {
   const char* auth = srs.GetAuthorityName(nullptr);
   const char* code = srs.GetAuthorityCode(nullptr);
@@ -189,6 +220,10 @@ void check_same_system(const std::string& a, const std::string& a_system, const 
   // EPSG code) and latitude-first or longitude-first axes count as the same.
   const char* criteria[] = {"CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", nullptr};
   if (sa->IsSame(sb.get(), criteria)) return;
+  // A projected system whose definition lists northing first (EPSG:31468) against a .prj of
+  // the same listing easting first: the same projection, datum shifts and axes aside.
+  const std::string projection = projection_text(*sa);
+  if (!projection.empty() && projection == projection_text(*sb)) return;
   throw Error(a + " and " + b + " are in different coordinate systems (" + system_name(*sa) + ", " +
               system_name(*sb) + "); reproject one into the other's first (ogr2ogr -t_srs)");
 }

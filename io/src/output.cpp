@@ -158,7 +158,10 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
         // Every digit that tells the value apart (GDAL's text keeps 15: 0.30000000000000004
         // would read back as 0.3).
         char buf[32];
-        const auto end = std::to_chars(buf, buf + sizeof buf, f->GetFieldAsDouble(i)).ptr;
+        const double v = f->GetFieldAsDouble(i);
+        const auto end = defn->GetFieldDefn(i)->GetSubType() == OFSTFloat32
+                             ? std::to_chars(buf, buf + sizeof buf, float(v)).ptr
+                             : std::to_chars(buf, buf + sizeof buf, v).ptr;
         line += csv_quoted(std::string(buf, end));
       } else {
         line += csv_quoted(f->GetFieldAsString(i));

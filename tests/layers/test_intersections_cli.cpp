@@ -242,6 +242,17 @@ TEST(IntersectionsCli, HandCasesFormatsAndErrors) {
         << cmd << ": " << r.err;
   }
   EXPECT_FALSE(fs::exists(dir / "cw.geojson"));
+  // A GeoPackage written from a layer without a system says "Undefined geographic SRS": no
+  // system, so not refused.
+  const fs::path none_csv = dir / "none.csv", none_gpkg = dir / "none.gpkg";
+  std::ofstream(none_csv) << "id,WKT\n1,\"LINESTRING (500000 0,500001 1)\"\n";
+  ASSERT_EQ(std::system(("ogr2ogr -q " + shell_quote(none_gpkg.string()) + " " +
+                         shell_quote(none_csv.string()))
+                            .c_str()),
+            0);
+  const CliRun undefined =
+      run_loci("intersections " + other + " " + shell_quote(none_gpkg.string()));
+  EXPECT_EQ(undefined.status, 0) << undefined.err;
   const fs::path shp = dir / "hand.shp";
   ASSERT_EQ(std::system(("ogr2ogr -q " + shell_quote(shp.string()) + " " + hand +
                          " -where \"OGR_GEOMETRY = 'LINESTRING'\"")

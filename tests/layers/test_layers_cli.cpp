@@ -1075,9 +1075,17 @@ TEST_F(LayersCli, ClipKeepsEveryAttributeWhateverTheDriverNamesIt) {
                                                 "\u4e2d\u6587 \u00e9"}))
         << ext;
     ASSERT_TRUE(f->GetGeometryRef()) << ext;
-    for (const auto& e : fs::directory_iterator(path("")))
-      if (e.path().stem() == "fields-out") fs::remove(e.path());
+    if (std::string(ext) != ".shp")
+      for (const auto& e : fs::directory_iterator(path("")))
+        if (e.path().stem() == "fields-out") fs::remove(e.path());
   }
+  // .SHP written over an earlier .shp of the same name replaces it: no old .shp left beside the
+  // new .shx and .dbf. (The loop above wrote fields-out.shp, then fields-out.SHP.)
+  EXPECT_FALSE(fs::exists(path("fields-out.shp")));
+  // KML's own Name field takes the source's Name.
+  const std::string kml = path("fields-out.kml");
+  ASSERT_EQ(run_loci("clip " + l + " --bbox 0,0,5,5 -q -o " + kml).status, 0);
+  EXPECT_NE(read_text(kml).find("<name>lower</name>"), std::string::npos) << read_text(kml);
 }
 
 // A real attribute is written with every digit that tells it apart (GDAL's text keeps 15).
