@@ -203,14 +203,18 @@ std::string projection_text(const OGRSpatialReference& srs) {
 }
 
 std::string system_name(const OGRSpatialReference& srs) {
-  const char* auth = srs.GetAuthorityName(nullptr);
-  const char* code = srs.GetAuthorityCode(nullptr);
-  if (auth && code) return std::string(auth) + ":" + code;
+  if (std::string code = authority_code(srs); !code.empty()) return code;
   const char* name = srs.GetName();
   return name ? name : "unnamed";
 }
 
 }  // namespace
+
+std::string authority_code(const OGRSpatialReference& srs) {
+  const char* auth = srs.GetAuthorityName(nullptr);
+  const char* code = srs.GetAuthorityCode(nullptr);
+  return auth && code ? std::string(auth) + ":" + code : std::string();
+}
 
 void check_same_system(const std::string& a, const std::string& a_system, const std::string& b,
                        const std::string& b_system) {

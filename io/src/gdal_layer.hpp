@@ -33,6 +33,9 @@ bool fast_random_read(GDALDataset& ds);
 // +-kMaxCoordinate (1e150), which loci's distance arithmetic cannot carry.
 void check_layer_point(const Point2& p, const std::string& what);
 
+// A coordinate system's authority and code ("EPSG:4326"), empty when it has none.
+std::string authority_code(const OGRSpatialReference& srs);
+
 // A layer's coordinate system as WKT, empty when it has none.
 std::string system_of(const OGRLayer& layer);
 

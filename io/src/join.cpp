@@ -53,7 +53,6 @@ JoinLayer read_join_layer(const std::string& path, const std::string& name) {
       if (!built) whole.reset(by_fid->layer->GetFeature(f->GetFID()));
       g = built ? built.get() : whole ? whole->GetGeometryRef() : nullptr;
     }
-    if (detail::without_points(g, detail::where(path, f->GetFID()))) continue;
     FlatGeometry flat = detail::flatten(g, detail::where(path, f->GetFID()));
     if (flat.empty()) continue;
     out.boxes.push_back(flat.envelope());

@@ -237,9 +237,8 @@ LayerSummary summarize_layer(const std::string& path, const std::string& layer,
   if (const OGRSpatialReference* srs = ol.layer->GetSpatialRef()) {
     const char* name = srs->GetName();
     s.crs = name ? name : "";
-    const char* auth = srs->GetAuthorityName(nullptr);
-    const char* code = srs->GetAuthorityCode(nullptr);
-    if (auth && code) s.crs += std::string(" (") + auth + ":" + code + ")";
+    if (const std::string code = detail::authority_code(*srs); !code.empty())
+      s.crs += " (" + code + ")";
   }
   const OGRFeatureDefn* defn = ol.layer->GetLayerDefn();
   for (int i = 0; i < defn->GetFieldCount(); ++i) {
