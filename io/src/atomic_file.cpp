@@ -18,8 +18,11 @@
 #include <system_error>
 #include <vector>
 
+#include <cpl_error.h>
 #include <cpl_string.h>
 #include <cpl_vsi.h>
+#include <gdal.h>
+#include <ogr_api.h>
 
 #include "loci/geom/error.hpp"
 
@@ -215,6 +218,7 @@ AtomicDataset::AtomicDataset(const std::string& path) : path_(path) {
   std::error_code ec;
   if (fs::is_directory(fs::status(path, ec)))
     throw Error("cannot write " + path + " (it is a directory)");
+  refuse_replacing_layers(path);
   // GDAL writes into memory: its drivers do not report every failed write to disk, so the files
   // go to disk afterwards through AtomicFile, every write checked.
   dir_ = "/vsimem/loci-dataset-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
@@ -307,6 +311,29 @@ bool same_file(const std::string& a, const std::string& b) {
   if (a == b) return true;
   std::error_code ec;
   return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
+}
+
+void refuse_replacing_layers(const std::string& out) {
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::status(out, ec))) return;
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  GDALDatasetH ds = GDALOpenEx(out.c_str(), GDAL_OF_VECTOR | GDAL_OF_RASTER | GDAL_OF_READONLY,
+                               nullptr, nullptr, nullptr);
+  CPLPopErrorHandler();
+  if (!ds) return;  // not a dataset GDAL reads: replaced as any file is
+  const int layers = GDALDatasetGetLayerCount(ds);
+  const bool rasters =
+      GDALGetRasterCount(ds) > 0 || CSLCount(GDALGetMetadata(ds, "SUBDATASETS")) > 0;
+  std::string names;
+  for (int i = 0; i < layers && i < 4; ++i)
+    names += std::string(i ? ", " : "") + OGR_L_GetName(GDALDatasetGetLayer(ds, i));
+  if (layers > 4) names += ", ...";
+  GDALClose(ds);
+  if (layers <= 1 && !rasters) return;
+  std::string held = layers > 1 ? std::to_string(layers) + " layers (" + names + ")" : "";
+  if (rasters) held += std::string(held.empty() ? "" : " and ") + "raster data";
+  throw Error("refusing to write " + out + ": it holds " + held +
+              ", which writing the whole file would lose; name another file");
 }
 
 void refuse_overwriting(const std::string& out, const std::string& input, const char* what) {

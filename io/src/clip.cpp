@@ -214,6 +214,7 @@ ClipResult clip_layer(const ClipOptions& options) {
   refuse_overwriting(options.out_path, options.load.layer_path);
   if (!options.window_layer.empty()) refuse_overwriting(options.out_path, options.window_layer);
   GDALDriver* driver = detail::driver_for(options.out_path);  // before any work
+  refuse_replacing_layers(options.out_path);
   const LayerIndex index = load_index(options.load);
   LayerQuery query(index, options.load.layer_path, index.layer_name());
   Query q;

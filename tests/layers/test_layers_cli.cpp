@@ -987,6 +987,36 @@ TEST_F(LayersCli, ClipRefusesUnknownFormatsAndMixedShapefiles) {
 // one polygon with the second arm as a hole outside it; a line that also touches the window's
 // edge at a vertex is a line (into a shapefile too, which once failed); what is left out is
 // counted. An invalid --wkt window is refused.
+// A dataset holding other layers is not replaced by a clip written over it (the layers would
+// be lost with the file); one holding only a layer is replaced, as any output file is.
+TEST_F(LayersCli, ClipRefusesToReplaceAFileHoldingOtherLayers) {
+  const std::string u = path("sq.geojson");
+  std::ofstream(u) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"n":1},"geometry":{"type":"Polygon","coordinates":
+[[[0,0],[6,0],[6,6],[0,6],[0,0]]]}}]})";
+  const std::string two = path("keep.gpkg");
+  fs::remove(two);
+  ASSERT_EQ(std::system(("ogr2ogr -f GPKG " + two + " " + u + " -nln alpha && ogr2ogr -update " +
+                         two + " " + u + " -nln beta")
+                            .c_str()),
+            0);
+  const auto size = fs::file_size(two);
+  expect_error("clip " + u + " --bbox 1,1,2,2 -q -o " + two,
+               "holds 2 layers (alpha, beta), which writing the whole file would lose");
+  EXPECT_EQ(fs::file_size(two), size);
+  EXPECT_EQ(read_with_ogr(two).geoms.size(), 1u);  // alpha, untouched
+  // A GeoPackage of one layer is replaced by the clip.
+  const std::string one = path("one.gpkg");
+  fs::remove(one);
+  ASSERT_EQ(std::system(("ogr2ogr -f GPKG " + one + " " + u + " -nln alpha").c_str()), 0);
+  const CliRun r = run_loci("clip " + u + " --bbox 1,1,2,2 -q -o " + one);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const OgrFeatureSet got = read_with_ogr(one);
+  ASSERT_EQ(got.geoms.size(), 1u);
+  EXPECT_EQ(got.envelopes[0].MinX, 1.0);
+  EXPECT_EQ(got.envelopes[0].MaxY, 2.0);
+}
+
 TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
   const std::string u = path("u.geojson"), line = path("touch.geojson");
   std::ofstream(u) << R"({"type":"FeatureCollection","features":[
