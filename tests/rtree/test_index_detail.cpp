@@ -123,6 +123,28 @@ TEST(RadixSort, MatchesStableSort) {
   }
 }
 
+// Small inputs are sorted by insertion: the same stable order as the counting passes, at every
+// size up to the threshold and just past it, with many equal keys and offset bits.
+TEST(RadixSort, SmallInputsMatchStableSort) {
+  std::mt19937_64 rng(9);
+  for (std::size_t n = 0; n <= kInsertionSortMax + 3; ++n)
+    for (int first : {0, 7}) {
+      const int bits = 20;
+      std::vector<KeyedIndex> v(n);
+      for (std::uint32_t i = 0; i < n; ++i)
+        v[i] = {(rng() % 16) << (first + 16) | (rng() & ((std::uint64_t(1) << first) - 1)), i};
+      auto key = [&](std::uint64_t k) { return (k >> first) & ((std::uint64_t(1) << bits) - 1); };
+      auto ref = v;
+      std::stable_sort(ref.begin(), ref.end(),
+                       [&](auto& a, auto& b) { return key(a.key) < key(b.key); });
+      radix_sort(v, first, bits, [](const KeyedIndex& k) { return k.key; });
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(v[i].key, ref[i].key) << n;
+        ASSERT_EQ(v[i].index, ref[i].index) << n;
+      }
+    }
+}
+
 // The kept second buffer gives the same order as a fresh one, sort after sort, on keys whose
 // sorted bits start above bit 0 (the bits below them left in input order).
 TEST(RadixSort, KeptBufferAndOffsetBits) {

@@ -191,16 +191,24 @@ constexpr bool is_valid(const Box<D>& b) {
   return true;
 }
 
-// Throws InvalidGeometry naming `what` for a NaN/infinite coordinate or an inverted box.
+namespace detail {
+// check_box's refusal, out of the callers' way.
 template <int D>
-void check_box(const Box<D>& b, const char* what = "box") {
-  if (is_valid(b)) return;
+[[gnu::cold, gnu::noinline]] void refuse_box(const Box<D>& b, const char* what) {
   if (!is_finite(b.min) || !is_finite(b.max))
     throw InvalidGeometry(std::string(what) + " has a NaN or infinite coordinate: " + to_string(b));
   for (int i = 0; i < D; ++i)
     if (b.min[i] > b.max[i])
       throw InvalidGeometry(std::string(what) + " is inverted (min > max on axis " +
                             std::to_string(i) + "): " + to_string(b));
+}
+}  // namespace detail
+
+// Throws InvalidGeometry naming `what` for a NaN/infinite coordinate or an inverted box.
+template <int D>
+inline void check_box(const Box<D>& b, const char* what = "box") {
+  if (!is_valid(b)) [[unlikely]]
+    detail::refuse_box(b, what);
 }
 
 }  // namespace loci

@@ -107,6 +107,8 @@ class PackedRTree {
                            std::span<const std::uint32_t> item_indices,
                            std::shared_ptr<const void> keep_alive,
                            const detail::LazyCheck* check = nullptr) {
+    if (size > std::numeric_limits<std::uint32_t>::max() - 1)
+      throw Error("packed R-tree arrays hold more than 2^32 - 2 items");
     PackedRTree t;
     t.size_ = size;
     t.packing_ = packing;
@@ -125,6 +127,13 @@ class PackedRTree {
   bool empty() const { return size_ == 0; }
   Packing packing() const { return packing_; }
   int levels() const { return static_cast<int>(levels_.size()); }
+  // The most levels a tree of at most 2^32 items has.
+  static constexpr int kMaxLevels = [] {
+    int l = 1;
+    for (std::uint64_t covered = NodeSize; covered < (std::uint64_t(1) << 32); covered *= NodeSize)
+      ++l;
+    return l;
+  }();
   Box<D> bounds() const {
     return empty() ? Box<D>::empty() : root_block().bounds(int(levels_.back().entries));
   }
@@ -462,10 +471,11 @@ QueryStats PackedRTree<D, NodeSize>::walk_window(const Box<D>& window, Visit& vi
   // The internal levels are walked depth first. The leaves they lead to are not read at once:
   // each is fetched as soon as it is found and read a little later, a batch at a time, so the
   // cache misses of a batch overlap instead of following one another.
-  detail::Scratch<std::uint64_t> stack_scratch, leaf_scratch;
-  auto& stack = *stack_scratch;
-  auto& leaves = *leaf_scratch;  // leaf block << 1 | 1 when the whole leaf is inside
+  // Both buffers are bounded, so they live on the call's stack: the depth-first stack holds
+  // fewer than NodeSize entries a level, and the leaves at most a batch and one node's.
   constexpr std::size_t kBatch = 32;
+  detail::FixedStack<std::uint64_t, std::size_t(kMaxLevels) * NodeSize> stack;
+  detail::FixedStack<std::uint64_t, kBatch + NodeSize> leaves;  // block << 1 | 1: all inside
   const auto read_leaves = [&]() -> bool {
     for (const std::uint64_t x : leaves) {
       const std::size_t b = std::size_t(x >> 1);

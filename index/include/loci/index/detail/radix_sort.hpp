@@ -20,11 +20,14 @@ struct KeyedIndex {
   std::uint32_t index;
 };
 
+// Up to this many elements radix_sort sorts by insertion (stable too, and allocation-free).
+inline constexpr std::size_t kInsertionSortMax = 128;
+
 // Sorts v by bits [first_bit, first_bit + bits) of key_of(element) (first_bit + bits <= 64;
 // the last digit also reads the bits just above them, which callers leave at 0), using `tmp` as the
 // second buffer (kept by a caller that sorts every tick, so that its memory is not faulted in
 // again). One pass counts every digit; each digit then costs one scatter pass. Nothing is
-// allocated when `tmp` is large enough already.
+// allocated when `tmp` is large enough already, nor for kInsertionSortMax elements or fewer.
 template <class T, class A, class KeyOf>
 void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of,
                 std::vector<T, A>& tmp) {
@@ -34,9 +37,25 @@ void radix_sort(std::vector<T, A>& v, int first_bit, int bits, KeyOf key_of,
   bits = std::min(bits, 64 - first_bit);  // no shift reaches 64
   const int passes = std::min((bits + kDigit - 1) / kDigit, kMaxPasses);
   if (v.size() < 2 || passes <= 0) return;
+  if (v.size() <= kInsertionSortMax) {
+    // A few keys: the counts' set-up (a 16 kB table a digit) would cost more than the sort.
+    // The bits the digits read, the last digit's spill above first_bit + bits included.
+    const int top = std::min(64, first_bit + passes * kDigit);
+    const std::uint64_t mask = top >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << top) - 1;
+    const auto digits = [&](const T& x) { return (key_of(x) & mask) >> first_bit; };
+    for (std::size_t i = 1; i < v.size(); ++i) {
+      T x = v[i];
+      const std::uint64_t k = digits(x);
+      std::size_t j = i;
+      for (; j > 0 && digits(v[j - 1]) > k; --j)
+        v[j] = v[j - 1];
+      v[j] = x;
+    }
+    return;
+  }
   Scratch<std::array<std::size_t, kBuckets>> lease;  // the digit counts, leased per thread
   auto& count = *lease;
-  count.assign(static_cast<std::size_t>(passes), {});
+  count.resize(static_cast<std::size_t>(passes));  // a leased vector comes empty: zeroed
   for (const auto& x : v) {
     const std::uint64_t k = key_of(x);
     for (int p = 0; p < passes; ++p)

@@ -3,21 +3,31 @@
 // faulting in fresh memory. An empty pool makes a new T. Leases nest (a visitor may run another
 // query on the same thread, which leases a second T). At the end of the lease the T goes back
 // to the pool, unless drop() was called (a holder that would keep too much memory) or the
-// lease ends by an exception, which may have left the T half-changed: then it is destroyed.
+// lease ends by an exception, which may have left the T half-changed: then it is destroyed
+// (kWatchExceptions; a holder that resets its T itself on every return may leave it off, and
+// skip asking the runtime twice a lease whether an exception is under way).
 //
-// Scratch<T>: a lease of a std::vector<T>, given back cleared but with its capacity kept.
+// FixedStack<T, N>: at most N values held in place (on the caller's stack), for a buffer whose
+// size the structure bounds: no lease and no allocation at all.
+//
+// Scratch<T>: a lease of a std::vector<T>, given back cleared but with its capacity kept (so
+// whatever an exception left in it is dropped too: it does not watch exceptions). Queries take
+// one or two on every call, so a lease costs a pool's pop and push and nothing else.
 #pragma once
 
+#include <array>
+#include <cassert>
+#include <cstddef>
 #include <exception>
 #include <memory>
 #include <vector>
 
 namespace loci::detail {
 
-template <class T>
+template <class T, bool kWatchExceptions = true>
 class Lease {
  public:
-  Lease() : exceptions_(std::uncaught_exceptions()) {
+  Lease() : exceptions_(kWatchExceptions ? std::uncaught_exceptions() : 0) {
     std::vector<std::unique_ptr<T>>* p = pool();
     if (!p || p->empty()) {
       obj_ = std::make_unique<T>();
@@ -28,7 +38,8 @@ class Lease {
   }
   ~Lease() {
     std::vector<std::unique_ptr<T>>* p = pool();
-    if (!p || !keep_ || std::uncaught_exceptions() != exceptions_) return;
+    if (!p || !keep_) return;
+    if (kWatchExceptions && std::uncaught_exceptions() != exceptions_) return;
     try {
       p->push_back(std::move(obj_));
     } catch (...) {  // no room in the pool: the T is destroyed instead
@@ -77,7 +88,27 @@ class Scratch {
   std::vector<T>* operator->() { return &*lease_; }
 
  private:
-  Lease<std::vector<T>> lease_;
+  Lease<std::vector<T>, false> lease_;
+};
+
+template <class T, std::size_t N>
+class FixedStack {
+ public:
+  void push_back(const T& v) {
+    assert(size_ < N);
+    items_[size_++] = v;
+  }
+  void pop_back() { --size_; }
+  T& back() { return items_[size_ - 1]; }
+  bool empty() const { return size_ == 0; }
+  std::size_t size() const { return size_; }
+  void clear() { size_ = 0; }
+  const T* begin() const { return items_.data(); }
+  const T* end() const { return items_.data() + size_; }
+
+ private:
+  std::array<T, N> items_;  // left uninitialised: only the first size_ are ever read
+  std::size_t size_ = 0;
 };
 
 }  // namespace loci::detail
