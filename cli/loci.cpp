@@ -795,17 +795,27 @@ Args parse(const Command& c, int first, int argc, char** argv) {
 
 int main(int argc, char** argv) {
   loci::io::silence_gdal_messages();
-  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+  const auto is_help = [](const char* a) {
+    return !std::strcmp(a, "--help") || !std::strcmp(a, "-h");
+  };
+  // Without a command: the help on stdout, and the failure said in one line on stderr.
+  if (argc < 2 || is_help(argv[1])) {
     print_help();
-    return argc < 2 ? 1 : 0;
+    if (argc >= 2) return 0;
+    std::fflush(stdout);
+    std::fprintf(stderr, "loci: error: no command given (see loci --help)\n");
+    return 1;
   }
   // `loci fleet SUB ...` is the command "fleet SUB" of the table.
   std::string name = argv[1];
   int first = 2;
   if (name == "fleet") {
-    if (argc < 3 || argv[2][0] == '-') {
+    if (argc < 3 || is_help(argv[2])) {
       print_fleet_help();
-      return argc < 3 ? 1 : 0;
+      if (argc >= 3) return 0;
+      std::fflush(stdout);
+      std::fprintf(stderr, "loci: error: no fleet command given (see loci fleet --help)\n");
+      return 1;
     }
     name += std::string(" ") + argv[2];
     first = 3;

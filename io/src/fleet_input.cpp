@@ -197,7 +197,8 @@ void check_field_count(const CsvRecords& csv, const std::vector<std::string_view
              std::to_string(h.names.size()));
 }
 
-// Sorts by (id, t, row) and drops the later rows of an (id, t) already seen.
+// Sorts by (id, t, row) and keeps, of the rows of one (id, t), the last in the file: a later
+// report replaces an earlier one, as an INSERT of one does in the SQL fleet table.
 struct Row {
   FleetReport r;
   std::size_t line;
@@ -214,6 +215,7 @@ void sort_and_drop_duplicates(std::vector<Row>& rows, SkipCounts& skipped) {
   for (std::size_t i = 0; i < rows.size(); ++i) {
     if (kept > 0 && rows[kept - 1].r.id == rows[i].r.id && rows[kept - 1].r.m.t == rows[i].r.m.t) {
       skipped.add(SkipReason::duplicate);
+      rows[kept - 1] = rows[i];
       continue;
     }
     rows[kept++] = rows[i];
@@ -548,10 +550,16 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
   while (csv.next(f)) {
     ++out.rows;
     check_field_count(csv, f, h);
-    const auto mmsi = whole_number(f[cm]);
-    if (!mmsi) csv.fail("MMSI " + quoted(f[cm]) + " is not a whole number");
     // The first reason found names the skip; the columns are looked at in a fixed order.
     std::optional<SkipReason> skip;
+    // An empty MMSI is a missing value like any other (skipped and counted); one that is not a
+    // number is a broken file.
+    const bool no_mmsi = trimmed(f[cm]).empty();
+    const auto mmsi = no_mmsi ? std::nullopt : whole_number(f[cm]);
+    if (no_mmsi)
+      skip = SkipReason::missing_value;
+    else if (!mmsi)
+      csv.fail("MMSI " + quoted(f[cm]) + " is not a whole number");
     auto num = [&](int col, const char* name) {
       if (trimmed(f[col]).empty()) {
         if (!skip) skip = SkipReason::missing_value;

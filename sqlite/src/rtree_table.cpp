@@ -616,6 +616,15 @@ RTreeIndex RTreeTable::load_stored() {
   return RTreeIndex::load(h, read, std::move(delta), std::move(dead));
 }
 
+namespace {
+// A message about the shadow tables ("%_node ...") with the table's own names ("t_node ...").
+std::string naming_shadows(std::string message, const std::string& table) {
+  for (std::size_t p = 0; (p = message.find("%_", p)) != std::string::npos; p += table.size())
+    message.replace(p, 1, table);
+  return message;
+}
+}  // namespace
+
 RTreeIndex& RTreeTable::current() {
   if (index && !index->has_touched() && changed_elsewhere()) index.reset();
   if (!index) {
@@ -623,9 +632,9 @@ RTreeIndex& RTreeTable::current() {
     try {
       index = std::make_unique<RTreeIndex>(load_stored());
     } catch (const Error& e) {
-      throw SqlError{
-          SQLITE_CORRUPT_VTAB,
-          format_sql("loci_rtree %s: the stored index is corrupt: %s", name.c_str(), e.what())};
+      throw SqlError{SQLITE_CORRUPT_VTAB,
+                     format_sql("loci_rtree %s: the stored index is corrupt: %s", name.c_str(),
+                                naming_shadows(e.what(), name).c_str())};
     }
     generation = g;
   }
@@ -704,17 +713,17 @@ std::string RTreeTable::check() {
         ++count;
         const RowId id = sqlite3_column_int64(ids.get(), 0);
         if (!live.find(id))
-          return format_sql("%%_aux holds id %lld, which has no box", (long long)id);
+          return format_sql("%s_aux holds id %lld, which has no box", name.c_str(), (long long)id);
       }
       if (count != live.size())
-        return format_sql("%%_aux holds %lld rows for %lld boxes", (long long)count,
+        return format_sql("%s_aux holds %lld rows for %lld boxes", name.c_str(), (long long)count,
                           (long long)live.size());
     }
     return "ok";
   } catch (const SqlError& e) {
     return e.message;
   } catch (const std::exception& e) {
-    return e.what();
+    return naming_shadows(e.what(), name);
   }
 }
 

@@ -156,8 +156,11 @@ bool is_schema(sqlite3* db, std::string_view name) {
 }  // namespace
 
 ShadowTable* Registry::find(std::string_view schema, std::string_view name) const {
-  for (ShadowTable* t : tables)
-    if (same_name(t->schema, schema) && same_name(t->name, name)) return t;
+  // The newest first: a table renamed inside a transaction keeps its old object alive, under
+  // the new name, until the transaction ends, while SQLite connects a new one that the
+  // statements after the rename write through.
+  for (auto it = tables.rbegin(); it != tables.rend(); ++it)
+    if (same_name((*it)->schema, schema) && same_name((*it)->name, name)) return *it;
   return nullptr;
 }
 

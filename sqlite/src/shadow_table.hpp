@@ -83,7 +83,8 @@ struct ShadowTable : sqlite3_vtab {
 // The loci tables connected on one database connection.
 struct Registry {
   std::vector<ShadowTable*> tables;
-  // The table `name` of `schema` (both case-insensitive); null when absent.
+  // The table `name` of `schema` (both case-insensitive), its newest object when two have the
+  // name (one renamed inside the transaction under way); null when absent.
   ShadowTable* find(std::string_view schema, std::string_view name) const;
 };
 

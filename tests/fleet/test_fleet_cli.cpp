@@ -493,6 +493,18 @@ TEST_F(FleetCli, HelpDocumentsEverySubcommand) {
     EXPECT_NE(h.out.find("examples:"), std::string::npos) << c;
   }
   EXPECT_NE(run_loci("fleet conflicts --help").out.find("metres for AIS"), std::string::npos);
+  // No command: the help, and exit 1 with one line saying so on stderr; an option where the
+  // subcommand goes is an unknown command.
+  for (const char* args : {"", "fleet"}) {
+    const CliRun r = run_loci(args);
+    EXPECT_EQ(r.status, 1) << args;
+    EXPECT_NE(r.out.find("usage: loci"), std::string::npos) << args;
+    EXPECT_EQ(r.err.rfind("loci: error: no ", 0), 0u) << args << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  const CliRun bogus = run_loci("fleet --bogus");
+  EXPECT_EQ(bogus.status, 1);
+  EXPECT_NE(bogus.err.find("unknown command 'fleet --bogus'"), std::string::npos) << bogus.err;
 }
 
 TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {

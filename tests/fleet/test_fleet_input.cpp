@@ -73,11 +73,12 @@ TEST(FleetCsv, MissingVelocityIsDerivedFromConsecutiveReportsSortedByTime) {
   EXPECT_EQ(e.latest(), 2);
 }
 
-TEST(FleetCsv, DuplicateReportsAreSkippedAndCountedTheFirstKept) {
+// The last line of an (id, t) replaces the earlier ones, as a later INSERT does in SQL.
+TEST(FleetCsv, DuplicateReportsAreSkippedAndCountedTheLastKept) {
   const FleetData d =
       read_fleet_csv("id,t,x,y,vx,vy\n1,0,0,0,1,1\n1,0,9,9,1,1\n1,0,8,8,1,1\n", "d");
   ASSERT_EQ(d.reports.size(), 1u);
-  EXPECT_EQ(d.reports[0].m.p, (Point2{0, 0}));
+  EXPECT_EQ(d.reports[0].m.p, (Point2{8, 8}));
   EXPECT_EQ(d.skipped[SkipReason::duplicate], 2u);
   EXPECT_EQ(d.rows, 3u);
   EXPECT_EQ(d.summary(), "read 1 reports of 1 objects; skipped 2 (2 duplicate)");
@@ -155,12 +156,12 @@ TEST(FleetAis, EverySentinelBadDateNanAndDuplicateIsSkippedAndCounted) {
             "not available, 1 SOG not available, 1 COG not available, 1 LAT out of range, 1 LON "
             "out of range, 1 SOG out of range, 1 COG out of range, 1 bad date, 1 NaN, 1 empty "
             "value)");
-  // Sorted by (MMSI, time); the duplicate's position is not the one kept.
+  // Sorted by (MMSI, time); of the two reports at 00:01:00, the later line is kept.
   EXPECT_EQ(d.reports[0].id, 219000001u);
   EXPECT_EQ(d.reports[0].m.t, 1672531200);
   EXPECT_EQ(d.reports[1].m.t, 1672531260);
   const Point2 kept = d.frame->to_lonlat(d.reports[1].m.p);
-  EXPECT_NEAR(kept[0], 10.009, 1e-9);
+  EXPECT_NEAR(kept[0], 10.0095, 1e-9);
   EXPECT_EQ(d.reports[2].id, 219000003u);
   EXPECT_EQ(d.reports[2].m.t, 1672531200);
   EXPECT_EQ(d.reports[3].m.t, 1672531320);
@@ -185,6 +186,20 @@ TEST(FleetAis, AVesselAtRestWithoutCourseStandsStill) {
   EXPECT_EQ(d.reports[0].m.v[0], 0.0);
   EXPECT_EQ(d.reports[0].m.v[1], 0.0);
   EXPECT_EQ(d.skipped.total(), 1u);
+}
+
+// An empty MMSI is a missing value, skipped and counted like an empty position; the other
+// vessels are read.
+TEST(FleetAis, AnEmptyMmsiIsSkippedAsAnEmptyValue) {
+  const std::string h = "MMSI,BaseDateTime,LAT,LON,SOG,COG\n";
+  const FleetData d = read_fleet(h + " ,2023-01-01T00:00:00,55,10,10,0\n" +
+                                     "2,2023-01-01T00:00:00,55.01,10,0,360\n" +
+                                     "3,2023-01-01T00:00:00,55.01,10,0,360\n",
+                                 "no-mmsi");
+  ASSERT_EQ(d.reports.size(), 2u);
+  EXPECT_EQ(d.reports[0].id, 2u);
+  EXPECT_EQ(d.skipped[SkipReason::missing_value], 1u);
+  EXPECT_EQ(d.summary(), "read 2 AIS reports of 2 vessels; skipped 1 (1 empty value)");
 }
 
 TEST(FleetAis, MalformedRowsAreErrorsNamingTheLine) {

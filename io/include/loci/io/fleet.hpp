@@ -28,8 +28,9 @@
 // COG (degrees from true north) become a velocity in metres per second in that frame, turned by the
 // frame's local direction of true north so that the course stays true away from the centre.
 //
-// Both formats: two reports of one id at the same time are one too many; the first in the
-// file is kept and the others are skipped and counted as duplicates. Reports may come in any
+// Both formats: two reports of one id at the same time are one too many; the last in the
+// file is kept (a later report replaces an earlier one, as in the SQL fleet table) and the
+// others are skipped and counted as duplicates. Reports may come in any
 // order; they are sorted by (id, t). The report of an id in force at time T is its latest
 // with t <= T (a later report replaces the earlier one); an id whose every report is after T
 // is absent at T. "now" is the latest report time unless the caller sets it.
@@ -62,7 +63,7 @@ struct FleetReport {
 
 // Why a row was skipped instead of used.
 enum class SkipReason : std::uint8_t {
-  duplicate,          // same id and time as an earlier row
+  duplicate,          // same id and time as a later row, which replaces it
   lat_not_available,  // AIS LAT 91
   lon_not_available,  // AIS LON 181
   sog_not_available,  // AIS SOG 102.3
