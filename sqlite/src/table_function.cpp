@@ -107,8 +107,17 @@ int x_filter(sqlite3_vtab_cursor* cur, int, const char*, int argc, sqlite3_value
       c.args.push_back(copy);
     }
     const TableFunction& f = *t.handle->function;
-    f.answer(t.db, *t.handle->registry, std::span<sqlite3_value* const>(argv, std::size_t(argc)),
-             c.rows);
+    try {
+      f.answer(t.db, *t.handle->registry, std::span<sqlite3_value* const>(argv, std::size_t(argc)),
+               c.rows);
+    } catch (const SqlError&) {
+      throw;  // worded by the function already
+    } catch (const std::bad_alloc&) {
+      throw;
+    } catch (const std::exception& e) {
+      // The library's refusals ("nearest time is beyond 1e150") name the function asked.
+      throw SqlError{SQLITE_ERROR, std::string(f.name) + ": " + e.what()};
+    }
     c.count = c.rows.rows(f.columns);
     return SQLITE_OK;
   });

@@ -441,6 +441,13 @@ TEST(SqliteFleetSql, BadInputIsAnSqlErrorWithAClearMessage) {
                   "too far for its distance"));
   EXPECT_EQ(db.value("SELECT id FROM loci_fleet_nearest('f', 0, 0, 1, 1e11)"), "1");
   EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_conflicts('f', 1, 1e160)"), "beyond 1e150"));
+  // Refusals from the library name the function asked, as the functions' own errors do.
+  for (const char* sql : {"SELECT * FROM loci_fleet_nearest('f', 0, 0, 2, 1e160)",
+                          "SELECT * FROM loci_conflicts('f', 1, 1e160)"}) {
+    const std::string function = std::string(sql).substr(14, std::string(sql).find('(') - 14);
+    const std::string error = db.error_of(sql);
+    EXPECT_EQ(error.rfind(function + ": ", 0), 0u) << sql << " -> " << error;
+  }
   db.exec("DELETE FROM f WHERE id IN (2, 3, 4)");
   // The object that would leave the range is named by its SQL id, negative ones too.
   db.exec("INSERT INTO f VALUES (-5, 0, 0, 0, 1e10, 0)");
