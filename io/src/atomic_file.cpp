@@ -317,6 +317,15 @@ void refuse_replacing_layers(const std::string& out) {
   std::error_code ec;
   if (!fs::is_regular_file(fs::status(out, ec))) return;
   CPLPushErrorHandler(CPLQuietErrorHandler);
+  // A format of one layer (GeoJSON, a shapefile, CSV) is replaced without being read: opening
+  // a big GeoJSON would parse all of it.
+  GDALDriverH driver =
+      GDALIdentifyDriverEx(out.c_str(), GDAL_OF_VECTOR | GDAL_OF_RASTER, nullptr, nullptr);
+  if (!driver || (!GDALGetMetadataItem(driver, GDAL_DCAP_MULTIPLE_VECTOR_LAYERS, nullptr) &&
+                  !GDALGetMetadataItem(driver, GDAL_DCAP_RASTER, nullptr))) {
+    CPLPopErrorHandler();
+    return;
+  }
   GDALDatasetH ds = GDALOpenEx(out.c_str(), GDAL_OF_VECTOR | GDAL_OF_RASTER | GDAL_OF_READONLY,
                                nullptr, nullptr, nullptr);
   CPLPopErrorHandler();
