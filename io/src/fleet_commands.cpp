@@ -238,6 +238,9 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
 }
 
 std::vector<Hit> nearest_hits(const Loaded& l, const FleetQueryOptions& o) {
+  // Report times lie within 1e150, so only --at can be beyond (the distances would not fit).
+  if (!(std::abs(l.now) <= kMaxCoordinate))
+    throw InvalidArgument("--at: nearest-n is answered at times within 1e150");
   Point2 q = o.point;
   if (l.ais()) {
     check_lonlat(q, "the point");
