@@ -214,7 +214,7 @@ ClipResult clip_layer(const ClipOptions& options) {
   refuse_overwriting(options.out_path, options.load.layer_path);
   if (!options.window_layer.empty()) refuse_overwriting(options.out_path, options.window_layer);
   GDALDriver* driver = detail::driver_for(options.out_path);  // before any work
-  refuse_replacing_layers(options.out_path);
+  OutputDataset out(options.out_path);  // refuses a file holding other layers, before any work
   const LayerIndex index = load_index(options.load);
   LayerQuery query(index, options.load.layer_path, index.layer_name());
   Query q;
@@ -233,7 +233,6 @@ ClipResult clip_layer(const ClipOptions& options) {
   if (!options.window_layer.empty())
     detail::check_same_system(options.load.layer_path, detail::system_of(*src.layer),
                               options.window_layer, window_system);
-  OutputDataset out(options.out_path);
   ClipResult result;
   {
     GDALDatasetUniquePtr ds(

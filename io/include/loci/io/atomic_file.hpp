@@ -72,8 +72,8 @@ class AtomicDataset {
 
 // Throws loci::Error when `out` is an existing dataset holding more than one layer, or raster
 // data (a GeoPackage with other tables, a KML with several folders): writing a dataset
-// replaces the whole file, and would lose what loci was not asked to write. AtomicDataset
-// calls it; commands call it before their work so that they fail early.
+// replaces the whole file, and would lose what loci was not asked to write. AtomicDataset's
+// constructor calls it (a command constructs its output before its work, to fail early).
 void refuse_replacing_layers(const std::string& out);
 
 // True when the two paths name one file (spelled alike, or the same file through another
