@@ -121,7 +121,7 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
                           "INSERT INTO %s VALUES('format', %d), ('generation', 0);",
                           t.shadow("report").c_str(), t.shadow("current").c_str(),
                           t.shadow("meta").c_str(), t.shadow("meta").c_str(), kFormat));
-    t.prepare_statements();
+    if (create || !t.find_missing_shadow()) t.prepare_statements();
     t.attach(db, argv[1], argv[2], registry_of(aux));
     *out = table.release();
     return SQLITE_OK;

@@ -183,7 +183,7 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
         exec(db, sql + ")");
       }
     }
-    table->prepare_statements();
+    if (create || !table->find_missing_shadow()) table->prepare_statements();
     table->attach(db, argv[1], argv[2], registry_of(aux));
     *out = table.release();
     return SQLITE_OK;

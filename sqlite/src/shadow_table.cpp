@@ -29,6 +29,27 @@ std::string ShadowTable::shadow(const char* suffix) const {
   return format_sql("\"%w\".\"%w_%s\"", schema.c_str(), name.c_str(), suffix);
 }
 
+namespace {
+bool holds_table(sqlite3* db, const char* schema, const std::string& table);
+}  // namespace
+
+bool ShadowTable::find_missing_shadow() {
+  for (const char* s : shadow_suffixes())
+    if (!holds_table(db, schema.c_str(), name + "_" + s)) {
+      missing_shadow = name + "_" + s;
+      return true;
+    }
+  return false;
+}
+
+void ShadowTable::refuse_if_broken() const {
+  if (missing_shadow.empty()) return;
+  throw SqlError{SQLITE_CORRUPT_VTAB,
+                 format_sql("%s %s: the stored index is corrupt: %s is missing (DROP TABLE "
+                            "removes what is left of the table)",
+                            module_name(), name.c_str(), missing_shadow.c_str())};
+}
+
 void ShadowTable::prepare_generation() {
   const std::string meta = shadow("meta");
   get_generation.prepare(db, format_sql("SELECT v FROM %s WHERE k = 'generation'", meta.c_str()));
@@ -37,6 +58,7 @@ void ShadowTable::prepare_generation() {
 }
 
 sqlite3_int64 ShadowTable::stored_generation() {
+  refuse_if_broken();
   const ResetOnExit reset{get_generation};
   if (get_generation.step() && sqlite3_column_type(get_generation.get(), 0) == SQLITE_INTEGER &&
       sqlite3_column_int64(get_generation.get(), 0) >= 0)
@@ -48,6 +70,7 @@ sqlite3_int64 ShadowTable::stored_generation() {
 }
 
 std::string ShadowTable::check_meta(int format) {
+  refuse_if_broken();
   Statement s;
   s.prepare(db, format_sql("SELECT k, v, quote(v) FROM %s", shadow("meta").c_str()));
   bool has_format = false, has_generation = false;
@@ -100,6 +123,7 @@ void ShadowTable::drop_shadows() {
 }
 
 void ShadowTable::rename_shadows(const char* new_name) {
+  refuse_if_broken();
   std::string sql;
   for (const char* s : shadow_suffixes())
     sql += format_sql("ALTER TABLE %s RENAME TO \"%w_%s\";", shadow(s).c_str(), new_name, s);

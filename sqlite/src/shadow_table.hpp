@@ -42,6 +42,9 @@ struct ShadowTable : sqlite3_vtab {
   std::string name;
   std::shared_ptr<Registry> registry;
 
+  // Set at xConnect when a shadow table is gone ("t_node"): the table then connects so that
+  // DROP TABLE can remove it, and refuses everything else (refuse_if_broken).
+  std::string missing_shadow;
   sqlite3_int64 generation = -1;  // the stored 'generation' the in-memory copy was read at
   unsigned data_version = 0;      // the file's data version when `generation` was last checked
   bool data_version_known = false;
@@ -62,6 +65,10 @@ struct ShadowTable : sqlite3_vtab {
               std::shared_ptr<Registry> on);
   // "schema"."name_suffix", quoted for SQL.
   std::string shadow(const char* suffix) const;
+  // Records in missing_shadow the first shadow table schema lacks; true when there is one.
+  bool find_missing_shadow();
+  // Throws SqlError (corrupt) naming the missing shadow table, when there is one.
+  void refuse_if_broken() const;
   // Prepares get_generation and set_generation on %_meta(k, v).
   void prepare_generation();
   // 'generation' in %_meta; SqlError (corrupt) when it is missing or not a whole number >= 0,

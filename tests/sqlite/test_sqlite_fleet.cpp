@@ -475,6 +475,36 @@ TEST(SqliteFleetSql, CorruptShadowTablesAreReportedNotTrusted) {
   }
 }
 
+// A fleet table whose shadow table was dropped by hand is reported as corrupt, naming it, and
+// can still be dropped.
+TEST(SqliteFleetSql, AMissingShadowTableIsNamedAndTheTableCanBeDropped) {
+  for (const char* gone : {"f_report", "f_current", "f_meta"}) {
+    SCOPED_TRACE(gone);
+    TempDir dir;
+    const std::string path = dir.file("m.db");
+    {
+      Db db(path);
+      db.exec("CREATE VIRTUAL TABLE f USING loci_fleet(id, t, x, y, vx, vy)");
+      insert(db, "f", make_fleet(20, 1, 0, 35));
+      db.exec(std::string("DROP TABLE ") + gone);
+    }
+    Db db(path);
+    const std::string corrupt =
+        std::string("loci_fleet f: the stored index is corrupt: ") + gone + " is missing";
+    EXPECT_TRUE(db.value("SELECT loci_check('f')").find(corrupt) != std::string::npos)
+        << db.value("SELECT loci_check('f')");
+    for (const char* sql : {"SELECT count(*) FROM f", "SELECT * FROM f WHERE id = 3",
+                            "SELECT count(*) FROM loci_fleet_nearest('f', 0, 0, 1)",
+                            "SELECT count(*) FROM loci_conflicts('f', 10, 0)",
+                            "INSERT INTO f VALUES (1000, 1, 0, 0, 0, 0)",
+                            "DELETE FROM f WHERE id = 3", "ALTER TABLE f RENAME TO g"})
+      EXPECT_TRUE(db.error_of(sql).find(corrupt) != std::string::npos)
+          << sql << ": " << db.error_of(sql);
+    EXPECT_EQ(db.try_exec("DROP TABLE f"), "");
+    EXPECT_EQ(db.value("SELECT count(*) FROM sqlite_schema WHERE name LIKE 'f%'"), "0");
+  }
+}
+
 TEST(SqliteFleetSql, ThePlannerUsesTheIdAndFeedsFunctionsFromJoins) {
   Db db;
   db.exec("CREATE VIRTUAL TABLE f USING loci_fleet(id, t, x, y, vx, vy)");
