@@ -316,6 +316,36 @@ TYPED_TEST(BroadPhaseTest, SubnormalExtents) {
   bp.validate();
 }
 
+// Boxes whose extent overflows (from -1e308 to 1e308: every coordinate finite, max - min
+// infinite) among small ones: the grid's median extent was infinite, its cells infinitely
+// wide, and validate() refused the grid although the pairs were right.
+TYPED_TEST(BroadPhaseTest, ExtentsBeyondTheLargestDouble) {
+  constexpr int D = TypeParam::dimension;
+  std::vector<Box<D>> boxes(5);
+  for (int k = 0; k < D; ++k) {
+    boxes[0].min[k] = -1e308, boxes[0].max[k] = 1e308;
+    boxes[1].min[k] = -1.7e308, boxes[1].max[k] = 1.5e308;
+    boxes[2].min[k] = 0, boxes[2].max[k] = 1;
+    boxes[3].min[k] = -1e308, boxes[3].max[k] = 1.7e308;
+    boxes[4].min[k] = 5, boxes[4].max[k] = 6;
+  }
+  TypeParam bp;
+  std::vector<IdPair> expected;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    bp.add(Id(i), boxes[i]);
+    for (std::size_t j = 0; j < i; ++j)
+      if (intersects(boxes[i], boxes[j])) expected.push_back({Id(j), Id(i)});
+  }
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(sorted(bp.pairs()), expected);
+  bp.validate();
+  bp.remove(0);
+  bp.remove(1);
+  std::erase_if(expected, [](const IdPair& p) { return p.a <= 1; });
+  EXPECT_EQ(sorted(bp.pairs()), expected);
+  bp.validate();
+}
+
 TEST(UniformGrid, SubnormalFixedCell) {
   UniformGrid<2> g(1e-310);
   g.add(1, Box2{{0, 0}, {1, 1}});

@@ -181,8 +181,9 @@ class UniformGrid {
     }
     // Subnormal sides (boxes of extent 1e-310) would make 1 / cell infinite and a coordinate
     // of 0 a NaN cell: cells are at least 2^-1000 wide (any finite coordinate times the
-    // inverse is then a number, clamped as the others).
-    cell_ = std::max(cell_, 0x1p-1000);
+    // inverse is then a number, clamped as the others). A median extent that overflows (boxes
+    // from -1e308 to 1e308) gives the widest finite cell instead of an infinite one.
+    cell_ = std::clamp(cell_, 0x1p-1000, std::numeric_limits<double>::max());
     inv_cell_ = 1.0 / cell_;
   }
 
