@@ -346,6 +346,44 @@ TYPED_TEST(BroadPhaseTest, ExtentsBeyondTheLargestDouble) {
   bp.validate();
 }
 
+// clear() removes every proxy as remove() would: the next update() reports their pairs as
+// ended (it forgot them, and a caller keeping contacts from the reports kept them open).
+TYPED_TEST(BroadPhaseTest, ClearEndsEveryPair) {
+  constexpr int D = TypeParam::dimension;
+  TypeParam bp;
+  if constexpr (requires { bp.clear(); }) {
+    auto cube = [](double lo, double hi) {
+      Box<D> b;
+      for (int k = 0; k < D; ++k)
+        b.min[k] = lo, b.max[k] = hi;
+      return b;
+    };
+    const auto tick = [&] {
+      std::vector<IdPair> begun, ended;
+      bp.update(
+          [&](Id a, Id b) {
+            return begun.push_back({a, b}), true;
+          },
+          [&](Id a, Id b) {
+            return ended.push_back({a, b}), true;
+          });
+      return std::pair{sorted(begun), sorted(ended)};
+    };
+    const std::vector<IdPair> all{{1, 2}, {2, 3}};
+    bp.add(1, cube(0, 2));
+    bp.add(2, cube(1, 3));
+    bp.add(3, cube(3, 4));
+    EXPECT_EQ(tick(), (std::pair{all, std::vector<IdPair>{}}));
+    bp.clear();
+    EXPECT_EQ(bp.size(), 0u);
+    EXPECT_EQ(tick(), (std::pair{std::vector<IdPair>{}, all}));
+    bp.add(2, cube(1, 3));
+    bp.add(3, cube(3, 4));
+    EXPECT_EQ(tick(), (std::pair{std::vector<IdPair>{{2, 3}}, std::vector<IdPair>{}}));
+    bp.validate();
+  }
+}
+
 TEST(UniformGrid, SubnormalFixedCell) {
   UniformGrid<2> g(1e-310);
   g.add(1, Box2{{0, 0}, {1, 1}});

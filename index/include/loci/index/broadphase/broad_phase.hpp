@@ -6,6 +6,7 @@
 //   add(id, box)     a new proxy; throws InvalidArgument when the id is already held
 //   move(id, box)    the proxy's new box; throws InvalidArgument for an unknown id
 //   remove(id)       false when the id is not held
+//   clear()          (where offered) removes every proxy, as remove() of each would
 //
 // A tick is one call that looks at the boxes as they are now:
 //

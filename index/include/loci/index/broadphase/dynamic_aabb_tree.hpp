@@ -115,6 +115,7 @@ class DynamicAabbTree {
     return true;
   }
 
+  // Removes every proxy, as remove() would: the next update() reports their pairs as ended.
   void clear() {
     proxies_.clear();
     pool_.clear();
@@ -123,7 +124,6 @@ class DynamicAabbTree {
     buffered_.clear();
     moved_.clear();
     pairs_.clear();
-    tracker_.reset();
   }
 
   bool contains(Id id) const { return proxies_.find(id) != kNone; }

@@ -149,12 +149,12 @@ class BasicSweepPrune {
     proxies_.remove(s);
     return true;
   }
+  // Removes every proxy, as remove() would: the next update() reports their pairs as ended.
   void clear() {
     proxies_.clear();
     order_.clear();
     pos_.clear();
     holes_ = 0;
-    tracker_.reset();
   }
 
   bool contains(Id id) const { return proxies_.find(id) != kNone; }

@@ -81,10 +81,8 @@ class UniformGrid {
     proxies_.remove(s);
     return true;
   }
-  void clear() {
-    proxies_.clear();
-    tracker_.reset();
-  }
+  // Removes every proxy, as remove() would: the next update() reports their pairs as ended.
+  void clear() { proxies_.clear(); }
 
   bool contains(Id id) const { return proxies_.find(id) != kNone; }
   std::size_t size() const { return proxies_.size(); }

@@ -42,9 +42,6 @@ class PairTracker {
     return st;
   }
 
-  // The next update() reports every pair as begun.
-  void reset() { prev_.clear(); }
-
  private:
   std::vector<IdPair> prev_;  // the pairs at the last update(), sorted
   std::vector<IdPair> cur_;   // scratch for the current pairs
