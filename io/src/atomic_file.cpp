@@ -140,6 +140,14 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   std::error_code ec;
   fs::path target = path;
   if (fs::is_symlink(fs::symlink_status(target, ec)) && !is_special_path(path)) {
+    // Followed link by link, as open() would: a link to a file not there yet is written
+    // through too (weakly_canonical leaves a dangling last link unresolved).
+    for (int hops = 0; fs::is_symlink(fs::symlink_status(target, ec)); ++hops) {
+      if (hops == 40) throw cannot_write(path, ELOOP);
+      const fs::path link = fs::read_symlink(target, ec);
+      if (ec) throw cannot_write(path, ec.value());
+      target = link.is_absolute() ? link : target.parent_path() / link;
+    }
     target = fs::weakly_canonical(target, ec);
     if (ec) throw cannot_write(path, ec.value());
     path_ = target.string();

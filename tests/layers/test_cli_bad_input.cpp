@@ -168,6 +168,23 @@ TEST_F(BadInput, DevicesFifosAndLinksAreWrittenThroughNeverReplaced) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::is_symlink(path("link.txt")));
   EXPECT_EQ(read_text(path("target.txt")), "0\n1\n");
+  // a link to a file not there yet (through a second, relative link into a subdirectory):
+  // the file is created where the links lead, the links stay
+  fs::create_directory(path("sub"));
+  fs::create_symlink("new.txt", path("sub/inner.txt"));
+  fs::create_symlink("sub/inner.txt", path("dangling.txt"));
+  const CliRun d = run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o " +
+                            shell_quote(path("dangling.txt")));
+  ASSERT_EQ(d.status, 0) << d.err;
+  EXPECT_TRUE(fs::is_symlink(path("dangling.txt")));
+  EXPECT_TRUE(fs::is_symlink(path("sub/inner.txt")));
+  EXPECT_EQ(read_text(path("sub/new.txt")), "0\n1\n");
+  // a loop of links is refused in one line
+  fs::create_symlink("loop_b.txt", path("loop_a.txt"));
+  fs::create_symlink("loop_a.txt", path("loop_b.txt"));
+  expect_one_line_error(run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o " +
+                                 shell_quote(path("loop_a.txt"))));
+  EXPECT_TRUE(fs::is_symlink(path("loop_a.txt")));
   // a FIFO as sidecar or layer is refused at once, not waited on
   const std::string fifo = path("fifo");
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
