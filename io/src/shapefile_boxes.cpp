@@ -393,12 +393,19 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
   }
   items.layer_name = ol.layer->GetName();
   items.has_polygons = is_polygon_type(file_type) && items.features > 0;
-  // The fingerprint's hash from the same bytes: the .shp as read, then the (small) .shx, in
-  // the order and with the seeds of fingerprint_of().
+  // The fingerprint's hash from the same bytes: the .shp as read, then the other files of
+  // layer_files() (.shx, .dbf), in the order and with the seeds of fingerprint_of().
   if (shp.hash_rest()) {
-    StreamHash shx_hash(shp_hash.digest());
-    ChunkReader again(shx_path, &shx_hash);
-    if (again.hash_rest()) items.content_hash = shx_hash.digest();
+    std::uint64_t hash = shp_hash.digest();
+    const std::vector<std::string> files = layer_files(path);
+    bool whole = !files.empty() && files[0] == path;
+    for (std::size_t i = 1; whole && i < files.size(); ++i) {
+      StreamHash next(hash);
+      ChunkReader rest(files[i], &next);
+      whole = rest.hash_rest();
+      hash = next.digest();
+    }
+    if (whole) items.content_hash = hash;
   }
   return true;
 }

@@ -11,7 +11,9 @@
 #include <bit>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "loci/geom/error.hpp"
@@ -19,6 +21,8 @@
 
 #define XXH_INLINE_ALL
 #include <xxhash.h>
+
+namespace fs = std::filesystem;
 
 namespace loci::io {
 namespace {
@@ -193,24 +197,39 @@ std::uint64_t hash_bytes(const void* data, std::size_t size, std::uint64_t seed)
   return XXH3_64bits_withSeed(data, size, seed);
 }
 
-namespace {
+namespace {}  // namespace
 
-// The files a layer's geometry lives in: the path itself, and a shapefile's index (.shx).
 std::vector<std::string> layer_files(const std::string& layer_path) {
+  struct stat st {};
+  if (stat_file(layer_path, st) && S_ISDIR(st.st_mode)) {
+    // A directory GDAL opens as one dataset (shapefiles, a FileGDB): every file in it, in name
+    // order, so that an edit to any of them is seen.
+    std::vector<std::string> files;
+    std::error_code ec;
+    for (fs::directory_iterator it(layer_path, ec), end; !ec && it != end; it.increment(ec))
+      if (it->is_regular_file(ec)) files.push_back(it->path().string());
+    if (ec) throw Error(layer_path + ": cannot list (" + ec.message() + ")");
+    std::sort(files.begin(), files.end());
+    return files;
+  }
   std::vector<std::string> files{layer_path};
   const std::string ext = layer_path.size() > 4 ? layer_path.substr(layer_path.size() - 4) : "";
   if (lower(ext) == ".shp") {
+    // Its index (.shx) and its attributes (.dbf, which also marks deleted records).
     const std::string stem = layer_path.substr(0, layer_path.size() - 4);
-    for (const char* shx : {".shx", ".SHX"}) {
-      struct stat s2 {};
-      if (stat_file(stem + shx, s2)) {
-        files.push_back(stem + shx);
-        break;
+    for (const auto& [lower_ext, upper_ext] : {std::pair{".shx", ".SHX"}, {".dbf", ".DBF"}})
+      for (const char* e : {lower_ext, upper_ext}) {
+        struct stat s2 {};
+        if (stat_file(stem + e, s2) && S_ISREG(s2.st_mode)) {
+          files.push_back(stem + e);
+          break;
+        }
       }
-    }
   }
   return files;
 }
+
+namespace {
 
 // Size, modification time and inode of the layer's files, nothing read; `regular` tells
 // whether there is content to hash. Nullopt for a GDAL path that is not a file.
@@ -224,11 +243,15 @@ std::optional<Fingerprint> stat_fingerprint(const std::string& layer_path, bool&
     throw Error(layer_path + ": no such file");
   }
   Fingerprint f;
-  regular = S_ISREG(st.st_mode);
+  regular = S_ISREG(st.st_mode) || S_ISDIR(st.st_mode);
   if (!regular) {
     f.mtime_ns = mtime_ns(st);
     f.inode = st.st_ino;
     return f;
+  }
+  if (S_ISDIR(st.st_mode)) {  // a file added or removed
+    f.mtime_ns = mtime_ns(st);
+    f.inode = std::uint64_t(st.st_ino);
   }
   for (const auto& file : layer_files(layer_path)) {
     struct stat s {};

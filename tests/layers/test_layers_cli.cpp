@@ -1371,6 +1371,61 @@ TEST_F(LayersCli, IndexChoosesTheGranularity) {
   fs::remove(sample + ".loci");
 }
 
+// The fingerprint covers a shapefile's .dbf (which marks deleted records) and every file of a
+// directory opened as one dataset: an edit to any of them makes the index stale, a touch of
+// them does not (the content hashed while indexing is the one checked later).
+TEST_F(LayersCli, SeesEditsToAShapefilesAttributesAndToADirectoryOfShapefiles) {
+  const std::string dir = path("shpdir");
+  fs::create_directories(dir);
+  for (const char* ext : {".shp", ".shx", ".dbf"}) {
+    fs::copy_file(path(std::string("polys") + ext), path(std::string("dbfedit") + ext),
+                  fs::copy_options::overwrite_existing);
+    fs::copy_file(path(std::string("polys") + ext), dir + "/polys" + ext,
+                  fs::copy_options::overwrite_existing);
+  }
+  // Byte `at` from the end (negative) or the start of `file`, xored with `bits`.
+  auto flip = [](const std::string& file, std::streamoff at, char bits) {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(0, at < 0 ? std::ios::end : std::ios::beg);
+    const std::streamoff where = std::streamoff(f.tellg()) + at;
+    char c = 0;
+    f.seekg(where);
+    f.read(&c, 1);
+    f.seekp(where);
+    c = char(c ^ bits);
+    f.write(&c, 1);
+  };
+  auto touch = [](const std::string& file) {
+    fs::last_write_time(file, fs::last_write_time(file) + std::chrono::seconds(5));
+  };
+  for (const std::string layer : {path("dbfedit.shp"), dir}) {
+    SCOPED_TRACE(layer);
+    ASSERT_EQ(run_loci("index -q " + layer).status, 0);
+    const std::string before = run_loci("query " + layer + " --bbox 0,0,9,9").out;
+    ASSERT_FALSE(before.empty());
+    const std::string dbf = layer == dir ? dir + "/polys.dbf" : path("dbfedit.dbf");
+    touch(dbf);
+    const CliRun touched = run_loci("query " + layer + " --bbox 0,0,9,9");
+    EXPECT_EQ(touched.status, 0) << touched.err;
+    EXPECT_EQ(touched.out, before);
+    EXPECT_NE(run_loci("info " + layer).out.find("fresh"), std::string::npos);
+    // The first record of the .dbf marked deleted ('*' for ' '), sizes unchanged.
+    {
+      std::ifstream f(dbf, std::ios::binary);
+      unsigned char head[12] = {};
+      f.read(reinterpret_cast<char*>(head), sizeof head);
+      const int header_size = head[8] | head[9] << 8;
+      flip(dbf, header_size, char(' ' ^ '*'));
+    }
+    expect_error("query " + layer + " --bbox 0,0,9,9", "stale index");
+    EXPECT_NE(run_loci("info " + layer).out.find("stale"), std::string::npos);
+  }
+  // In the directory, a coordinate of the .shp changed in place.
+  ASSERT_EQ(run_loci("index -q " + dir).status, 0);
+  flip(dir + "/polys.shp", -8, 0x10);
+  expect_error("query " + dir + " --bbox 0,0,9,9", "stale index");
+}
+
 TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {
   // A copy, so that other tests keep their layer.
   for (const char* ext : {".shp", ".shx", ".dbf"})
