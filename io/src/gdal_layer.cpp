@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "loci/geom/error.hpp"
+#include "loci/io/atomic_file.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/sidecar.hpp"
 
@@ -87,6 +88,16 @@ void check_layer_point(const Point2& p, const std::string& what) {
     std::snprintf(buf, sizeof buf, " has coordinate (%.6g, %.6g), beyond +-1e150", p[0], p[1]);
     throw InvalidGeometry(what + buf + ": too large for exact distances");
   }
+}
+
+bool same_layer(const std::string& path_a, const std::string& name_a, const std::string& path_b,
+                const std::string& name_b) {
+  if (!same_file(path_a, path_b)) return false;
+  if (name_a == name_b) return true;
+  const OpenLayer ol = open_layer(path_a, name_a);
+  OGRLayer* b =
+      name_b.empty() ? ol.dataset->GetLayer(0) : ol.dataset->GetLayerByName(name_b.c_str());
+  return b == ol.layer;
 }
 
 std::string where(const std::string& path, std::int64_t fid) {

@@ -22,6 +22,12 @@ struct OpenLayer {
 // Throws loci::Error for a path GDAL cannot open, a missing layer or a layer without geometry.
 OpenLayer open_layer(const std::string& path, const std::string& name);
 
+// Whether (path_a, name_a) and (path_b, name_b) select the same layer: the same file however
+// spelled (same_file), and names that pick the same layer of it (an empty name is the first
+// layer; GDAL matches a name without regard to case when no layer has it exactly).
+bool same_layer(const std::string& path_a, const std::string& name_a, const std::string& path_b,
+                const std::string& name_b);
+
 std::string where(const std::string& path, std::int64_t fid);
 
 // Whether the dataset's driver reads a feature by FID in place (shapefile, GeoPackage,

@@ -49,9 +49,10 @@ std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o,
   std::string left_system;
   const Linework left(read_segments(o.layer_path, o.layer_name, o.progress, &left_system));
   if (system) *system = left_system;
-  // The layer given twice (however its path is spelled) is the layer against itself.
+  // The layer given twice (however its path is spelled, and by name or as the default first
+  // layer) is the layer against itself.
   if (o.other_path.empty() ||
-      (same_file(o.layer_path, o.other_path) && o.layer_name == o.other_name))
+      detail::same_layer(o.layer_path, o.layer_name, o.other_path, o.other_name))
     return intersection_rows(left, nullptr, o.pairs_only, o.jobs);
   std::string right_system;
   const Linework right(read_segments(o.other_path, o.other_name, o.progress, &right_system));

@@ -165,9 +165,9 @@ std::vector<JoinRow> closest_pair(const JoinLayer& left, const JoinLayer& right,
 }  // namespace
 
 std::vector<JoinRow> join_layers(const JoinOptions& o) {
-  // A layer joined with itself (however its path is spelled) is read once, and no feature is
-  // paired with itself.
-  const bool self = same_file(o.left_path, o.right_path) && o.left_name == o.right_name;
+  // A layer joined with itself (however its path is spelled, and by name or as the default
+  // first layer) is read once, and no feature is paired with itself.
+  const bool self = detail::same_layer(o.left_path, o.left_name, o.right_path, o.right_name);
   const JoinLayer left = read_join_layer(o.left_path, o.left_name);
   if (self) return join_layers(left, nullptr, o.predicate, o.distance, o.progress);
   const JoinLayer right = read_join_layer(o.right_path, o.right_name);

@@ -197,6 +197,17 @@ TEST(IntersectionsCli, HandCasesFormatsAndErrors) {
   const CliRun closest = run_loci("join " + shell_quote(p.string()) + " " + again + " --closest");
   ASSERT_EQ(closest.status, 0) << closest.err;
   EXPECT_EQ(closest.out.substr(closest.out.find('\n') + 1, 4), "0,1,");
+  // Also when one side names the layer and the other takes the default (the first layer), in
+  // any case GDAL matches.
+  for (const char* names : {" --layer hand", " --layer2 HAND"}) {
+    const CliRun named = run_loci("intersections " + shell_quote(p.string()) + " " + again + names);
+    ASSERT_EQ(named.status, 0) << named.err;
+    EXPECT_EQ(named.out, r.out) << names;
+    const CliRun join =
+        run_loci("join " + shell_quote(p.string()) + " " + again + names + " --closest");
+    ASSERT_EQ(join.status, 0) << join.err;
+    EXPECT_EQ(join.out, closest.out) << names;
+  }
   const CliRun gj = run_loci("intersections " + shell_quote(p.string()) + " -f geojson -o " +
                              shell_quote((dir / "x.geojson").string()));
   ASSERT_EQ(gj.status, 0) << gj.err;
