@@ -261,7 +261,8 @@ bool without_points(const OGRGeometry* g, const std::string& what) {
   const auto type = wkbFlatten(g->getGeometryType());
   if (type == wkbPoint) {
     const OGRPoint* p = g->toPoint();
-    if (std::isnan(p->getX()) || std::isnan(p->getY()))
+    // Both NaN is how WKB and GeoPackage write POINT EMPTY; one NaN is a bad coordinate.
+    if (std::isnan(p->getX()) != std::isnan(p->getY()))
       throw InvalidGeometry(what + " has a NaN or infinite coordinate");
   } else if (OGR_GT_IsSubClassOf(type, wkbGeometryCollection)) {
     for (const auto* part : *g->toGeometryCollection())

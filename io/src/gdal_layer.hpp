@@ -59,7 +59,8 @@ std::string geojson_crs_member(const std::string& system);
 // Whether a feature's geometry has no points to index (none, or an empty one), to be skipped.
 // GDAL reads a point with a NaN coordinate (GeoJSON's NaN, `[NaN, 3]`) as an empty point that
 // keeps its NaN: that one is bad input, and throws InvalidGeometry naming `what` like any other
-// NaN coordinate, also inside an empty collection.
+// NaN coordinate, also inside an empty collection. A point with both coordinates NaN is
+// POINT EMPTY as WKB and GeoPackage write it, and is empty.
 bool without_points(const OGRGeometry* g, const std::string& what);
 
 // Calls f(curve, is_ring, polygon) for every line string and ring of g, in reading order;

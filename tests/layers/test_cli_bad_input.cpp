@@ -129,6 +129,41 @@ TEST_F(BadInput, NaNPointsGdalReadsAsEmptyAreRefusedToo) {
   }
 }
 
+// POINT EMPTY in a GeoPackage (stored with both coordinates NaN, as in WKB) is an empty
+// geometry like any other: skipped, not refused as a NaN coordinate (which made the whole
+// layer unusable).
+TEST_F(BadInput, EmptyPointsOfAGeoPackageAreSkipped) {
+  const std::string csv = write("pe.csv", "id,WKT\n1,\"POINT EMPTY\"\n2,\"POINT (1 1)\"\n");
+  const std::string gpkg = path("pe.gpkg");
+  GDALAllRegister();
+  {
+    GDALDatasetUniquePtr src(GDALDataset::Open(csv.c_str(), GDAL_OF_VECTOR));
+    ASSERT_TRUE(src);
+    GDALDriver* drv = GetGDALDriverManager()->GetDriverByName("GPKG");
+    ASSERT_NE(drv, nullptr);
+    GDALDatasetUniquePtr out(drv->Create(gpkg.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    ASSERT_TRUE(out);
+    OGRLayer* l = out->CreateLayer("pe", nullptr, wkbPoint, nullptr);
+    ASSERT_NE(l, nullptr);
+    for (const char* wkt : {"POINT EMPTY", "POINT (1 1)"}) {
+      OGRFeature f(l->GetLayerDefn());
+      OGRGeometry* g = nullptr;
+      ASSERT_EQ(OGRGeometryFactory::createFromWkt(wkt, nullptr, &g), OGRERR_NONE);
+      f.SetGeometryDirectly(g);
+      ASSERT_EQ(l->CreateFeature(&f), OGRERR_NONE);
+    }
+  }
+  for (const std::string& layer : {csv, gpkg}) {
+    SCOPED_TRACE(layer);
+    const CliRun q = run_loci("query " + shell_quote(layer) + " --bbox 0,0,2,2");
+    ASSERT_EQ(q.status, 0) << q.err;
+    EXPECT_EQ(q.out, "2\n");  // both drivers number features from 1
+    const CliRun i = run_loci("index -q " + shell_quote(layer));
+    ASSERT_EQ(i.status, 0) << i.err;
+    EXPECT_EQ(run_loci("query " + shell_quote(layer) + " --nearest 0,0 -k 5").out, q.out);
+  }
+}
+
 // Features without points are skipped by `loci index`, which says how many.
 TEST_F(BadInput, IndexCountsTheFeaturesItSkips) {
   const std::string l = write("skips.csv", "id,wkt\n1,POINT EMPTY\n2,\n3,POINT (1 2)\n");
