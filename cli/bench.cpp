@@ -99,13 +99,13 @@ std::string bench_layer(const BenchOptions& o) {
   if (std::abs(loci_sum - boost_sum) > 1e-9 * std::max(1.0, std::abs(boost_sum)))
     throw Error("nearest-n distances differ between loci and Boost");
 
-  char head[400];
+  char head[200];  // the layer's path goes around it: it may be of any length
   std::snprintf(head, sizeof head,
-                "%s: %zu %s boxes, %zu windows (%zu hits), %zu nearest-%zu queries\n"
+                ": %zu %s boxes, %zu windows (%zu hits), %zu nearest-%zu queries\n"
                 "%-28s %12s %12s %10s\n",
-                o.layer_path.c_str(), boxes.size(), o.per == Per::segment ? "segment" : "feature",
-                o.queries, loci_hits, o.queries, o.k, "", "loci ms", "Boost ms", "Boost/loci");
-  return std::string(head) + row("build (packed)", loci_build, boost_build) +
+                boxes.size(), o.per == Per::segment ? "segment" : "feature", o.queries, loci_hits,
+                o.queries, o.k, "", "loci ms", "Boost ms", "Boost/loci");
+  return o.layer_path + head + row("build (packed)", loci_build, boost_build) +
          row("window queries", loci_window, boost_window) +
          row("nearest-n queries", loci_nearest, boost_nearest);
 }

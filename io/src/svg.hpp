@@ -4,6 +4,7 @@
 // that round together dropped.
 #pragma once
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdio>
@@ -45,15 +46,21 @@ inline void write_linework(std::FILE* o, const Frame& f, const std::string& laye
                            const std::string& layer_name) {
   auto src = open_layer(layer_path, layer_name);
   std::fprintf(o, "<g fill=\"none\" stroke=\"#555\" stroke-width=\"0.5\">\n");
+  // Tenths of a pixel, clamped far outside any canvas (a vertex beyond the frame's range
+  // would overflow a long: a layer much larger than a fleet drawn at one point).
+  const auto tenths = [](double v) { return std::lround(std::clamp(v * 10, -1e15, 1e15)); };
   for (auto& feature : *src.layer) {
+    const std::string what = where(layer_path, feature->GetFID());
     detail::for_each_curve(
         feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
           const int n = c.getNumPoints();
+          for (int i = 0; i < n; ++i)
+            check_layer_point({c.getX(i), c.getY(i)}, what);
           if (n < 2) return;
           std::fprintf(o, "<path d=\"");
           long lx = LONG_MIN, ly = LONG_MIN;
           for (int i = 0; i < n; ++i) {
-            const long px = std::lround(f.x(c.getX(i)) * 10), py = std::lround(f.y(c.getY(i)) * 10);
+            const long px = tenths(f.x(c.getX(i))), py = tenths(f.y(c.getY(i)));
             if (px == lx && py == ly && i + 1 < n) continue;
             std::fprintf(o, "%c%.1f %.1f", i == 0 ? 'M' : 'L', px / 10.0, py / 10.0);
             lx = px;

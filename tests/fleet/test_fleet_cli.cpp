@@ -697,6 +697,31 @@ TEST_F(FleetCli, DrawShowsEveryObjectInForceAndEveryConflict) {
       run_loci("fleet draw " + shell_quote(f) + " --at -5 -o " + shell_quote(none));
   EXPECT_EQ(early.status, 1);
   EXPECT_FALSE(fs::exists(none));
+
+  // One vessel standing still (a frame about 1e-10 wide) over a road 400 km long: the road's
+  // far ends are far off the canvas, written as numbers, not as an overflowed long.
+  const std::string still = write("still.csv", "id,t,x,y,vx,vy\n1,0,0,0,0,0\n");
+  const std::string road =
+      write("road.geojson", R"({"type":"FeatureCollection","features":[{"type":"Feature",
+"properties":{},"geometry":{"type":"LineString","coordinates":[[-200000,-1],[200000,1]]}}]})");
+  const std::string rs = path("road.svg");
+  const CliRun rr = run_loci("fleet draw " + shell_quote(still) + " --over " + shell_quote(road) +
+                             " -q -o " + shell_quote(rs));
+  ASSERT_EQ(rr.status, 0) << rr.err;
+  const std::string road_svg = read_text(rs);
+  EXPECT_EQ(road_svg.find("922337203685477"), std::string::npos) << road_svg;
+  EXPECT_NE(road_svg.find("stroke=\"#555\" stroke-width=\"0.5\">\n<path d=\"M"), std::string::npos)
+      << road_svg;
+  // A layer beyond +-1e150 is refused under the fleet as loci draw refuses it.
+  const std::string big =
+      write("big.geojson", R"({"type":"FeatureCollection","features":[{"type":"Feature",
+"properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1e200,1]]}}]})");
+  const CliRun rb = run_loci("fleet draw " + shell_quote(still) + " --over " + shell_quote(big) +
+                             " -q -o " + shell_quote(none));
+  EXPECT_EQ(rb.status, 1);
+  EXPECT_EQ(lines(rb.err).size(), 1u) << rb.err;
+  EXPECT_NE(rb.err.find("beyond +-1e150"), std::string::npos) << rb.err;
+  EXPECT_FALSE(fs::exists(none));
 }
 
 }  // namespace
