@@ -58,6 +58,7 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o, std::string& system
     const detail::ReadCheck check(o.window_layer);
     OGRMultiPolygon all;
     for (auto& f : *wl.layer) {
+      check.feature(f->GetFID());
       const OGRGeometry* g = f->GetGeometryRef();
       if (detail::without_points(g, detail::where(o.window_layer, f->GetFID()))) continue;
       if (!polygonal(*g))

@@ -30,6 +30,12 @@ ReadCheck::ReadCheck(std::string path) : path_(std::move(path)) {
   CPLErrorReset();
 }
 
+void ReadCheck::feature(std::int64_t fid) const {
+  if (CPLGetLastErrorType() == CE_Failure || CPLGetLastErrorType() == CE_Fatal)
+    throw Error(path_ + ": cannot read the layer whole (feature " + std::to_string(fid) + ": " +
+                CPLGetLastErrorMsg() + ")");
+}
+
 void ReadCheck::finish() const {
   if (CPLGetLastErrorType() == CE_Failure || CPLGetLastErrorType() == CE_Fatal)
     throw Error(path_ + ": cannot read the layer whole (" + CPLGetLastErrorMsg() + ")");

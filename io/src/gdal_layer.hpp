@@ -78,6 +78,10 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what);
 class ReadCheck {
  public:
   explicit ReadCheck(std::string path);
+  // Called right after feature `fid` is read: throws as finish() does, naming the feature,
+  // when reading it failed (GDAL reports a geometry it cannot parse, a CSV's unreadable WKT
+  // say, while reading its feature, and hands the feature out without it).
+  void feature(std::int64_t fid) const;
   void finish() const;
 
  private:

@@ -45,6 +45,7 @@ JoinLayer read_join_layer(const std::string& path, const std::string& name) {
   const detail::ReadCheck check(path);
   ol.layer->ResetReading();
   for (auto& f : *ol.layer) {
+    check.feature(f->GetFID());
     std::unique_ptr<OGRGeometry> built;
     OGRFeatureUniquePtr whole;
     const OGRGeometry* g = f->GetGeometryRef();

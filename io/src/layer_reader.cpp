@@ -26,6 +26,7 @@ std::vector<SegmentRecord> read_segments(const std::string& path, const std::str
   for (auto& feature : *ol.layer) {
     ticker.tick(double(++seen));
     const std::int64_t fid = feature->GetFID();
+    read_check.feature(fid);
     std::int32_t part = 0;
     detail::for_each_curve(feature->GetGeometryRef(),
                            [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
@@ -52,6 +53,7 @@ std::vector<FeatureRecord> read_envelopes(const std::string& path, const std::st
   std::vector<FeatureRecord> out;
   const detail::ReadCheck read_check(path);
   for (auto& feature : *ol.layer) {
+    read_check.feature(feature->GetFID());
     const OGRGeometry* g = feature->GetGeometryRef();
     if (detail::without_points(g, where(path, feature->GetFID()))) continue;
     OGREnvelope e;
@@ -134,6 +136,7 @@ void read_layer_items(const std::string& path, const std::string& layer, const P
     ticker.tick(double(++seen));
     const OGRGeometry* g = feature->GetGeometryRef();
     const std::int64_t fid = feature->GetFID();
+    read_check.feature(fid);
     if (detail::without_points(g, where(path, fid))) {
       for (LayerItems* out : {by_feature, by_segment})
         if (out) ++out->without_geometry;
@@ -262,6 +265,7 @@ LayerSummary summarize_layer(const std::string& path, const std::string& layer,
   for (auto& feature : *ol.layer) {
     ++s.feature_count;
     ticker.tick(double(s.feature_count));
+    read_check.feature(feature->GetFID());
     const OGRGeometry* g = feature->GetGeometryRef();
     if (!g) {
       ++types["(none)"];

@@ -164,6 +164,30 @@ TEST_F(BadInput, EmptyPointsOfAGeoPackageAreSkipped) {
   }
 }
 
+// A geometry GDAL cannot parse (a CSV's WKT with an infinite coordinate, or not WKT at all)
+// is refused in one line naming its feature, by every command that reads the layer.
+TEST_F(BadInput, UnreadableGeometriesAreRefusedNamingTheFeature) {
+  for (const char* wkt : {"LINESTRING (0 0,inf 1)", "garbage"}) {
+    SCOPED_TRACE(wkt);
+    const std::string l = write("badwkt.csv", std::string("id,WKT\n1,\"POINT (1 2)\"\n2,\"") + wkt +
+                                                  "\"\n3,\"POINT (2 2)\"\n");
+    fs::remove(l + ".loci");
+    for (const std::string command :
+         {"query " + shell_quote(l) + " --bbox 0,0,5,5", "info " + shell_quote(l),
+          "index " + shell_quote(l), "index --per segment " + shell_quote(l),
+          "join " + shell_quote(l) + " " + shell_quote(l) + " --closest",
+          "intersections " + shell_quote(l)}) {
+      const CliRun r = run_loci(command);
+      expect_one_line_error(r);
+      EXPECT_NE(r.err.find("badwkt.csv: cannot read the layer whole (feature 2: "),
+                std::string::npos)
+          << command << ": " << r.err;
+      EXPECT_EQ(r.out, "") << command;
+    }
+    EXPECT_FALSE(fs::exists(l + ".loci"));
+  }
+}
+
 // Features without points are skipped by `loci index`, which says how many.
 TEST_F(BadInput, IndexCountsTheFeaturesItSkips) {
   const std::string l = write("skips.csv", "id,wkt\n1,POINT EMPTY\n2,\n3,POINT (1 2)\n");
