@@ -672,7 +672,9 @@ const std::vector<Command>& commands() {
          "area (default 0,0,10000,10000, or the --along layer's extent; AIS 8,54.5,13,58 in "
          "lon/lat)"},
         {"--speed", nullptr, "MIN,MAX", "speed range (default 1,10 per time unit; AIS 5,20 knots)"},
-        {"--time", nullptr, "T0", "time of the last reports (default 0; AIS 2023-01-01T00:00:00)"},
+        {"--time", nullptr, "T0",
+         "the last reports are staggered over the half --interval before T0, whole units apart "
+         "(default 0; AIS 2023-01-01T00:00:00)"},
         {"--reports", nullptr, "R", "reports per object (default 3)"},
         {"--interval", nullptr, "S", "time between an object's reports (default 60; AIS: >= 1)"},
         {"--output", "-o", "OUT", "the fleet file"},
