@@ -673,8 +673,8 @@ const std::vector<Command>& commands() {
          "lon/lat)"},
         {"--speed", nullptr, "MIN,MAX", "speed range (default 1,10 per time unit; AIS 5,20 knots)"},
         {"--time", nullptr, "T0",
-         "the last reports are staggered over the half --interval before T0, whole units apart "
-         "(default 0; AIS 2023-01-01T00:00:00)"},
+         "each object's last report at T0 or up to half an --interval before it, in whole time "
+         "units (default 0; AIS 2023-01-01T00:00:00)"},
         {"--reports", nullptr, "R", "reports per object (default 3)"},
         {"--interval", nullptr, "S", "time between an object's reports (default 60; AIS: >= 1)"},
         {"--output", "-o", "OUT", "the fleet file"},
