@@ -572,11 +572,22 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
     return Point2{b.min[0] + (b.max[0] - b.min[0]) * unit(rng),
                   b.min[1] + (b.max[1] - b.min[1]) * unit(rng)};
   };
+  // Uniform over the area: for AIS over the box's surface on the sphere (longitude uniform,
+  // the sine of latitude uniform), not over the local frame's image of it, which a box wide in
+  // longitude distorts (and one spanning all longitudes collapses onto a meridian).
+  auto uniform_point = [&]() {
+    if (!ais) return uniform_in(area);
+    constexpr double kDeg = std::numbers::pi / 180;
+    const double lon = bbox.min[0] + (bbox.max[0] - bbox.min[0]) * unit(rng);
+    const double s0 = std::sin(bbox.min[1] * kDeg), s1 = std::sin(bbox.max[1] * kDeg);
+    const double lat = std::asin(std::clamp(s0 + (s1 - s0) * unit(rng), -1.0, 1.0)) / kDeg;
+    return frame->to_local(lon, lat);
+  };
   std::optional<Lanes> lanes;
   if (o.distribution == Dist::lanes) lanes.emplace(o.along, ais ? &*frame : nullptr);
   std::vector<Point2> centres;
   for (int i = 0; i < 8; ++i)
-    centres.push_back(uniform_in(area));
+    centres.push_back(uniform_point());
   std::normal_distribution<double> spread(0, size / 40);
 
   auto place = [&]() -> std::optional<Start> {
@@ -584,7 +595,7 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
       Start s{};
       s.heading = 2 * std::numbers::pi * unit(rng);
       if (o.distribution == Dist::uniform) {
-        s.p = uniform_in(area);
+        s.p = uniform_point();
       } else if (o.distribution == Dist::clustered) {
         const Point2 c = centres[std::size_t(unit(rng) * double(centres.size())) % centres.size()];
         s.p = {c[0] + spread(rng), c[1] + spread(rng)};

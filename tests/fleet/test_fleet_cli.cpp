@@ -482,6 +482,33 @@ TEST_F(FleetCli, GenerateIsDeterministicAndStaysInTheBox) {
   EXPECT_LT(full, 40u);  // some ticks were incremental
 }
 
+// AIS vessels spread over the whole --bbox, however wide: the box was mapped to a local frame
+// through six of its points, so one 340 degrees wide held every vessel within 18 degrees of
+// its middle, and one around the globe put them all on a meridian.
+TEST_F(FleetCli, GeneratedAisFleetsCoverWideBoxes) {
+  for (const std::string box : {"-170,-60,170,60", "-180,-60,180,60", "8,54.5,13,58"}) {
+    SCOPED_TRACE(box);
+    const std::string out = path("wide.csv");
+    ASSERT_EQ(run_loci("fleet generate --count 400 --seed 3 --format ais --reports 1 --bbox " +
+                       box + " -q -o " + shell_quote(out))
+                  .status,
+              0);
+    const auto rows = csv_rows(read_text(out));
+    ASSERT_EQ(rows.size(), 401u);
+    double x0, y0, x1, y1;
+    ASSERT_EQ(std::sscanf(box.c_str(), "%lf,%lf,%lf,%lf", &x0, &y0, &x1, &y1), 4);
+    // Every vessel inside; each quarter of the longitudes holds about a quarter of them.
+    std::size_t quarter[4] = {};
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+      const double lat = std::stod(rows[i][2]), lon = std::stod(rows[i][3]);
+      EXPECT_TRUE(lon >= x0 && lon <= x1 && lat >= y0 && lat <= y1) << lon << "," << lat;
+      ++quarter[std::min<std::size_t>(3, std::size_t(4 * (lon - x0) / (x1 - x0)))];
+    }
+    for (std::size_t q : quarter)
+      EXPECT_TRUE(q >= 60 && q <= 140) << q;
+  }
+}
+
 TEST_F(FleetCli, HelpDocumentsEverySubcommand) {
   const CliRun top = run_loci("--help"), fleet = run_loci("fleet --help");
   EXPECT_EQ(fleet.status, 0);
