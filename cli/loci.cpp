@@ -426,6 +426,7 @@ int run_fleet_generate(const Args& a) {
   if (a.has("--reports")) o.reports = parse_count("--reports", a.get("--reports"), 1, 100000);
   if (a.has("--interval")) o.interval = parse_nonnegative("--interval", a.get("--interval"));
   o.out_path = a.get("--output");
+  o.progress = progress_bar(a, "generating");
   const std::size_t n = fleet_generate(o, stdout);
   if (!a.has("--quiet"))
     std::fprintf(stderr, "loci: %zu reports of %zu objects written into %s\n", n, o.count,

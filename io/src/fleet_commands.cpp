@@ -646,7 +646,10 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
       throw InvalidArgument(
           "reports would lie beyond 1e150: lower --speed, --interval or --reports");
   };
+  // Placing an object and writing its reports count alike.
+  ProgressTicker ticker(o.progress, double(o.count) * double(1 + o.reports));
   for (std::size_t n = 0; n < o.count; ++n) {
+    ticker.tick(double(n + 1));
     const auto s = place();
     if (!s)
       throw Error("cannot place object " + std::to_string(n + 1) +
@@ -673,11 +676,13 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
 
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
+  std::size_t written = 0;
   if (ais) {
     std::fprintf(f,
                  "MMSI,BaseDateTime,LAT,LON,SOG,COG,Heading,VesselName,IMO,CallSign,VesselType,"
                  "Status,Length,Width,Draft,Cargo,TransceiverClass\n");
     for (const Out& r : rows) {
+      ticker.tick(double(o.count + ++written));
       const Point2 ll = frame->to_lonlat(r.p);
       auto [speed, cog] = frame->course(r.p, r.v);
       cog = std::round(cog * 10) / 10;
@@ -689,10 +694,12 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
     }
   } else {
     std::fprintf(f, "id,t,x,y,vx,vy\n");
-    for (const Out& r : rows)
+    for (const Out& r : rows) {
+      ticker.tick(double(o.count + ++written));
       std::fprintf(f, "%llu,%s,%s,%s,%s,%s\n", static_cast<unsigned long long>(r.id),
                    num(r.t).c_str(), num(r.p[0]).c_str(), num(r.p[1]).c_str(), num(r.v[0]).c_str(),
                    num(r.v[1]).c_str());
+    }
   }
   out.commit();
   return rows.size();

@@ -84,6 +84,7 @@ struct FleetGenerateOptions {
   std::size_t reports = 3;     // reports per object
   double interval = 60;        // time between an object's reports
   std::string out_path;
+  Progress progress;  // over the objects placed, then the rows written
 };
 
 // Returns the number of rows written.
