@@ -483,6 +483,7 @@ struct Lanes {
 
   Lanes(const std::string& path, const LocalFrame* frame) {
     auto ol = detail::open_layer(path, "");
+    if (frame) detail::check_lonlat_system(path, detail::system_of(*ol.layer));
     auto map = [&](const Point2& p) { return frame ? frame->to_local(p[0], p[1]) : p; };
     for (auto& f : *ol.layer) {
       const OGRGeometry* g = f->GetGeometryRef();
@@ -845,7 +846,7 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
   OutputFile out(o.out_path, fallback);
   std::FILE* svg = out.stream();
   detail::write_svg_head(svg, f);
-  if (!o.over.empty()) detail::write_linework(svg, f, o.over, o.over_layer);
+  if (!o.over.empty()) detail::write_linework(svg, f, o.over, o.over_layer, l.ais());
   std::fprintf(svg, "<g stroke=\"#2b6cb0\" stroke-width=\"0.8\" fill=\"none\">\n");
   for (std::size_t i = 0; i < at.size(); ++i)
     std::fprintf(svg, "<path d=\"M%.1f %.1fL%.1f %.1f\"/>\n", f.x(at[i][0]), f.y(at[i][1]),

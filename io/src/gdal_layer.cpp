@@ -249,6 +249,14 @@ void check_same_system(const std::string& a, const std::string& a_system, const 
               system_name(*sb) + "); reproject one into the other's first (ogr2ogr -t_srs)");
 }
 
+void check_lonlat_system(const std::string& path, const std::string& system) {
+  const auto srs = system_from(system);
+  if (!srs || srs->IsGeographic()) return;
+  throw Error(path + " is in a projected coordinate system (" + system_name(*srs) +
+              "), and AIS positions are longitudes and latitudes; reproject it first (ogr2ogr "
+              "-t_srs EPSG:4326)");
+}
+
 std::string geojson_crs_member(const std::string& system) {
   const auto srs = system_from(system);
   if (!srs) return "";

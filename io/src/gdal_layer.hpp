@@ -51,6 +51,11 @@ std::string system_of(const OGRLayer& layer);
 void check_same_system(const std::string& a, const std::string& a_system, const std::string& b,
                        const std::string& b_system);
 
+// Throws loci::Error when the layer at `path` (its system as system_of gives it) is in a
+// projected system: AIS positions are longitudes and latitudes. Any geographic system (WGS 84,
+// ETRS89, NAD83: within metres of each other) or none is taken as theirs.
+void check_lonlat_system(const std::string& path, const std::string& system);
+
 // The "crs" member (with its trailing comma) a GeoJSON text written by hand gives coordinates
 // in `system` (system_of's WKT), as GDAL's GeoJSON writer names it: empty for WGS 84
 // longitudes and latitudes (GeoJSON's own), for no system, or one without an authority code.

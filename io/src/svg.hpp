@@ -42,9 +42,11 @@ inline void write_rect(std::FILE* o, const Frame& f, const Box2& r) {
                f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);
 }
 
+// With `lonlat`, a layer in a projected system is refused (check_lonlat_system).
 inline void write_linework(std::FILE* o, const Frame& f, const std::string& layer_path,
-                           const std::string& layer_name) {
+                           const std::string& layer_name, bool lonlat = false) {
   auto src = open_layer(layer_path, layer_name);
+  if (lonlat) check_lonlat_system(layer_path, system_of(*src.layer));
   std::fprintf(o, "<g fill=\"none\" stroke=\"#555\" stroke-width=\"0.5\">\n");
   // Tenths of a pixel, clamped far outside any canvas (a vertex beyond the frame's range
   // would overflow a long: a layer much larger than a fleet drawn at one point).

@@ -739,6 +739,27 @@ TEST_F(FleetCli, DrawShowsEveryObjectInForceAndEveryConflict) {
   EXPECT_EQ(road_svg.find("922337203685477"), std::string::npos) << road_svg;
   EXPECT_NE(road_svg.find("stroke=\"#555\" stroke-width=\"0.5\">\n<path d=\"M"), std::string::npos)
       << road_svg;
+  // AIS vessels over a layer in a projected system: refused (the layer would land far off the
+  // canvas, in metres read as degrees); a geographic one other than WGS 84 is drawn.
+  for (const auto& [code, status] : {std::pair{"3857", 1}, std::pair{"4258", 0}}) {
+    const std::string projected = write(
+        "sys.geojson",
+        std::string(R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":)"
+                    R"("urn:ogc:def:crs:EPSG::)") +
+            code +
+            R"("}},"features":[{"type":"Feature","properties":{},"geometry":{"type":)"
+            R"("LineString","coordinates":[[10,55],[11,56]]}}]})");
+    const CliRun rp = run_loci("fleet draw " + shell_quote(kSample) + " --over " +
+                               shell_quote(projected) + " -q -o " + shell_quote(none));
+    EXPECT_EQ(rp.status, status) << code << ": " << rp.err;
+    if (status) {
+      EXPECT_EQ(lines(rp.err).size(), 1u) << rp.err;
+      EXPECT_NE(rp.err.find("projected coordinate system (EPSG:3857)"), std::string::npos)
+          << rp.err;
+      EXPECT_FALSE(fs::exists(none));
+    }
+    fs::remove(none);
+  }
   // A layer beyond +-1e150 is refused under the fleet as loci draw refuses it.
   const std::string big =
       write("big.geojson", R"({"type":"FeatureCollection","features":[{"type":"Feature",
