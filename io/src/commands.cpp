@@ -208,7 +208,26 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   return o.str();
 }
 
+namespace {
+
+// Whether `path` is an OGR VRT: a file describing layers whose features live in other files
+// or databases, which a fingerprint of the file does not see change.
+bool is_vrt(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::string head(256, '\0');
+  f.read(head.data(), std::streamsize(head.size()));
+  head.resize(std::size_t(f.gcount()));
+  return head.find("<OGRVRTDataSource") != std::string::npos;
+}
+
+}  // namespace
+
 IndexReport index_layer(const IndexOptions& options) {
+  if (is_vrt(options.layer_path))
+    throw Error(options.layer_path +
+                ": a VRT's features live in its sources, whose changes an index of it would not "
+                "see; query it without an index (loci query builds one in memory), or index "
+                "its source");
   if (options.structure == Structure::rstar || options.structure == Structure::rtree)
     throw InvalidArgument(std::string("--structure ") + to_string(options.structure) +
                           " is built in memory only; a sidecar holds packed-hilbert or packed-str");

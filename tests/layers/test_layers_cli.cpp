@@ -1426,6 +1426,25 @@ TEST_F(LayersCli, SeesEditsToAShapefilesAttributesAndToADirectoryOfShapefiles) {
   expect_error("query " + dir + " --bbox 0,0,9,9", "stale index");
 }
 
+// A VRT's features live in its sources: an index of the VRT would stay "fresh" while they
+// change, so loci index refuses it (in one line, nothing written) and queries build their
+// index in memory, following the source.
+TEST_F(LayersCli, RefusesToIndexAVrtWhoseSourcesItCannotWatch) {
+  const std::string src = path("vsrc.csv"), vrt = path("v.vrt");
+  std::ofstream(src) << "id,WKT\n1,\"POINT (1 1)\"\n2,\"POINT (5 5)\"\n";
+  std::ofstream(vrt) << "<OGRVRTDataSource><OGRVRTLayer name=\"v\"><SrcDataSource "
+                        "relativeToVRT=\"1\">vsrc.csv</SrcDataSource><SrcLayer>vsrc</SrcLayer>"
+                        "<GeometryType>wkbPoint</GeometryType><GeometryField encoding=\"WKT\" "
+                        "field=\"WKT\"/></OGRVRTLayer></OGRVRTDataSource>\n";
+  const CliRun r = run_loci("index " + vrt);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("a VRT's features live in its sources"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(vrt + ".loci"));
+  EXPECT_EQ(run_loci("query " + vrt + " --bbox 0,0,2,2").out, "1\n");
+  std::ofstream(src) << "id,WKT\n1,\"POINT (9 9)\"\n2,\"POINT (1 1)\"\n";
+  EXPECT_EQ(run_loci("query " + vrt + " --bbox 0,0,2,2").out, "2\n");
+}
+
 TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {
   // A copy, so that other tests keep their layer.
   for (const char* ext : {".shp", ".shx", ".dbf"})
