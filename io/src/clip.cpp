@@ -213,6 +213,7 @@ ClipResult clip_layer(const ClipOptions& options) {
   std::string window_system;  // the window layer's coordinate system
   const std::unique_ptr<OGRGeometry> window = window_of(options, window_system);
   refuse_overwriting(options.out_path, options.load.layer_path);
+  refuse_overwriting(options.out_path, sidecar_path_of(options.load), "index");
   if (!options.window_layer.empty()) refuse_overwriting(options.out_path, options.window_layer);
   GDALDriver* driver = detail::driver_for(options.out_path);  // before any work
   OutputDataset out(options.out_path);  // refuses a file holding other layers, before any work

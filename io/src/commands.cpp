@@ -350,10 +350,14 @@ std::string check_sidecar(const std::string& path) {
          std::to_string(i.file_size) + " bytes";
 }
 
+std::string sidecar_path_of(const LoadOptions& o) {
+  return o.index_path.empty() ? default_sidecar_path(o.layer_path) : o.index_path;
+}
+
 LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries* geometries) {
   const bool dynamic =
       o.structure && (*o.structure == Structure::rstar || *o.structure == Structure::rtree);
-  const std::string path = o.index_path.empty() ? default_sidecar_path(o.layer_path) : o.index_path;
+  const std::string path = sidecar_path_of(o);
   if (!o.index_path.empty() && !file_exists(path)) throw Error(path + ": no such index file");
   if (!dynamic && file_exists(path)) {
     Sidecar sc = Sidecar::open(path);
@@ -408,6 +412,7 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
 
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   refuse_overwriting(options.out_path, options.load.layer_path);
+  refuse_overwriting(options.out_path, sidecar_path_of(options.load), "index");
   QueryReport report;
   // A text layer is read whole once, for every thread; an index built in memory hands over
   // the geometries it read.

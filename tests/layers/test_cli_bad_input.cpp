@@ -279,6 +279,23 @@ TEST_F(BadInput, TheInputLayerIsNeverOverwritten) {
   expect_one_line_error(run_loci("query " + shell_quote(path("roads.shp")) + " --bbox 0,0,9,9 -o " +
                                  shell_quote(path("roads.dbf"))));
   EXPECT_EQ(read_text(path("roads.dbf")), dbf);
+  // nor the index the command reads, the layer's own or one given with --index
+  ASSERT_EQ(run_loci("index -q " + shell_quote(l)).status, 0);
+  ASSERT_EQ(
+      run_loci("index -q " + shell_quote(l) + " -o " + shell_quote(path("other.loci"))).status, 0);
+  const std::string sidecar = read_text(l + ".loci"), other = read_text(path("other.loci"));
+  for (const std::string command : {"query " + shell_quote(l) + " --bbox 0,0,9,9",
+                                    "clip " + shell_quote(l) + " --bbox 0,0,9,9"}) {
+    const CliRun own = run_loci(command + " -o " + shell_quote(l + ".loci"));
+    expect_one_line_error(own);
+    EXPECT_NE(own.err.find("it is the index"), std::string::npos) << own.err;
+    const CliRun given = run_loci(command + " --index " + shell_quote(path("other.loci")) + " -o " +
+                                  shell_quote(path("other.loci")));
+    expect_one_line_error(given);
+    EXPECT_NE(given.err.find("it is the index"), std::string::npos) << given.err;
+  }
+  EXPECT_EQ(read_text(l + ".loci"), sidecar);
+  EXPECT_EQ(read_text(path("other.loci")), other);
 }
 
 TEST_F(BadInput, FullDiskAndFullStdoutFailAndKeepTheOldFile) {

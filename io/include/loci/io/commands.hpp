@@ -84,6 +84,9 @@ struct LoadOptions {
   Progress progress;
 };
 
+// The sidecar a load reads when it is there: index_path, or the layer's default one.
+std::string sidecar_path_of(const LoadOptions& options);
+
 // `origin` receives a short description ("sidecar FILE" or "built in memory").
 // With `geometries`, an index built in memory per feature from a text layer hands over the
 // geometries it read (LayerGeometries::adopt).
