@@ -709,8 +709,8 @@ const std::vector<Command>& commands() {
         {"--within", nullptr, "D", "conflict distance (metres for AIS input)"},
         {"--horizon", nullptr, "H", "conflict horizon (seconds for AIS input)"},
         {"--update-fraction", nullptr, "F",
-         "share of the fleet reporting each tick, round robin, with a small random turn (default "
-         "1/60)"},
+         "share of the fleet reporting each tick, round robin, with a small random turn (a "
+         "number from 0 to 1; default 0.0166667, one in 60)"},
         {"--tick", nullptr, "S", "time between ticks (default 1)"},
         {"--seed", nullptr, "S", "random seed of the turns (default 1)"},
         {"--slack", nullptr, "S",

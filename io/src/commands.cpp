@@ -169,6 +169,7 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   }
   o << "features:  " << s.feature_count << '\n';
   o << "geometry: ";
+  if (s.geometry_types.empty()) o << " (no features)";
   for (const auto& [type, count] : s.geometry_types)
     o << ' ' << type << " x" << count;
   o << '\n';

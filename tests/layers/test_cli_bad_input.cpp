@@ -75,6 +75,10 @@ TEST_F(BadInput, EmptyLayerGivesAnEmptyIndexAndEmptyAnswers) {
       const CliRun info = run_loci("info " + shell_quote(l));
       EXPECT_EQ(info.status, 0) << info.err;
       EXPECT_NE(info.out.find("0 entries"), std::string::npos) << info.out;
+      const bool none = std::string(text).find("null") == std::string::npos;
+      EXPECT_NE(info.out.find(none ? "geometry:  (no features)\n" : "geometry:  (none) x1\n"),
+                std::string::npos)
+          << info.out;
       for (const char* q : {"--bbox 0,0,1,1", "--nearest 0,0 -k 3", "--point 0,0", "--within 0,0,5",
                             "--segment 0,0,1,1"}) {
         const CliRun r = run_loci("query " + shell_quote(l) + " " + q);
