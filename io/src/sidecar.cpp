@@ -197,8 +197,6 @@ std::uint64_t hash_bytes(const void* data, std::size_t size, std::uint64_t seed)
   return XXH3_64bits_withSeed(data, size, seed);
 }
 
-namespace {}  // namespace
-
 std::vector<std::string> layer_files(const std::string& layer_path) {
   struct stat st {};
   if (stat_file(layer_path, st) && S_ISDIR(st.st_mode)) {
