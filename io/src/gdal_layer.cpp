@@ -30,15 +30,25 @@ ReadCheck::ReadCheck(std::string path) : path_(std::move(path)) {
   CPLErrorReset();
 }
 
+namespace {
+
+bool read_failed() {
+  const CPLErr e = CPLGetLastErrorType();
+  return e == CE_Failure || e == CE_Fatal;
+}
+
+}  // namespace
+
+void ReadCheck::fail(const std::string& where) const {
+  throw Error(path_ + ": cannot read the layer whole (" + where + CPLGetLastErrorMsg() + ")");
+}
+
 void ReadCheck::feature(std::int64_t fid) const {
-  if (CPLGetLastErrorType() == CE_Failure || CPLGetLastErrorType() == CE_Fatal)
-    throw Error(path_ + ": cannot read the layer whole (feature " + std::to_string(fid) + ": " +
-                CPLGetLastErrorMsg() + ")");
+  if (read_failed()) fail("feature " + std::to_string(fid) + ": ");
 }
 
 void ReadCheck::finish() const {
-  if (CPLGetLastErrorType() == CE_Failure || CPLGetLastErrorType() == CE_Fatal)
-    throw Error(path_ + ": cannot read the layer whole (" + CPLGetLastErrorMsg() + ")");
+  if (read_failed()) fail("");
 }
 
 }  // namespace detail

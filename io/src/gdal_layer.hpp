@@ -90,6 +90,8 @@ class ReadCheck {
   void finish() const;
 
  private:
+  // Throws the failure GDAL's error state holds, `where` (say "feature 2: ") before its text.
+  [[noreturn]] void fail(const std::string& where) const;
   std::string path_;
 };
 

@@ -52,12 +52,13 @@ inline void write_linework(std::FILE* o, const Frame& f, const std::string& laye
   // would overflow a long: a layer much larger than a fleet drawn at one point).
   const auto tenths = [](double v) { return std::lround(std::clamp(v * 10, -1e15, 1e15)); };
   for (auto& feature : *src.layer) {
-    const std::string what = where(layer_path, feature->GetFID());
+    const std::int64_t fid = feature->GetFID();
     detail::for_each_curve(
         feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
           const int n = c.getNumPoints();
           for (int i = 0; i < n; ++i)
-            check_layer_point({c.getX(i), c.getY(i)}, what);
+            if (const Point2 p{c.getX(i), c.getY(i)}; !within_coordinate_range(p))
+              check_layer_point(p, where(layer_path, fid));
           if (n < 2) return;
           std::fprintf(o, "<path d=\"");
           long lx = LONG_MIN, ly = LONG_MIN;

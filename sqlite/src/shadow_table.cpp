@@ -29,27 +29,6 @@ std::string ShadowTable::shadow(const char* suffix) const {
   return format_sql("\"%w\".\"%w_%s\"", schema.c_str(), name.c_str(), suffix);
 }
 
-namespace {
-bool holds_table(sqlite3* db, const char* schema, const std::string& table);
-}  // namespace
-
-bool ShadowTable::find_missing_shadow() {
-  for (const char* s : shadow_suffixes())
-    if (!holds_table(db, schema.c_str(), name + "_" + s)) {
-      missing_shadow = name + "_" + s;
-      return true;
-    }
-  return false;
-}
-
-void ShadowTable::refuse_if_broken() const {
-  if (missing_shadow.empty()) return;
-  throw SqlError{SQLITE_CORRUPT_VTAB,
-                 format_sql("%s %s: the stored index is corrupt: %s is missing (DROP TABLE "
-                            "removes what is left of the table)",
-                            module_name(), name.c_str(), missing_shadow.c_str())};
-}
-
 void ShadowTable::prepare_generation() {
   const std::string meta = shadow("meta");
   get_generation.prepare(db, format_sql("SELECT v FROM %s WHERE k = 'generation'", meta.c_str()));
@@ -178,6 +157,23 @@ bool is_schema(sqlite3* db, std::string_view name) {
 }
 
 }  // namespace
+
+bool ShadowTable::find_missing_shadow() {
+  for (const char* s : shadow_suffixes())
+    if (!holds_table(db, schema.c_str(), name + "_" + s)) {
+      missing_shadow = name + "_" + s;
+      return true;
+    }
+  return false;
+}
+
+void ShadowTable::refuse_if_broken() const {
+  if (missing_shadow.empty()) return;
+  throw SqlError{SQLITE_CORRUPT_VTAB,
+                 format_sql("%s %s: the stored index is corrupt: %s is missing (DROP TABLE "
+                            "removes what is left of the table)",
+                            module_name(), name.c_str(), missing_shadow.c_str())};
+}
 
 ShadowTable* Registry::find(std::string_view schema, std::string_view name) const {
   // The newest first: a table renamed inside a transaction keeps its old object alive, under
