@@ -81,27 +81,31 @@ class ChunkReader {
   const unsigned char* get(std::uint64_t offset, std::uint64_t n) {
     if (offset > size_ || n > size_ - offset) return nullptr;
     if (offset >= at_ && offset + n <= at_ + held_) return buffer_.data() + (offset - at_);
-    const std::uint64_t want = std::min(size_ - offset, std::max<std::uint64_t>(n, chunk_));
+    // A read less than a chunk past what was hashed starts there (the .dbf's deletion marks,
+    // a byte a record): the hash stays whole and the file is read once.
+    const bool fill = hash_ && hashed_ != kBroken && offset > hashed_ && offset - hashed_ < chunk_;
+    const std::uint64_t start = fill ? hashed_ : offset, skip = offset - start;
+    const std::uint64_t want = std::min(size_ - start, std::max<std::uint64_t>(skip + n, chunk_));
     if (buffer_.size() < want) buffer_.resize(want);
     std::uint64_t done = 0;
     while (done < want) {
-      const ssize_t r = ::pread(fd_, buffer_.data() + done, want - done, off_t(offset + done));
+      const ssize_t r = ::pread(fd_, buffer_.data() + done, want - done, off_t(start + done));
       if (r < 0 && errno == EINTR) continue;
       if (r < 0) throw Error(path_ + ": cannot read (" + std::strerror(errno) + ")");
       if (r == 0) break;  // shrunk while read: the caller sees too few bytes
       done += std::uint64_t(r);
     }
-    at_ = offset;
+    at_ = start;
     held_ = done;
     if (hash_ && hashed_ != kBroken) {
-      if (offset > hashed_) {
+      if (start > hashed_) {
         hashed_ = kBroken;  // a gap: the hash needs a pass of its own
-      } else if (offset + done > hashed_) {
-        hash_->update(buffer_.data() + (hashed_ - offset), offset + done - hashed_);
-        hashed_ = offset + done;
+      } else if (start + done > hashed_) {
+        hash_->update(buffer_.data() + (hashed_ - start), start + done - hashed_);
+        hashed_ = start + done;
       }
     }
-    return done >= n ? buffer_.data() : nullptr;
+    return done >= skip + n ? buffer_.data() + skip : nullptr;
   }
 
   // Reads what no get() reached; false when the bytes did not pass in order.
@@ -205,8 +209,7 @@ std::optional<DbfLayout> dbf_layout(ChunkReader& dbf, std::uint64_t count) {
 }
 
 // Whether the .dbf holds exactly `count` records, none deleted.
-bool plain_attributes(const std::string& dbf_path, std::uint64_t count) {
-  ChunkReader dbf(dbf_path);
+bool plain_attributes(ChunkReader& dbf, std::uint64_t count) {
   if (!dbf.is_open()) return false;
   const auto layout = dbf_layout(dbf, count);
   if (!layout) return false;
@@ -367,7 +370,6 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
   if (!headers || kind_of(headers->file_type) == Kind::other) return false;
   const auto [file_type, count] = *headers;
   if (ol.layer->GetFeatureCount(FALSE) != GIntBig(count)) return false;
-  if (!plain_attributes(dbf_path, count)) return false;
   begin(file_type, count, shp.size());
 
   ProgressTicker ticker(progress, double(count));
@@ -394,7 +396,12 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
   items.layer_name = ol.layer->GetName();
   items.has_polygons = is_polygon_type(file_type) && items.features > 0;
   // The fingerprint's hash from the same bytes: the .shp as read, then the other files of
-  // layer_files() (.shx, .dbf), in the order and with the seeds of fingerprint_of().
+  // layer_files() (.shx, .dbf), in the order and with the seeds of fingerprint_of(). The
+  // .dbf must hold exactly `count` records, none deleted (else GDAL reads the layer): its
+  // marks are checked as it is hashed, so that it is read once. (Checked last, a layer with
+  // a deleted record is scanned for nothing; such layers are rare, and GDAL's read of them
+  // costs more than the scan.)
+  bool dbf_checked = false;
   if (shp.hash_rest()) {
     std::uint64_t hash = shp_hash.digest();
     const std::vector<std::string> files = layer_files(path);
@@ -402,10 +409,18 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
     for (std::size_t i = 1; whole && i < files.size(); ++i) {
       StreamHash next(hash);
       ChunkReader rest(files[i], &next);
+      if (files[i] == dbf_path) {
+        if (!plain_attributes(rest, count)) return false;
+        dbf_checked = true;
+      }
       whole = rest.hash_rest();
       hash = next.digest();
     }
     if (whole) items.content_hash = hash;
+  }
+  if (!dbf_checked) {
+    ChunkReader dbf(dbf_path);
+    if (!plain_attributes(dbf, count)) return false;
   }
   return true;
 }

@@ -20,6 +20,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "loci/geom/error.hpp"
@@ -808,6 +809,71 @@ TEST(ShapefileBoxes, DeletedRecordsAndMissingAttributesGoToGdal) {
   const std::string bare = lines_layer("no_dbf", 10);
   fs::remove(fs::path(bare).replace_extension(".dbf"));
   EXPECT_FALSE(loci::io::read_shapefile_boxes(bare));
+}
+
+TEST(ShapefileBoxes, WideAttributesAreCheckedAndHashedInOneRead) {
+  // Records of about 770 bytes: the deletion marks lie past the reads' 256 KiB chunks at
+  // offsets no chunk ends on, so each read of a mark fills the bytes skipped before it.
+  const std::string path = (dir() / "wide.shp").string();
+  constexpr int kCount = 1500;
+  {
+    GDALDriver* d = GetGDALDriverManager()->GetDriverByName("ESRI Shapefile");
+    GDALDatasetUniquePtr ds(d->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    ASSERT_TRUE(ds);
+    OGRLayer* layer = ds->CreateLayer("wide", nullptr, wkbLineString, nullptr);
+    OGRFieldDefn number("n", OFTInteger);
+    layer->CreateField(&number);
+    for (const char* name : {"a", "b", "c"}) {
+      OGRFieldDefn text(name, OFTString);
+      text.SetWidth(254);
+      layer->CreateField(&text);
+    }
+    std::mt19937_64 rng(91);
+    for (int i = 0; i < kCount; ++i) {
+      OGRFeature f(layer->GetLayerDefn());
+      f.SetField(0, i);
+      for (int k = 1; k <= 3; ++k)
+        f.SetField(k, std::string(std::size_t(rng() % 254), char('a' + rng() % 26)).c_str());
+      f.SetGeometryDirectly(random_line(rng, 2 + int(rng() % 4), false).release());
+      ASSERT_EQ(layer->CreateFeature(&f), OGRERR_NONE);
+    }
+  }
+  ASSERT_GT(fs::file_size(fs::path(path).replace_extension(".dbf")), 4u << 18);
+  const auto direct = loci::io::read_shapefile_boxes(path);
+  ASSERT_TRUE(direct);
+  ASSERT_TRUE(direct->items.content_hash);
+  EXPECT_EQ(*direct->items.content_hash, loci::io::fingerprint_of(path).hash);
+  EXPECT_EQ(direct->items.boxes, gdal_reference(path).boxes);
+
+  // Deleted: the first record whose mark lies past the first chunk (read by filling), then
+  // also one near the end. Each time the direct reader sees it and GDAL reads the layer.
+  std::array<unsigned char, 12> header{};
+  {
+    std::ifstream dbf(fs::path(path).replace_extension(".dbf"), std::ios::binary);
+    dbf.read(reinterpret_cast<char*>(header.data()), header.size());
+  }
+  const std::uint64_t header_bytes = header[8] | std::uint64_t(header[9]) << 8,
+                      record_bytes = header[10] | std::uint64_t(header[11]) << 8;
+  ASSERT_GT(record_bytes, 3 * 254u);
+  const std::uint64_t past_chunk = ((256u << 10) - header_bytes + record_bytes - 1) / record_bytes;
+  ASSERT_NE(header_bytes + past_chunk * record_bytes, 256u << 10);
+  for (const GIntBig victim : {GIntBig(past_chunk), GIntBig(kCount - 2)}) {
+    {
+      const char* const options[] = {"AUTO_REPACK=NO", nullptr};
+      GDALDatasetUniquePtr ds(
+          GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, options));
+      ASSERT_EQ(ds->GetLayer(0)->DeleteFeature(victim), OGRERR_NONE);
+    }
+    EXPECT_FALSE(loci::io::read_shapefile_boxes(path)) << "record " << victim << " deleted";
+    EXPECT_FALSE(loci::io::read_shapefile_segments(path)) << "record " << victim << " deleted";
+    const LayerItems items = loci::io::read_items(path, "", Per::feature);
+    const Reference ref = gdal_reference(path);
+    EXPECT_EQ(items.boxes, ref.boxes);
+    ASSERT_EQ(items.records.size(), ref.fids.size());
+    for (std::size_t i = 0; i < ref.fids.size(); ++i)
+      EXPECT_EQ(items.records[i].fid, ref.fids[i]);
+    EXPECT_EQ(std::count(ref.fids.begin(), ref.fids.end(), victim), 0);
+  }
 }
 
 TEST(ShapefileBoxes, MeasuredShapesAndOnePointParts) {
