@@ -679,12 +679,12 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     top.emplace_back(d2, f);
     std::push_heap(top.begin(), top.end());
   };
+  // A polygon holding p is at 0, for candidates too (its boxes need not reach p).
   std::vector<std::uint32_t> inside;
-  if (!candidates_only)
-    for (const std::uint32_t f : containing_features(index_, p, features)) {
-      inside.push_back(f);
-      if (top.size() < q.k) keep(0.0, f);
-    }
+  for (const std::uint32_t f : containing_features(index_, p, features)) {
+    inside.push_back(f);
+    if (top.size() < q.k) keep(0.0, f);
+  }
   // First the candidates: the features in increasing distance of their roots' boxes, each
   // with an upper bound on its distance from one dive down its hierarchy, until a root is
   // no nearer than the k-th smallest upper bound (no feature from there on can rank).
@@ -783,7 +783,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       }
     };
     const ItemRecord* records = features.records.data();
-    if (per_segment && !candidates_only) {
+    if (per_segment) {
       for (const auto fid : containing_polygons(index_, p))
         offer(features.number.at(fid), 0.0);
     }
@@ -814,7 +814,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     auto offer = [&](std::int64_t fid, double t) {
       if (t < best_t || (t == best_t && fid < best_fid)) best_t = t, best_fid = fid;
     };
-    if (per_segment && !candidates_only)
+    if (per_segment)
       for (const auto fid : containing_polygons(index_, s.a))
         offer(fid, 0.0);
     index_.ordered(
@@ -867,9 +867,11 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       }
       return true;
     });
-    if (!candidates_only)
-      for (const auto fid : containing_polygons(index_, region.probe))
-        hit(fid, region.with_distance || q.kind == Query::Kind::segment ? 0.0 : kNaN);
+    // Polygons holding the query (whose segments' boxes it may not meet), for candidates too:
+    // they are part of the exact answer.
+    for (const auto fid : containing_polygons(index_, region.probe))
+      hit(fid, region.with_distance || (q.kind == Query::Kind::segment && !candidates_only) ? 0.0
+                                                                                            : kNaN);
   } else {
     std::vector<std::pair<std::int64_t, Box2>> candidates;
     index_.window(region.search, [&](const ItemRecord& r, const Box2& b) {

@@ -8,11 +8,13 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <map>
 #include <numbers>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -501,8 +503,9 @@ TEST(LayerNearest, FeatureBeyondTheSquaredRangeIsLeftOut) {
   }
 }
 
-// --candidates: each feature at the distance of its nearest segment box (no exact test, no
-// polygon holding the point), against brute force over the boxes, for every structure.
+// --candidates: each feature at the distance of its nearest segment box (no exact distance),
+// a polygon holding the point at 0 (its boxes need not reach the point), against brute force
+// over the boxes and the rings, for every structure.
 TEST(LayerNearest, CandidatesRankFeaturesByTheirBoxes) {
   const Polygons l = star_polygons(150, 31);
   for (const Structure s : {Structure::packed_hilbert, Structure::packed_str, Structure::rstar}) {
@@ -511,15 +514,19 @@ TEST(LayerNearest, CandidatesRankFeaturesByTheirBoxes) {
     LayerQuery query(index, "", "");
     std::mt19937_64 rng(32);
     std::uniform_real_distribution<double> any(-20, 120);
-    std::size_t compared = 0;
+    std::size_t compared = 0, inside = 0;
     for (int i = 0; i < 400; ++i) {
       const Point2 p{any(rng), any(rng)};
       std::map<std::int64_t, double> best;
+      std::map<std::int64_t, bool> odd;
       for (const auto& [fid, seg] : l.rings) {
         const double d = std::sqrt(squared_distance(p, seg.box()));
         const auto [it, fresh] = best.try_emplace(fid, d);
         if (!fresh) it->second = std::min(it->second, d);
+        odd[fid] ^= ray_crosses(seg.a, seg.b, p);
       }
+      for (auto& [fid, d] : best)
+        if (odd[fid]) d = 0, ++inside;
       std::vector<double> distances;
       for (const auto& [fid, d] : best)
         distances.push_back(d);
@@ -538,6 +545,68 @@ TEST(LayerNearest, CandidatesRankFeaturesByTheirBoxes) {
       }
     }
     EXPECT_GT(compared, 2000u);
+    EXPECT_GT(inside, 200u);
+  }
+}
+
+// --candidates per segment holds the exact answer of every kind of query: a window, a point
+// or a segment inside a polygon meets none of its segments' boxes, and the polygon is among
+// the candidates all the same (it was left out), for every structure.
+TEST(LayerNearest, CandidatesPerSegmentHoldTheExactAnswer) {
+  const Polygons l = star_polygons(150, 33);
+  for (const Structure s : {Structure::packed_hilbert, Structure::packed_str, Structure::rstar}) {
+    Polygons copy = l;
+    const LayerIndex index = LayerIndex::build(std::move(copy.items), s);
+    LayerQuery query(index, "", "");
+    std::mt19937_64 rng(34);
+    std::uniform_real_distribution<double> any(-5, 105), size(0, 1.5);
+    std::size_t exact_total = 0, without_boxes = 0, holding = 0;
+    for (int i = 0; i < 1500; ++i) {
+      Query q;
+      const Point2 p{any(rng), any(rng)};
+      q.kind = std::array{Query::Kind::bbox, Query::Kind::point, Query::Kind::segment,
+                          Query::Kind::within, Query::Kind::nearest}[std::size_t(i % 5)];
+      q.box = {p, {p[0] + size(rng), p[1] + size(rng)}};
+      q.point = p;
+      q.segment = {p, {p[0] + size(rng), p[1] - size(rng)}};
+      q.radius = size(rng);
+      q.k = 3;
+      q.first = i % 10 == 2;
+      std::vector<Answer> exact, candidates;
+      query.run(q, 1, false, exact);
+      query.run(q, 1, true, candidates);
+      std::set<std::int64_t> c;
+      for (const Answer& a : candidates)
+        c.insert(a.fid);
+      for (const Answer& a : exact) {
+        if (q.kind == Query::Kind::nearest || q.first) break;  // ranks may differ
+        EXPECT_TRUE(c.count(a.fid)) << "query " << i << " feature " << a.fid;
+        ++exact_total;
+        // Whether a box of its segments met the query's box.
+        const Box2 reach =
+            q.kind == Query::Kind::segment ? q.segment.box()
+            : q.kind == Query::Kind::within
+                ? Box2{{p[0] - q.radius, p[1] - q.radius}, {p[0] + q.radius, p[1] + q.radius}}
+            : q.kind == Query::Kind::point ? Box2::of_point(p)
+                                           : q.box;
+        bool met = false;
+        for (const auto& [fid, seg] : l.rings)
+          met |= fid == a.fid && intersects(seg.box(), reach);
+        without_boxes += !met;
+      }
+      // Nearest: a polygon holding the point ranks at 0 among the candidates too.
+      if (q.kind == Query::Kind::nearest) {
+        const auto at_zero = [](const std::vector<Answer>& answers) {
+          return std::count_if(answers.begin(), answers.end(),
+                               [](const Answer& a) { return a.distance == 0; });
+        };
+        EXPECT_GE(at_zero(candidates), at_zero(exact)) << "query " << i;
+        holding += at_zero(exact) > 0;
+      }
+    }
+    EXPECT_GT(exact_total, 1000u);
+    EXPECT_GT(without_boxes, 100u);
+    EXPECT_GT(holding, 100u);
   }
 }
 

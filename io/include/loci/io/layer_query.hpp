@@ -30,8 +30,9 @@
 // first, is measured exactly by a depth-first descent of its own hierarchy, nearest child
 // first, that drops every node no nearer than the feature's bound or the k-th distance found
 // so far. A feature's many segments never come out one by one. --candidates answers from
-// boxes alone. Thread-safety: a LayerIndex is immutable; a LayerQuery caches geometry
-// and belongs to one thread.
+// boxes alone, with the polygons holding the query (which none of their segments' boxes may
+// meet) added, so that it holds the exact answer. Thread-safety: a LayerIndex is immutable; a
+// LayerQuery caches geometry and belongs to one thread.
 #pragma once
 
 #include <algorithm>
