@@ -214,6 +214,10 @@ namespace {
 // Whether `path` is an OGR VRT: a file describing layers whose features live in other files
 // or databases, which a fingerprint of the file does not see change.
 bool is_vrt(const std::string& path) {
+  // Only a regular file is read: opening a FIFO would wait for a writer (open_layer refuses
+  // it, with a message, once this says no).
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
   std::ifstream f(path, std::ios::binary);
   std::string head(256, '\0');
   f.read(head.data(), std::streamsize(head.size()));

@@ -11,10 +11,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "layers/cli_support.hpp"
 #include "loci/io/atomic_file.hpp"
@@ -176,11 +179,11 @@ TEST_F(BadInput, UnreadableGeometriesAreRefusedNamingTheFeature) {
     const std::string l = write("badwkt.csv", std::string("id,WKT\n1,\"POINT (1 2)\"\n2,\"") + wkt +
                                                   "\"\n3,\"POINT (2 2)\"\n");
     fs::remove(l + ".loci");
-    for (const std::string command :
-         {"query " + shell_quote(l) + " --bbox 0,0,5,5", "info " + shell_quote(l),
-          "index " + shell_quote(l), "index --per segment " + shell_quote(l),
-          "join " + shell_quote(l) + " " + shell_quote(l) + " --closest",
-          "intersections " + shell_quote(l)}) {
+    for (const std::string& command : std::vector<std::string>{
+             "query " + shell_quote(l) + " --bbox 0,0,5,5", "info " + shell_quote(l),
+             "index " + shell_quote(l), "index --per segment " + shell_quote(l),
+             "join " + shell_quote(l) + " " + shell_quote(l) + " --closest",
+             "intersections " + shell_quote(l)}) {
       const CliRun r = run_loci(command);
       expect_one_line_error(r);
       EXPECT_NE(r.err.find("badwkt.csv: cannot read the layer whole (feature 2: "),
@@ -255,6 +258,32 @@ TEST_F(BadInput, DevicesFifosAndLinksAreWrittenThroughNeverReplaced) {
   expect_one_line_error(
       run_loci("query " + shell_quote(l) + " --index " + shell_quote(fifo) + " --bbox 0,0,1,1"));
   expect_one_line_error(run_loci("info " + shell_quote(fifo)));
+  {
+    // ... by every command that reads a layer. A guard opens it for writing after 20 s, so
+    // that a command waiting on it ends (and the test fails) instead of hanging.
+    std::atomic<bool> done{false};
+    std::thread guard([&] {
+      for (int i = 0; !done; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        if (i < 200) continue;
+        const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+        if (fd >= 0) ::close(fd);
+      }
+    });
+    for (const std::string& command : std::vector<std::string>{
+             "index", "index --per feature", "check", "query --bbox 0,0,1,1", "intersections",
+             "draw -o " + shell_quote(path("fifo.svg")),
+             "clip --bbox 0,0,1,1 -o " + shell_quote(path("fifo_clip.geojson"))}) {
+      const auto space = command.find(' ');
+      const std::string verb = command.substr(0, space),
+                        rest = space == std::string::npos ? "" : command.substr(space);
+      const CliRun r = run_loci(verb + " " + shell_quote(fifo) + rest);
+      expect_one_line_error(r);
+      EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << command << ": " << r.err;
+    }
+    done = true;
+    guard.join();
+  }
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(20));
   // a directory as output
   expect_one_line_error(
