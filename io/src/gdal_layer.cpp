@@ -172,6 +172,13 @@ void add_points(const OGRGeometry* g, FlatGeometry& out, const std::string& what
 
 }  // namespace
 
+void check_points(const OGRGeometry* g, const std::string& what) {
+  const auto type = g ? wkbFlatten(g->getGeometryType()) : wkbUnknown;
+  if (type != wkbPoint && type != wkbMultiPoint && type != wkbGeometryCollection) return;
+  FlatGeometry points;
+  add_points(g, points, what);
+}
+
 void for_each_curve(const OGRGeometry* g,
                     const std::function<void(const OGRSimpleCurve&, bool, std::uint32_t)>& f) {
   const auto linear = linear_copy(g);

@@ -68,6 +68,11 @@ std::string geojson_crs_member(const std::string& system);
 // POINT EMPTY as WKB and GeoPackage write it, and is empty.
 bool without_points(const OGRGeometry* g, const std::string& what);
 
+// Checks the isolated points of g (a point, or the points of a collection) as flatten() does:
+// throws InvalidGeometry naming `what` for a NaN, infinite or too large coordinate. For readers
+// of linework only, which skip points but must refuse bad ones like every other reader.
+void check_points(const OGRGeometry* g, const std::string& what);
+
 // Calls f(curve, is_ring, polygon) for every line string and ring of g, in reading order;
 // `polygon` counts the polygons met so far (rings of one polygon share it).
 void for_each_curve(const OGRGeometry* g,

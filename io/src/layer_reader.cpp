@@ -27,22 +27,31 @@ std::vector<SegmentRecord> read_segments(const std::string& path, const std::str
     ticker.tick(double(++seen));
     const std::int64_t fid = feature->GetFID();
     read_check.feature(fid);
+    // Points have no linework, but a bad one (a NaN point GDAL reads as empty, or one in a
+    // multipoint) is bad input here as in every other command.
+    const OGRGeometry* g = feature->GetGeometryRef();
+    if (!g) continue;
+    const auto type = wkbFlatten(g->getGeometryType());
+    if (type == wkbPoint || type == wkbMultiPoint || type == wkbGeometryCollection) {
+      const std::string what = where(path, fid);
+      if (detail::without_points(g, what)) continue;
+      detail::check_points(g, what);
+    }
     std::int32_t part = 0;
-    detail::for_each_curve(feature->GetGeometryRef(),
-                           [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
-                             const int n = c.getNumPoints();
-                             // A curve of one point is that point: a segment of length zero.
-                             for (int i = 0; i + 1 < n || (i == 0 && n == 1); ++i) {
-                               const int j = std::min(i + 1, n - 1);
-                               const Segment<2> s{{c.getX(i), c.getY(i)}, {c.getX(j), c.getY(j)}};
-                               if (!within_coordinate_range(s.a) || !within_coordinate_range(s.b)) {
-                                 detail::check_layer_point(s.a, where(path, fid));
-                                 detail::check_layer_point(s.b, where(path, fid));
-                               }
-                               out.push_back({s, fid, part});
-                             }
-                             ++part;
-                           });
+    detail::for_each_curve(g, [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
+      const int n = c.getNumPoints();
+      // A curve of one point is that point: a segment of length zero.
+      for (int i = 0; i + 1 < n || (i == 0 && n == 1); ++i) {
+        const int j = std::min(i + 1, n - 1);
+        const Segment<2> s{{c.getX(i), c.getY(i)}, {c.getX(j), c.getY(j)}};
+        if (!within_coordinate_range(s.a) || !within_coordinate_range(s.b)) {
+          detail::check_layer_point(s.a, where(path, fid));
+          detail::check_layer_point(s.b, where(path, fid));
+        }
+        out.push_back({s, fid, part});
+      }
+      ++part;
+    });
   }
   read_check.finish();
   return out;

@@ -133,6 +133,10 @@ TEST_F(BadInput, NaNPointsGdalReadsAsEmptyAreRefusedToo) {
     }
     const CliRun join = run_loci("join " + shell_quote(l) + " " + shell_quote(l));
     expect_one_line_error(join);
+    // intersections reads linework only, and refuses such a point all the same
+    const CliRun crossings = run_loci("intersections " + shell_quote(l));
+    expect_one_line_error(crossings);
+    EXPECT_NE(crossings.err.find("feature 1 has a NaN"), std::string::npos) << crossings.err;
   }
 }
 
