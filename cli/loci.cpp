@@ -31,6 +31,11 @@ namespace {
 using namespace loci;
 using namespace loci::io;
 
+// "1 pair", "2 pairs".
+std::string counted(std::uint64_t n, const char* noun) {
+  return std::to_string(n) + ' ' + noun + (n == 1 ? "" : "s");
+}
+
 struct Flag {
   const char* name;   // "--bbox"
   const char* alias;  // "-b" or nullptr
@@ -144,16 +149,13 @@ int run_index(const Args& a) {
   o.progress = progress_bar(a, "indexing");
   const IndexReport r = index_layer(o);
   if (!a.has("--quiet")) {
-    const auto count = [](std::uint64_t n, const char* noun) {
-      return std::to_string(n) + ' ' + noun + (n == 1 ? "" : "s");
-    };
     std::string what = r.per == Per::segment
-                           ? count(r.items, "segment") + " of " + count(r.features, "feature")
-                           : count(r.items, "feature");
+                           ? counted(r.items, "segment") + " of " + counted(r.features, "feature")
+                           : counted(r.items, "feature");
     // Features without points are left out of every index: say how many, or they go unseen.
     std::string skipped;
     if (r.without_geometry > 0)
-      skipped = "; skipped " + count(r.without_geometry, "feature") + " without a geometry";
+      skipped = "; skipped " + counted(r.without_geometry, "feature") + " without a geometry";
     std::fprintf(stderr, "loci: indexed %s of layer '%s' into %s (%llu bytes, %.2f s)%s\n",
                  what.c_str(), r.layer_name.c_str(), r.path.c_str(),
                  static_cast<unsigned long long>(r.bytes), r.seconds, skipped.c_str());
@@ -267,16 +269,19 @@ int run_intersections(const Args& a) {
   o.progress = progress_bar(a, "reading");
   const std::size_t n = write_intersections(o, stdout);
   if (!a.has("--quiet") && !o.out_path.empty())
-    std::fprintf(stderr, "loci: %zu rows written into %s\n", n, o.out_path.c_str());
+    std::fprintf(stderr, "loci: %s written into %s\n", counted(n, "row").c_str(),
+                 o.out_path.c_str());
   return 0;
 }
 
 int run_join(const Args& a) {
   if (a.positional.size() != 2)
     throw UsageError("loci join needs LEFT and RIGHT layers (see loci join --help)");
-  if (a.has("--predicate") == a.has("--closest"))
+  if (a.has("--predicate") && a.has("--closest"))
+    throw UsageError("loci join takes --predicate or --closest, not both");
+  if (!a.has("--predicate") && !a.has("--closest"))
     throw UsageError(
-        "loci join needs one of --predicate intersects|contains|within|dwithin:D and --closest");
+        "loci join needs --predicate intersects|contains|within|dwithin:D or --closest");
   JoinOptions o;
   o.left_path = a.positional[0];
   o.left_name = a.get("--layer");
@@ -294,7 +299,8 @@ int run_join(const Args& a) {
   o.progress = progress_bar(a, "joining");
   const std::size_t n = write_join(o, stdout);
   if (!a.has("--quiet") && !o.out_path.empty())
-    std::fprintf(stderr, "loci: %zu pairs written into %s\n", n, o.out_path.c_str());
+    std::fprintf(stderr, "loci: %s written into %s\n", counted(n, "pair").c_str(),
+                 o.out_path.c_str());
   return 0;
 }
 
@@ -313,8 +319,8 @@ int run_draw(const Args& a) {
   o.progress = progress_bar(a, o.cell_levels >= 0 ? "cells" : "indexing");
   const std::size_t n = draw_index(o);
   if (!a.has("--quiet"))
-    std::fprintf(stderr, "loci: %zu %s drawn into %s\n", n, o.cell_levels >= 0 ? "cells" : "nodes",
-                 o.out_path.c_str());
+    std::fprintf(stderr, "loci: %s drawn into %s\n",
+                 counted(n, o.cell_levels >= 0 ? "cell" : "node").c_str(), o.out_path.c_str());
   return 0;
 }
 
@@ -403,7 +409,8 @@ int run_fleet_conflicts(const Args& a) {
   o.out_path = a.get("--output");
   const FleetRun r = fleet_conflicts(o, stdout);
   print_fleet_run(a, r);
-  if (!a.has("--quiet")) std::fprintf(stderr, "loci: %zu pairs in conflict\n", r.answers);
+  if (!a.has("--quiet"))
+    std::fprintf(stderr, "loci: %s in conflict\n", counted(r.answers, "pair").c_str());
   return 0;
 }
 
@@ -429,8 +436,8 @@ int run_fleet_generate(const Args& a) {
   o.progress = progress_bar(a, "generating");
   const std::size_t n = fleet_generate(o, stdout);
   if (!a.has("--quiet"))
-    std::fprintf(stderr, "loci: %zu reports of %zu objects written into %s\n", n, o.count,
-                 o.out_path.c_str());
+    std::fprintf(stderr, "loci: %s of %s written into %s\n", counted(n, "report").c_str(),
+                 counted(o.count, "object").c_str(), o.out_path.c_str());
   return 0;
 }
 
@@ -450,7 +457,8 @@ int run_fleet_draw(const Args& a) {
   const FleetDrawReport r = fleet_draw(o, stdout);
   print_fleet_run(a, r.run);
   if (!a.has("--quiet"))
-    std::fprintf(stderr, "loci: drew %zu objects and %zu pairs in conflict\n", r.objects, r.pairs);
+    std::fprintf(stderr, "loci: drew %s and %s in conflict\n", counted(r.objects, "object").c_str(),
+                 counted(r.pairs, "pair").c_str());
   return 0;
 }
 
@@ -847,6 +855,8 @@ int main(int argc, char** argv) {
   std::string shown;
   for (unsigned char ch : name.substr(0, 40))
     shown += ch < 0x20 || ch == 0x7f ? '?' : char(ch);
-  std::fprintf(stderr, "loci: error: unknown command '%s' (see loci --help)\n", shown.c_str());
+  const bool fleet = name.rfind("fleet ", 0) == 0;
+  std::fprintf(stderr, "loci: error: unknown command '%s' (see loci %s--help)\n", shown.c_str(),
+               fleet ? "fleet " : "");
   return 1;
 }

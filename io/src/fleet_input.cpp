@@ -476,8 +476,11 @@ double FleetData::latest() const {
 
 std::string FleetData::summary() const {
   const bool ais = format == FleetFormat::ais;
-  return "read " + std::to_string(reports.size()) + (ais ? " AIS reports of " : " reports of ") +
-         std::to_string(objects()) + (ais ? " vessels; " : " objects; ") + skipped.summary();
+  const auto counted = [](std::size_t n, const char* noun) {
+    return std::to_string(n) + ' ' + noun + (n == 1 ? "" : "s");
+  };
+  return "read " + counted(reports.size(), ais ? "AIS report" : "report") + " of " +
+         counted(objects(), ais ? "vessel" : "object") + "; " + skipped.summary();
 }
 
 FleetData read_fleet_csv(std::string_view text, const std::string& source) {

@@ -531,7 +531,16 @@ TEST_F(FleetCli, HelpDocumentsEverySubcommand) {
   }
   const CliRun bogus = run_loci("fleet --bogus");
   EXPECT_EQ(bogus.status, 1);
-  EXPECT_NE(bogus.err.find("unknown command 'fleet --bogus'"), std::string::npos) << bogus.err;
+  EXPECT_NE(bogus.err.find("unknown command 'fleet --bogus' (see loci fleet --help)"),
+            std::string::npos)
+      << bogus.err;
+  // Counts of one are singular.
+  const std::string one = path("one.csv");
+  const CliRun generated = run_loci("fleet generate --count 1 -o " + shell_quote(one));
+  ASSERT_EQ(generated.status, 0) << generated.err;
+  EXPECT_NE(generated.err.find("of 1 object written"), std::string::npos) << generated.err;
+  const CliRun read = run_loci("fleet conflicts " + shell_quote(one) + " --within 1 --horizon 1");
+  EXPECT_NE(read.err.find("reports of 1 object;"), std::string::npos) << read.err;
 }
 
 TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {

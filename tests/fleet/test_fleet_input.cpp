@@ -35,7 +35,7 @@ TEST(FleetCsv, ColumnsByNameInAnyOrderWithExtraColumns) {
   EXPECT_EQ(a.reports, b.reports);
   EXPECT_EQ(a.reports[0], (FleetReport{7, {1, {2, 3}, {4, 5}}}));
   EXPECT_EQ(a.format, FleetFormat::planar);
-  EXPECT_EQ(b.summary(), "read 1 reports of 1 objects; skipped none");
+  EXPECT_EQ(b.summary(), "read 1 report of 1 object; skipped none");
 }
 
 TEST(FleetCsv, QuotingLineBreaksBlankLinesCrLfAndByteOrderMark) {
@@ -81,7 +81,7 @@ TEST(FleetCsv, DuplicateReportsAreSkippedAndCountedTheLastKept) {
   EXPECT_EQ(d.reports[0].m.p, (Point2{8, 8}));
   EXPECT_EQ(d.skipped[SkipReason::duplicate], 2u);
   EXPECT_EQ(d.rows, 3u);
-  EXPECT_EQ(d.summary(), "read 1 reports of 1 objects; skipped 2 (2 duplicate)");
+  EXPECT_EQ(d.summary(), "read 1 report of 1 object; skipped 2 (2 duplicate)");
 }
 
 TEST(FleetCsv, MalformedInputIsOneLineErrorNamingFileAndLine) {

@@ -954,6 +954,8 @@ TEST_F(LayersCli, ReportsBadInput) {
   expect_error("query " + polys + " --bbox 0,0,1,1 -f xml", "unknown format 'xml'");
   expect_error("index " + polys + " --structure rstar", "built in memory only");
   expect_error("frobnicate", "unknown command");
+  expect_error("join " + polys + " " + polys + " --closest --predicate intersects", "not both");
+  expect_error("join " + polys + " " + polys, "needs --predicate");
   const std::string windows = path("bad.windows");
   std::ofstream(windows) << "0,0,1,1\n0,0,x,1\n";
   expect_error("query " + polys + " --bbox-file " + windows, "line 2");
