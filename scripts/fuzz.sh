@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 seconds=${LOCI_FUZZ_SECONDS:-30}
 CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOCI_FUZZ=ON \
   -DLOCI_BUILD_BENCH=OFF >/dev/null
-targets=(sidecar query_text geojson_index fleet_csv ais_csv sql)
+targets=(sidecar query_text geojson_index shapefile fleet_csv ais_csv sql)
 cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}"
 mkdir -p build-fuzz/findings
 for t in "${targets[@]}"; do
