@@ -798,6 +798,17 @@ Args parse(const Command& c, int first, int argc, char** argv) {
     if (i + 1 >= argc) throw UsageError(arg + " needs a value: " + flag->value);
     if (argv[i + 1][0] == '\0')  // `-o ""` would otherwise mean stdout or a default
       throw UsageError(arg + " needs a value: " + flag->value + ", not an empty one");
+    // `-o -` is stdout, as usual, where the output is text that may go there; a command that
+    // writes a file says so (a file named "-" is ./-).
+    if (!std::strcmp(flag->name, "--output") && !std::strcmp(argv[i + 1], "-")) {
+      ++i;
+      if (std::strstr(flag->help, "instead of stdout")) {
+        a.values.erase(flag->name);
+        continue;
+      }
+      throw UsageError(arg + " -: loci " + c.name +
+                       " writes a file, not stdout; name it (./- for a file named -)");
+    }
     a.values[flag->name] = argv[++i];
   }
   return a;

@@ -296,6 +296,19 @@ TEST_F(BadInput, DevicesFifosAndLinksAreWrittenThroughNeverReplaced) {
   expect_one_line_error(run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o ''"));
   expect_one_line_error(run_loci("index " + shell_quote(l) + " -o ''"));
   expect_one_line_error(run_loci("fleet generate --count 3 -o ''"));
+  // `-o -` is stdout where the output may go there; a command writing a file refuses it
+  const std::string cwd = fs::current_path().string();
+  fs::current_path(dir_);
+  const CliRun dash = run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9 -o -");
+  EXPECT_EQ(dash.status, 0) << dash.err;
+  EXPECT_EQ(dash.out, run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9").out);
+  EXPECT_FALSE(dash.out.empty());
+  for (const std::string command :
+       {"index " + shell_quote(l) + " -o -", "clip " + shell_quote(l) + " --bbox 0,0,9,9 -o -",
+        std::string("fleet generate --count 3 -o -")})
+    expect_one_line_error(run_loci(command));
+  EXPECT_FALSE(fs::exists(dir_ / "-"));
+  fs::current_path(cwd);
 }
 
 TEST_F(BadInput, TheInputLayerIsNeverOverwritten) {
