@@ -479,8 +479,12 @@ std::string FleetData::summary() const {
   const auto counted = [](std::size_t n, const char* noun) {
     return std::to_string(n) + ' ' + noun + (n == 1 ? "" : "s");
   };
-  return "read " + counted(reports.size(), ais ? "AIS report" : "report") + " of " +
-         counted(objects(), ais ? "vessel" : "object") + "; " + skipped.summary();
+  std::string s = "read " + counted(reports.size(), ais ? "AIS report" : "report") + " of " +
+                  counted(objects(), ais ? "vessel" : "object") + "; " + skipped.summary();
+  if (heading_not_available)
+    s += "; " + std::to_string(heading_not_available) +
+         " kept with Heading 511 (not available; heading is not used)";
+  return s;
 }
 
 FleetData read_fleet_csv(std::string_view text, const std::string& source) {
@@ -541,11 +545,15 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
   const int cm = require(h, csv, "mmsi", kHeader), cd = require(h, csv, "basedatetime", kHeader),
             clat = require(h, csv, "lat", kHeader), clon = require(h, csv, "lon", kHeader),
             csog = require(h, csv, "sog", kHeader), ccog = require(h, csv, "cog", kHeader);
+  // Heading is not used (the course over ground gives the motion), but its "not available"
+  // (511) is counted, so that the summary says how many reports lacked it.
+  const int cheading = column(h, csv, "heading");
   FleetData out;
   out.format = FleetFormat::ais;
   out.source = source;
   struct Raw {
     double lon, lat, sog, cog;
+    bool no_heading;
   };
   std::vector<Row> rows;  // positions hold lon/lat until projected
   std::vector<Raw> raw;
@@ -608,9 +616,12 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
     row.r.m.t = *t;
     row.r.m.p = {double(raw.size()), 0};  // the index of its raw values, until projected
     rows.push_back(row);
-    raw.push_back({lon, lat, sog, cog});
+    raw.push_back(
+        {lon, lat, sog, cog, cheading >= 0 && number(f[cheading]) == std::optional<double>(511)});
   }
   sort_and_drop_duplicates(rows, out.skipped);
+  for (const Row& r : rows)
+    out.heading_not_available += raw[std::size_t(r.r.m.p[0])].no_heading;
   if (rows.empty()) return out;
   // The frame's centre: the mean position, the longitude averaged on the circle so that a
   // fleet astride the antimeridian is centred on it.

@@ -155,7 +155,9 @@ TEST(FleetAis, EverySentinelBadDateNanAndDuplicateIsSkippedAndCounted) {
             "read 6 AIS reports of 4 vessels; skipped 12 (1 duplicate, 1 LAT not available, 1 LON "
             "not available, 1 SOG not available, 1 COG not available, 1 LAT out of range, 1 LON "
             "out of range, 1 SOG out of range, 1 COG out of range, 1 bad date, 1 NaN, 1 empty "
-            "value)");
+            "value); 1 kept with Heading 511 (not available; heading is not used)");
+  // Heading 511 is counted, not skipped: heading is not used, the course gives the motion.
+  EXPECT_EQ(d.heading_not_available, 1u);
   // Sorted by (MMSI, time); of the two reports at 00:01:00, the later line is kept.
   EXPECT_EQ(d.reports[0].id, 219000001u);
   EXPECT_EQ(d.reports[0].m.t, 1672531200);

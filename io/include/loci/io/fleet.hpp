@@ -131,13 +131,17 @@ struct FleetData {
   std::vector<FleetReport> reports;  // sorted by (id, t), one report per id and time
   std::size_t rows = 0;              // data rows read, kept or skipped
   SkipCounts skipped;
+  // AIS: reports kept whose Heading is 511, "not available" (heading is not used: the course
+  // over ground gives the motion).
+  std::size_t heading_not_available = 0;
   std::optional<LocalFrame> frame;  // AIS: the frame positions and velocities are in
 
   // Distinct ids.
   std::size_t objects() const;
   // The latest report time; -infinity when there is none.
   double latest() const;
-  // "read 1234 AIS reports of 56 vessels; skipped 3 (2 COG not available, 1 duplicate)"
+  // "read 1234 AIS reports of 56 vessels; skipped 3 (2 COG not available, 1 duplicate)", and
+  // "; 5 kept with Heading 511 (not available; heading is not used)" when there are such.
   std::string summary() const;
 };
 
