@@ -11,6 +11,7 @@
 #include "loci/index/moving/fleet.hpp"
 #include "loci/index/moving/moving_grid.hpp"
 #include "loci/index/moving/moving_scan.hpp"
+#include "loci/index/moving/star_tree.hpp"
 #include "loci/index/moving/tpr_tree.hpp"
 
 namespace loci {
@@ -25,7 +26,7 @@ const Motion2* at(const std::map<double, Motion2>& h, double s) {
 
 template <class T>
 class FleetTest : public ::testing::Test {};
-using Indexes = ::testing::Types<MovingScan<2>, TprTree<2>, MovingGrid<2>>;
+using Indexes = ::testing::Types<MovingScan<2>, TprTree<2>, StarTree<2>, MovingGrid<2>>;
 TYPED_TEST_SUITE(FleetTest, Indexes);
 
 TYPED_TEST(FleetTest, AnswersFromTheReportsInForce) {
