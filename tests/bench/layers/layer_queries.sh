@@ -5,7 +5,9 @@
 #      1 MB): median wall time of 7 runs, resident memory, and instructions (valgrind) when
 #      valgrind is installed. Opening must not grow with the file.
 #   2. a --nearest-file batch of N nearest-10 queries (default 10000, fixed seed) on one core
-#      (-j 1) on the coastline sidecar: queries per second, start-up and opening included.
+#      (-j 1) on the coastline sidecar: queries per second, start-up and opening included;
+#      beside it the library's own nearest-10 on the same segment boxes (`loci bench`: a
+#      packed R-tree in memory, random points in the layer's extent) and the ratio.
 # Usage: layer_queries.sh [LOCI_EXE] [N]; LOCI_BENCH_DIR is the working directory. Needs
 # datasets/fetch.sh to have filled the cache.
 set -euo pipefail
@@ -54,3 +56,9 @@ t0=$(date +%s.%N)
 t1=$(date +%s.%N)
 echo "$n nearest-10 on one core: $(awk -v a="$t0" -v b="$t1" -v n="$n" 'BEGIN { printf "%.2f s, %.0f queries/s", b - a, n / (b - a) }')" \
   "($(wc -l < "$work/nearest.out") rows)"
+# The library's own nearest-10 on the same boxes, in one process (the layer read through GDAL
+# first, not timed).
+lib_ms=$("$loci" bench "$work/coast.geojson" --per segment --queries "$n" -k 10 2>/dev/null |
+  awk '/^nearest-n queries/ { print $3 }')
+echo "library nearest-10 on the same boxes: $(awk -v ms="$lib_ms" -v n="$n" 'BEGIN { printf "%.0f queries/s", n / (ms / 1000) }');" \
+  "the command's batch takes $(awk -v ms="$lib_ms" -v a="$t0" -v b="$t1" 'BEGIN { printf "%.1f", (b - a) / (ms / 1000) }')x its time (aim: within 5x)"
