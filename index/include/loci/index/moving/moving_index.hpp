@@ -21,6 +21,10 @@
 //                            InvalidArgument, as it does for the static indexes
 //   for_each(visit)          every object, in the structure's order
 //
+// The trees (TprTree, StarTree) also browse(p, s, visit): the objects in increasing distance
+// from p at time s, visit(id, motion, distance), one at a time until it returns false
+// (distance browsing, as the static trees' browse(); no k fixed in advance).
+//
 // Times. Queries may ask about any time. The trees keep bounds that hold from their clock
 // (the latest report time they were given) onwards; a query reaching back before the clock
 // is still answered exactly, by looking at every object (the cost of a scan).

@@ -320,35 +320,23 @@ class MovingRTree {
 
   template <MotionNearestVisitor<D> F>
   QueryStats nearest(const Point<D>& q, double s, std::size_t k, F&& visit) const {
-    check_point(q, "nearest point");
-    detail::check_nearest_time(s);
     detail::check_nearest_count(k);
-    if (root_ == kNone) return {};
-    const double r = s - epoch_;
-    const bool prune = s >= clock_;
-    auto expand = [&](std::uint64_t ref, detail::BestFirstSink& sink) -> std::size_t {
-      const Node& n = nodes_[std::uint32_t(ref)];
-      double d2[M + 1];
-      if (n.level == 0) {
-        for (int e = 0; e < n.count; ++e)
-          d2[e] = squared_distance(position(n.motion[e], s), q);
-        sink.push_entries(
-            d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); },
-            [&](int e) { return n.id[e]; });
-      } else {
-        for (int e = 0; e < n.count; ++e)
-          d2[e] = prune ? detail::tpbr_distance2(n.box[e], r, q) : 0.0;
-        sink.push_subtrees(d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); });
-      }
-      return n.count;
-    };
-    return detail::best_first(root_, k, expand, [&](Id id, std::uint64_t ref, double d) {
-      detail::check_nearest_distance(d);
-      return visit(id, obj_motion_[std::uint32_t(ref)], d);
+    return walk_nearest(q, s, visit, [k](std::uint64_t root, auto& expand, auto& report) {
+      return detail::best_first(root, k, expand, report);
     });
   }
   std::vector<Neighbor> nearest(const Point<D>& q, double s, std::size_t k) const {
     return collect_neighbors([&](auto&& v) { return nearest(q, s, k, v); });
+  }
+
+  // Calls visit(id, motion, distance) for the objects in increasing distance from q at time s,
+  // one at a time, until it returns false (distance browsing: no k fixed in advance). Times
+  // before the clock are answered too, without pruning by the bounds (kept for now and later).
+  template <MotionNearestVisitor<D> F>
+  QueryStats browse(const Point<D>& q, double s, F&& visit) const {
+    return walk_nearest(q, s, visit, [](std::uint64_t root, auto& expand, auto& report) {
+      return detail::browse(root, expand, report);
+    });
   }
 
   template <MotionVisitor<D> F>
@@ -380,6 +368,38 @@ class MovingRTree {
   }
 
  private:
+  // Runs walk(root, expand, report), detail::best_first or detail::browse, with this tree's
+  // expansion around q at time s (the bounds prune only from the clock on).
+  template <class F, class Walk>
+  QueryStats walk_nearest(const Point<D>& q, double s, F& visit, Walk&& walk) const {
+    check_point(q, "nearest point");
+    detail::check_nearest_time(s);
+    if (root_ == kNone) return {};
+    const double r = s - epoch_;
+    const bool prune = s >= clock_;
+    auto expand = [&](std::uint64_t ref, auto& sink) -> std::size_t {
+      const Node& n = nodes_[std::uint32_t(ref)];
+      double d2[M + 1];
+      if (n.level == 0) {
+        for (int e = 0; e < n.count; ++e)
+          d2[e] = squared_distance(position(n.motion[e], s), q);
+        sink.push_entries(
+            d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); },
+            [&](int e) { return n.id[e]; });
+      } else {
+        for (int e = 0; e < n.count; ++e)
+          d2[e] = prune ? detail::tpbr_distance2(n.box[e], r, q) : 0.0;
+        sink.push_subtrees(d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); });
+      }
+      return n.count;
+    };
+    auto report = [&](Id id, std::uint64_t ref, double d) {
+      detail::check_nearest_distance(d);
+      return visit(id, obj_motion_[std::uint32_t(ref)], d);
+    };
+    return walk(root_, expand, report);
+  }
+
   friend struct MovingRTreeAccess;
   using Box_ = detail::Tpbr<D>;
   static constexpr int kSlots = M + 1;  // one spare entry while overflowing
