@@ -546,8 +546,9 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
             clat = require(h, csv, "lat", kHeader), clon = require(h, csv, "lon", kHeader),
             csog = require(h, csv, "sog", kHeader), ccog = require(h, csv, "cog", kHeader);
   // Heading is not used (the course over ground gives the motion), but its "not available"
-  // (511) is counted, so that the summary says how many reports lacked it.
-  const int cheading = column(h, csv, "heading");
+  // (511) is counted, so that the summary says how many reports lacked it (not when the header
+  // names it twice: a column loci does not use is no reason to refuse the file).
+  const int cheading = h.twice("heading") ? -1 : h.find("heading");
   FleetData out;
   out.format = FleetFormat::ais;
   out.source = source;
