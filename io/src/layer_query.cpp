@@ -2,6 +2,7 @@
 #include "loci/io/layer_query.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -432,10 +433,24 @@ LayerIndex::Features LayerIndex::build_features(const PackedRTree2* t, Per per,
   if (t->levels() == 1)
     for (std::size_t pos = 0; pos < n; ++pos)
       only_leaf.expand(t->box_at(pos));
+  // Each part's slots: which of the leaf's entries are the feature's, and which of those run
+  // antidiagonally.
+  auto slots_of = [&](const Part& part) {
+    std::uint32_t slots = 0;
+    const std::size_t first = std::size_t(part.leaf) * kFanout;
+    const std::size_t end = std::min<std::size_t>(first + kFanout, n);
+    for (std::size_t pos = first; pos < end; ++pos) {
+      if (feature_at(pos) != part.feature) continue;
+      const std::uint32_t e = std::uint32_t(pos - first);
+      slots |= 1u << e;
+      if (records[items[pos]].flags & item_antidiagonal) slots |= 1u << (kFanout + e);
+    }
+    return slots;
+  };
   loci::detail::LargeVector<Features::Node> level(parts.size());
   for (const Part& part : parts)
     level[start[part.feature]++] = {t->levels() > 1 ? t->entry_box(1, part.leaf) : only_leaf,
-                                    part.feature, part.leaf, part.leaf, 0};
+                                    part.feature, part.leaf, part.leaf, slots_of(part)};
   parts = {};
   // Then up to 16 nodes of one feature per node, until each feature has one node, its root.
   while (!level.empty()) {
@@ -585,27 +600,29 @@ struct FeatureDescent {
   double near2 = near_zone_squared(p, tree.bounds());
   mutable std::size_t visits = 0;  // nodes read by this query's walks (Features::node_count)
 
-  void operator()(std::uint32_t level, std::uint32_t i, double& best, bool touched) const {
+  // `skip` is a leaf (level 0 node) already measured into best (by dive), not read again.
+  void operator()(std::uint32_t level, std::uint32_t i, double& best, bool touched,
+                  std::uint32_t skip = kNoLeaf) const {
     if (++visits > 2 * features.node_count) features.corrupt();
     const LayerIndex::Features::Node& node = features.node(level, i, touched);
     if (level == 0) {
       const std::size_t first = std::size_t(node.first) * PackedRTree2::node_size;
-      const int used = int(std::min<std::size_t>(PackedRTree2::node_size, tree.size() - first));
+      const std::size_t used = std::min<std::size_t>(PackedRTree2::node_size, tree.size() - first);
       const PackedRTree2::Block& leaf = tree.leaf(node.first);
       double box2[PackedRTree2::Block::kSlots];
       leaf.squared_distances(p, box2);
-      const std::int64_t fid = features.fid_of(node.feature);
-      const std::uint32_t* ids = features.leaf_items(node.first);
-      for (int e = 0; e < used; ++e) {
+      // The feature's slots among those the leaf uses (the node says which they are).
+      constexpr unsigned kAnti = PackedRTree2::node_size;
+      for (std::uint32_t mine = node.slots & ((1u << used) - 1); mine != 0; mine &= mine - 1) {
+        const int e = std::countr_zero(mine);
         if (!(box2[e] < best)) continue;
-        const ItemRecord* r = features.record(ids[e]);
-        if (!r || r->fid != fid) continue;
         if (boxes_only) {
           best = box2[e];
           continue;
         }
         // A segment is no nearer than its box, so only those whose box is nearer are measured.
-        const Segment2 s = segment_of(leaf.box(e), r->flags);
+        const Segment2 s =
+            segment_of(leaf.box(e), (node.slots >> (kAnti + e)) & 1 ? item_antidiagonal : 0u);
         const double d2 = squared_distance(p, s);
         // Measured exactly where rounding could be much of it (a point on the segment: 0),
         // also when the rounded value does not beat the best (which may be rounded too).
@@ -622,7 +639,7 @@ struct FeatureDescent {
     int n = 0;
     for (std::uint32_t c = 0; c < below.size(); ++c) {
       const double c2 = squared_distance(p, below[c].box);
-      if (!(c2 < best)) continue;
+      if (!(c2 < best) || (level == 1 && node.first + c == skip)) continue;
       if (level == 1 && below[c].first < features.leaves) {
         // The leaf will likely be read: its loads overlap the work before it.
         tree.prefetch_leaf(below[c].first);
@@ -633,13 +650,18 @@ struct FeatureDescent {
       order[j] = {c2, node.first + c};
     }
     for (int j = 0; j < n && order[j].d2 < best; ++j)
-      (*this)(level - 1, order[j].node, best, true);
+      (*this)(level - 1, order[j].node, best, true, skip);
   }
+
+  static constexpr std::uint32_t kNoLeaf = std::numeric_limits<std::uint32_t>::max();
 
   // An upper bound on the squared distance of the feature of node (level, i): the nearest
   // child at every level down to one leaf, measured there (infinity when that leaf holds none
   // of its segments, in a corrupt index, or when every child's squared distance overflows).
-  double dive(std::uint32_t level, std::uint32_t i) const {
+  // `leaf` is set to the leaf measured (kNoLeaf when none was): the bound is the least
+  // distance of the feature's segments there, so a descent need not read it again.
+  double dive(std::uint32_t level, std::uint32_t i, std::uint32_t& leaf) const {
+    leaf = kNoLeaf;
     bool touched = false;  // node (level, i) was read as a child
     for (; level > 0; --level, touched = true) {
       if (++visits > 2 * features.node_count) features.corrupt();
@@ -654,6 +676,7 @@ struct FeatureDescent {
     }
     double best = std::numeric_limits<double>::infinity();
     (*this)(0, i, best, touched);
+    leaf = i;
     return best;
   }
 };
@@ -702,8 +725,9 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     const auto [level, i] = features.root(r);
     const std::uint32_t f = features.node(level, i).feature;
     if (std::find(inside.begin(), inside.end(), f) != inside.end()) return true;
-    const double upper = descend.dive(level, i);
-    candidates.push_back({upper, lower, std::uint32_t(r)});
+    std::uint32_t leaf;
+    const double upper = descend.dive(level, i, leaf);
+    candidates.push_back({upper, lower, std::uint32_t(r), leaf});
     if (bounds.size() == q.k) {
       if (!(upper < bounds.front())) return true;
       std::pop_heap(bounds.begin(), bounds.end());
@@ -725,7 +749,7 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     if (!(c.lower < limit)) continue;
     const auto [level, i] = features.root(c.root);
     double best = std::min(c.upper, limit);
-    descend(level, i, best, false);
+    if (level > 0 || i != c.leaf) descend(level, i, best, false, c.leaf);
     if (best < limit) keep(best, features.node(level, i).feature);
   }
   std::sort_heap(top.begin(), top.end());

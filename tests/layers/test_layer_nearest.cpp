@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -295,23 +296,70 @@ TEST(LayerNearest, ForgedHierarchiesAreRefusedWhenRead) {
 }
 
 // Hierarchies that stay within their arrays but are not those of the segments (two nodes'
-// boxes swapped) may answer wrongly; loci check compares them with the segments' and says so.
+// boxes swapped, a leaf's slot given to the wrong feature or the wrong diagonal) may answer
+// wrongly; loci check compares them with the segments' and says so.
 TEST(LayerNearest, CheckComparesTheStoredHierarchiesWithTheSegments) {
   const Layer l = interleaved(40, 200, 18);
   const std::string path = scratch("check");
   write_with_hierarchies(l.items, path);
   EXPECT_NE(check_sidecar(path).find(": ok,"), std::string::npos);
-  write_with_hierarchies(l.items, path, [](Levels& levels, std::vector<HierarchyRoot>&) {
-    std::swap(levels[0][3].box, levels[0][levels[0].size() - 4].box);
-  });
-  try {
-    check_sidecar(path);
-    ADD_FAILURE() << "a hierarchy unlike the segments' passed loci check";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("feature hierarchies do not match"), std::string::npos)
-        << e.what();
+  const std::vector<std::pair<const char*, Tamper>> tampers = {
+      {"boxes swapped",
+       [](Levels& levels, std::vector<HierarchyRoot>&) {
+         std::swap(levels[0][3].box, levels[0][levels[0].size() - 4].box);
+       }},
+      {"a slot dropped",
+       [](Levels& levels, std::vector<HierarchyRoot>&) {
+         std::uint32_t& slots = levels[0][5].slots;
+         slots &= ~(1u << std::countr_zero(slots));
+       }},
+      {"a diagonal turned",
+       [](Levels& levels, std::vector<HierarchyRoot>&) {
+         std::uint32_t& slots = levels[0][7].slots;
+         slots ^= 1u << (16 + std::countr_zero(slots));
+       }},
+  };
+  for (const auto& [what, tamper] : tampers) {
+    write_with_hierarchies(l.items, path, tamper);
+    try {
+      check_sidecar(path);
+      ADD_FAILURE() << what << ": a hierarchy unlike the segments' passed loci check";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("feature hierarchies do not match"), std::string::npos)
+          << what << ": " << e.what();
+    }
   }
   ::unlink(path.c_str());
+}
+
+// A level-0 node says which of its leaf's slots hold the feature's segments and which of those
+// run antidiagonally: exactly what the records give.
+TEST(LayerNearest, LeafSlotsAreTheFeaturesSegments) {
+  const Layer l = interleaved(40, 200, 19);
+  const PackedRTree2 tree = PackedRTree2::build(l.items.boxes);
+  const LayerIndex::Features f = LayerIndex::build_features(&tree, Per::segment, l.items.records);
+  ASSERT_TRUE(f.hierarchical);
+  const auto items = tree.item_indices();
+  std::size_t anti = 0, seen = 0;
+  for (const HierarchyNode& node : f.levels[0]) {
+    std::uint32_t expect = 0;
+    for (std::size_t e = 0; e < PackedRTree2::node_size; ++e) {
+      const std::size_t pos = std::size_t(node.first) * PackedRTree2::node_size + e;
+      if (pos >= tree.size()) break;
+      const ItemRecord& r = l.items.records[items[pos]];
+      if (r.fid != f.fid[node.feature]) continue;
+      expect |= 1u << e;
+      if (r.flags & item_antidiagonal) expect |= 1u << (16 + e), ++anti;
+      ++seen;
+    }
+    EXPECT_EQ(node.slots, expect);
+  }
+  EXPECT_EQ(seen, tree.size()) << "every segment in exactly one node";
+  EXPECT_GT(anti, 0u);
+  EXPECT_LT(anti, seen);
+  for (std::size_t level = 1; level < f.levels.size(); ++level)
+    for (const HierarchyNode& node : f.levels[level])
+      EXPECT_EQ(node.slots, 0u);
 }
 
 // Opening costs the same whatever the file's size for nearest-n too: one query verifies the

@@ -1329,11 +1329,15 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
   EXPECT_GT(refused, 4u);
   put(good + "extra");
   expect_error(query, "damaged index");
-  // A sidecar of the previous format (whose nearest-n built the hierarchies at every run).
-  std::string older = good;
-  older[8] = 2;
-  put(older);
-  expect_error(query, "index format version 2, this loci reads 3; run 'loci index' to rebuild it");
+  // Sidecars of earlier formats: 2 (nearest-n built the hierarchies at every run), 3 (their
+  // level-0 nodes did not say which of the leaf's slots are the feature's).
+  for (const int version : {2, 3}) {
+    std::string older = good;
+    older[8] = char(version);
+    put(older);
+    expect_error(query, "index format version " + std::to_string(version) +
+                            ", this loci reads 4; run 'loci index' to rebuild it");
+  }
   put(good);
   EXPECT_EQ(run_loci(query).status, 0);
   const CliRun ok = run_loci("check " + sidecar);

@@ -344,6 +344,7 @@ class LayerQuery {
   struct Candidate {
     double upper, lower;
     std::uint32_t root;
+    std::uint32_t leaf;  // the leaf whose segments gave `upper`, not read again
   };
   std::vector<Candidate> candidates_;
 };

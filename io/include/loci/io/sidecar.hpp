@@ -1,7 +1,7 @@
 // The sidecar index file (`LAYER.loci`, DESIGN.md section 7): a packed R-tree over a layer's
 // features or segments, saved so that later queries map it into memory and search it in place.
 //
-// Layout (little-endian, every offset a multiple of 64 from the start of the file), format 3:
+// Layout (little-endian, every offset a multiple of 64 from the start of the file), format 4:
 //
 //   0    header, 256 bytes (SidecarHeader in sidecar.cpp): magic "\x89LOCI\r\n\x1a", format
 //        version, byte-order mark, structure kind, packing, coordinate type, granularity (per
@@ -19,7 +19,7 @@
 //        LayerIndex::Features), each array from a 64-byte boundary: the FID of every feature
 //        (int64), the node count of every level (uint64), the roots (HierarchyRoot: level and
 //        node, one per feature), the nodes of every level, level 0 first (HierarchyNode, 48
-//        bytes: box, feature, first, last, zero), and a packed tree over the roots' boxes
+//        bytes: box, feature, first, last, slots), and a packed tree over the roots' boxes
 //        (blocks, then item indices, as above; its entry r is root r)
 //
 // The hierarchies are what `loci index` builds from the tree and the records; storing them
@@ -41,8 +41,10 @@
 // chunk is read and never answers; `loci check` verifies every chunk and the tree's invariants.
 // Item ids read from the file are bounds-checked where they index the records, so even a file
 // forged with valid checksums cannot make a query read outside the mapping. Format 1 (one
-// checksum over the whole payload, hashed on every open) and format 2 (no hierarchies: every
-// nearest-n run read all the records to build them) are refused with the usual message.
+// checksum over the whole payload, hashed on every open), format 2 (no hierarchies: every
+// nearest-n run read all the records to build them) and format 3 (level-0 nodes without their
+// slots: nearest-n read an item index and a record for every box it measured) are refused with
+// the usual message.
 //
 // Fingerprint. The index is valid for the exact bytes it was built from: at index time the
 // source's size, modification time (nanoseconds), inode and a 64-bit XXH3 hash of its contents
@@ -107,7 +109,11 @@ struct HierarchyNode {
   std::uint32_t feature;      // the feature's number, an index into the FIDs
   std::uint32_t first, last;  // level 0: the leaf of the tree (first == last); above: the
                               // nodes [first, last) of the level below
-  std::uint32_t zero = 0;     // padding, written as 0
+  // Level 0: bit e (e < 16) is set when slot e of the leaf holds one of the feature's
+  // segments, and bit 16 + e when that segment runs antidiagonally (item_antidiagonal), so
+  // that nearest-n measures the feature's segments from the leaf's boxes alone, without
+  // reading item indices or records. Above level 0: 0.
+  std::uint32_t slots = 0;
 };
 static_assert(sizeof(HierarchyNode) == 48);
 
