@@ -44,10 +44,27 @@ Linework::Linework(const std::vector<SegmentRecord>& recs) {
   }
 }
 
+namespace {
+
+// A layer whose features are all points has no linework to intersect: answering "no
+// intersections" would read as if its lines did not cross, so it is refused. (A layer
+// without features has nothing to intersect either way and answers nothing.)
+void check_has_linework(const Linework& l, const std::string& path, const std::string& name) {
+  if (!l.segs.empty()) return;
+  const std::size_t features = read_envelopes(path, name).size();
+  if (features > 0)
+    throw InvalidArgument(path + ": no lines or polygon rings to intersect (its " +
+                          std::to_string(features) +
+                          (features == 1 ? " feature is a point" : " features are points") + ")");
+}
+
+}  // namespace
+
 std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o,
                                                 std::string* system) {
   std::string left_system;
   const Linework left(read_segments(o.layer_path, o.layer_name, o.progress, &left_system));
+  check_has_linework(left, o.layer_path, o.layer_name);
   if (system) *system = left_system;
   // The layer given twice (however its path is spelled, and by name or as the default first
   // layer) is the layer against itself.
@@ -56,6 +73,7 @@ std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o,
     return intersection_rows(left, nullptr, o.pairs_only, o.jobs);
   std::string right_system;
   const Linework right(read_segments(o.other_path, o.other_name, o.progress, &right_system));
+  check_has_linework(right, o.other_path, o.other_name);
   detail::check_same_system(o.layer_path, left_system, o.other_path, right_system);
   return intersection_rows(left, &right, o.pairs_only, o.jobs);
 }

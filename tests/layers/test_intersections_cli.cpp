@@ -275,6 +275,29 @@ TEST(IntersectionsCli, HandCasesFormatsAndErrors) {
   const CliRun ids = run_loci("intersections " + shell_quote(p.string()) + " -f ids");
   EXPECT_EQ(ids.status, 1);
   EXPECT_NE(ids.err.find("loci: error:"), std::string::npos);
+  // A layer of points has no linework: refused (not "no intersections"), alone or as either
+  // layer; a layer without features answers nothing.
+  const fs::path points = dir / "points.geojson", empty = dir / "empty.geojson";
+  std::ofstream(points) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1,0]}},
+{"type":"Feature","properties":{},"geometry":{"type":"MultiPoint","coordinates":[[3,0],[4,0]]}}]})";
+  std::ofstream(empty) << R"({"type":"FeatureCollection","features":[]})";
+  const std::string point_layer = shell_quote(points.string());
+  for (const std::string& cmd :
+       {"intersections " + point_layer, "intersections " + hand + " " + point_layer,
+        "intersections " + point_layer + " " + hand}) {
+    const CliRun r = run_loci(cmd);
+    EXPECT_EQ(r.status, 1) << cmd;
+    EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_NE(r.err.find(points.string() +
+                         ": no lines or polygon rings to intersect (its 2 features are points)"),
+              std::string::npos)
+        << cmd << ": " << r.err;
+    EXPECT_EQ(r.out, "") << cmd;
+  }
+  const CliRun nothing = run_loci("intersections " + shell_quote(empty.string()));
+  EXPECT_EQ(nothing.status, 0) << nothing.err;
+  EXPECT_EQ(nothing.out, "fid_a,fid_b,x,y\n");
   const CliRun none = run_loci("intersections");
   EXPECT_EQ(none.status, 1);
   const CliRun missing = run_loci("intersections " + shell_quote((dir / "nope.shp").string()));
