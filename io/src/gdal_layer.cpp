@@ -154,6 +154,17 @@ std::unique_ptr<OGRGeometry> linear_copy(const OGRGeometry* g) {
 }
 
 void add_points(const OGRGeometry* g, FlatGeometry& out, const std::string& what) {
+  for_each_point(g, what, [&](const Point2& q) {
+    const auto at = std::uint32_t(out.points.size());
+    out.points.push_back(q);
+    out.parts.push_back({at, at + 1, PartKind::point, 0});
+  });
+}
+
+}  // namespace
+
+void for_each_point(const OGRGeometry* g, const std::string& what,
+                    const std::function<void(const Point2&)>& f) {
   if (!g) return;
   const auto type = wkbFlatten(g->getGeometryType());
   if (type == wkbPoint) {
@@ -161,22 +172,15 @@ void add_points(const OGRGeometry* g, FlatGeometry& out, const std::string& what
     if (without_points(p, what)) return;
     const Point2 q{p->getX(), p->getY()};
     check_layer_point(q, what);
-    const auto at = std::uint32_t(out.points.size());
-    out.points.push_back(q);
-    out.parts.push_back({at, at + 1, PartKind::point, 0});
+    f(q);
   } else if (type == wkbMultiPoint || type == wkbGeometryCollection) {
     for (const auto* part : *g->toGeometryCollection())
-      add_points(part, out, what);
+      for_each_point(part, what, f);
   }
 }
 
-}  // namespace
-
 void check_points(const OGRGeometry* g, const std::string& what) {
-  const auto type = g ? wkbFlatten(g->getGeometryType()) : wkbUnknown;
-  if (type != wkbPoint && type != wkbMultiPoint && type != wkbGeometryCollection) return;
-  FlatGeometry points;
-  add_points(g, points, what);
+  for_each_point(g, what, [](const Point2&) {});
 }
 
 void for_each_curve(const OGRGeometry* g,

@@ -73,6 +73,12 @@ bool without_points(const OGRGeometry* g, const std::string& what);
 // of linework only, which skip points but must refuse bad ones like every other reader.
 void check_points(const OGRGeometry* g, const std::string& what);
 
+// Calls f(p) for every isolated point of g (a point, or the points of a multipoint or
+// collection, in reading order), each checked as check_points() checks it; empty points are
+// skipped.
+void for_each_point(const OGRGeometry* g, const std::string& what,
+                    const std::function<void(const Point2&)>& f);
+
 // Calls f(curve, is_ring, polygon) for every line string and ring of g, in reading order;
 // `polygon` counts the polygons met so far (rings of one polygon share it).
 void for_each_curve(const OGRGeometry* g,

@@ -1,7 +1,7 @@
 // The drawing primitives of loci's SVG output (`loci draw`, `loci fleet draw`): a frame from
 // world coordinates to pixels (y up, the world's width fitted to the drawing's), rectangles,
-// and a layer's linework, projected and rounded to a tenth of a pixel with consecutive points
-// that round together dropped.
+// and a layer's linework (its isolated points as dots), projected and rounded to a tenth of a
+// pixel with consecutive points that round together dropped.
 #pragma once
 
 #include <algorithm>
@@ -71,6 +71,11 @@ inline void write_linework(std::FILE* o, const Frame& f, const std::string& laye
           }
           std::fprintf(o, "\"/>\n");
         });
+    // Isolated points (a point layer, the points of a collection) as dots.
+    detail::for_each_point(feature->GetGeometryRef(), where(layer_path, fid), [&](const Point2& p) {
+      std::fprintf(o, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"1.5\" fill=\"#555\"/>\n",
+                   tenths(f.x(p[0])) / 10.0, tenths(f.y(p[1])) / 10.0);
+    });
   }
   std::fprintf(o, "</g>\n");
 }

@@ -565,6 +565,29 @@ TEST_F(LayersCli, DrawWritesAnSvg) {
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_NE(svg.find("<rect x="), std::string::npos);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  EXPECT_EQ(svg.find("<circle"), std::string::npos) << "a layer of lines has no dots";
+  // The isolated points of a layer are drawn as dots, one per point, a collection's too.
+  const std::string points = path("draw-points.geojson");
+  std::ofstream(points) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[0,0]}},
+{"type":"Feature","properties":{},"geometry":{"type":"MultiPoint","coordinates":[[4,2],[2,4]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"GeometryCollection","geometries":[
+{"type":"LineString","coordinates":[[0,4],[4,4]]},{"type":"Point","coordinates":[4,0]}]}}]})";
+  const std::string dots = path("points.svg");
+  const CliRun p = run_loci("draw " + points + " -q -o " + dots);
+  ASSERT_EQ(p.status, 0) << p.err;
+  const std::string drawn = read_text(dots);
+  std::size_t circles = 0;
+  for (std::size_t at = drawn.find("<circle"); at != std::string::npos;
+       at = drawn.find("<circle", at + 1))
+    ++circles;
+  EXPECT_EQ(circles, 4u) << drawn;
+  // Corners of the 4 x 4 extent at 1200 pixels: (0,0) at the bottom left, (4,0) bottom right.
+  EXPECT_NE(drawn.find("<circle cx=\"0.0\" cy=\"1200.0\""), std::string::npos) << drawn;
+  EXPECT_NE(drawn.find("<circle cx=\"1200.0\" cy=\"1200.0\""), std::string::npos) << drawn;
+  EXPECT_NE(drawn.find("<path d=\"M0.0 0.0L1200.0 0.0\"/>"), std::string::npos) << drawn;
+  fs::remove(points);
+  fs::remove(dots);
 }
 
 TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
