@@ -41,6 +41,9 @@ struct Flag {
   const char* alias;  // "-b" or nullptr
   const char* value;  // "XMIN,YMIN,XMAX,YMAX", nullptr for a switch
   const char* help;
+  // For --output: the output is text that may go to stdout, so `-o -` means stdout (commands
+  // that write a file refuse it).
+  bool stdout_allowed = false;
 };
 
 struct Args {
@@ -546,7 +549,7 @@ const std::vector<Command>& commands() {
          "the index's answer before the exact test (it holds the exact answer)"},
         {"--format", "-f", "ids|csv|geojson",
          "output: FIDs (default), CSV with attributes, GeoJSON"},
-        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         {"--jobs", "-j", "N", "threads for a batch file (default: one per core)"},
         kIndex,
         kStructure,
@@ -583,7 +586,7 @@ const std::vector<Command>& commands() {
        {{"--format", "-f", "csv|geojson",
          "CSV `fid_a,fid_b,x,y` (default) or GeoJSON points with both FIDs"},
         {"--pairs-only", nullptr, nullptr, "only the feature pairs (`fid_a,fid_b`)"},
-        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         {"--jobs", "-j", "N", "threads (default: one per core; the rows do not depend on it)"},
         kLayer,
         {"--layer2", nullptr, "NAME", "layer of LAYER2 (default: its first)"},
@@ -606,7 +609,7 @@ const std::vector<Command>& commands() {
         {"--format", "-f", "csv|ids",
          "CSV `fid_left,fid_right` (plus `distance` for dwithin and --closest; default) or "
          "`LEFT RIGHT` lines"},
-        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         kLayer,
         {"--layer2", nullptr, "NAME", "layer of RIGHT (default: its first)"},
         kQuiet},
@@ -646,7 +649,7 @@ const std::vector<Command>& commands() {
         {"--during", nullptr, "T1,T2", "objects in the window at some time of [T1, T2]"},
         {"--format", "-f", "ids|csv|geojson",
          "ids (default), CSV id,[distance,]t,x,y (AIS: lon,lat, metres), GeoJSON points"},
-        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         kQuiet},
        "  loci fleet query fleet.csv --bbox 0,0,100,100 --at 30\n"
        "  loci fleet query ais.csv --nearest 10.5,56.0 -k 5 -f csv\n",
@@ -661,7 +664,7 @@ const std::vector<Command>& commands() {
         {"--format", "-f", "csv|geojson",
          "CSV id_a,id_b,tcpa,dcpa,t_enter,t_exit,... (default) or GeoJSON lines between the "
          "two positions at tcpa"},
-        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout"},
+        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         kQuiet},
        "  loci fleet conflicts fleet.csv --within 5 --horizon 60\n"
        "  loci fleet conflicts ais.csv --within 1852 --horizon 1800 -f geojson -o cpa.geojson\n",
@@ -705,7 +708,7 @@ const std::vector<Command>& commands() {
         {"--horizon", nullptr, "H", "with --within: how far ahead (seconds for AIS)"},
         {"--arrows", nullptr, "T", "time an arrow covers (default: the horizon, else 60)"},
         {"--width", nullptr, "PX", "drawing width in pixels (default 1200)"},
-        {"--output", "-o", "OUT", "the SVG (whole or not at all) instead of stdout"},
+        {"--output", "-o", "OUT", "the SVG (whole or not at all) instead of stdout", true},
         kQuiet},
        "  loci fleet draw ais.csv --over coastline.geojson --within 926 --horizon 1200 -o "
        "fleet.svg\n",
@@ -726,7 +729,7 @@ const std::vector<Command>& commands() {
          "conflicts are kept up to date incrementally and recomputed in full once the clock "
          "is S past the last full computation (default H/4)"},
         {"--from-scratch", nullptr, nullptr, "compute the conflicts from scratch every tick"},
-        {"--output", "-o", "OUT", "write the per-tick CSV to OUT instead of stdout"},
+        {"--output", "-o", "OUT", "write the per-tick CSV to OUT instead of stdout", true},
         kQuiet},
        "  loci fleet simulate ais.csv --ticks 600 --within 1852 --horizon 1800\n",
        run_fleet_simulate},
@@ -802,7 +805,7 @@ Args parse(const Command& c, int first, int argc, char** argv) {
     // writes a file says so (a file named "-" is ./-).
     if (!std::strcmp(flag->name, "--output") && !std::strcmp(argv[i + 1], "-")) {
       ++i;
-      if (std::strstr(flag->help, "instead of stdout")) {
+      if (flag->stdout_allowed) {
         a.values.erase(flag->name);
         continue;
       }
