@@ -92,7 +92,8 @@ std::size_t draw_index(const DrawOptions& options) {
   RegionQuadtree quadtree;
   if (cells) quadtree = layer_cells(index, options.cell_levels, options.progress);
 
-  const Frame f = detail::frame_of(cells ? quadtree.region() : tree->bounds(), options.width);
+  const Frame f = detail::frame_of(detail::drawn_world(cells ? quadtree.region() : tree->bounds()),
+                                   options.width);
   OutputFile out(options.out_path, stdout);
   std::FILE* o = out.stream();
   detail::write_svg_head(o, f);

@@ -831,11 +831,7 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
     world.expand(at[i]);
     world.expand(to[i]);
   }
-  // A margin of 5% (and some extent for a fleet at one point).
-  const double pad = 0.05 * std::max({world.extent(0), world.extent(1), 1e-9});
-  for (int a = 0; a < 2; ++a)
-    world.min[a] -= pad, world.max[a] += pad;
-  const detail::Frame f = detail::frame_of(world, o.width);
+  const detail::Frame f = detail::frame_of(detail::drawn_world(world), o.width);
   std::vector<bool> conflicting(ids.size(), false);
   auto index_of = [&](Id id) {
     return std::size_t(std::lower_bound(ids.begin(), ids.end(), id) - ids.begin());

@@ -37,6 +37,23 @@ inline Frame frame_of(const Box2& world, int width) {
   return f;
 }
 
+// The world a drawing shows around `world`: a margin of 5% of its larger side, so that what
+// lies on its edges is drawn whole, and a side of no extent (a layer of one horizontal line,
+// of one point) given a tenth of the other, or 1 unit when both have none, so that the drawing
+// is not one pixel high. A world too large to pad is kept as it is.
+inline Box2 drawn_world(Box2 world) {
+  const double larger = std::max(world.extent(0), world.extent(1));
+  if (!std::isfinite(larger)) return world;
+  const double least = larger > 0 ? larger / 10 : 1;
+  const double margin = 0.05 * std::max(larger, least);
+  for (int a = 0; a < 2; ++a) {
+    const double grow = std::max(0.0, least - world.extent(a)) / 2 + margin;
+    world.min[a] -= grow;
+    world.max[a] += grow;
+  }
+  return world;
+}
+
 inline void write_rect(std::FILE* o, const Frame& f, const Box2& r) {
   std::fprintf(o, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", f.x(r.min[0]),
                f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);

@@ -582,10 +582,27 @@ TEST_F(LayersCli, DrawWritesAnSvg) {
        at = drawn.find("<circle", at + 1))
     ++circles;
   EXPECT_EQ(circles, 4u) << drawn;
-  // Corners of the 4 x 4 extent at 1200 pixels: (0,0) at the bottom left, (4,0) bottom right.
-  EXPECT_NE(drawn.find("<circle cx=\"0.0\" cy=\"1200.0\""), std::string::npos) << drawn;
-  EXPECT_NE(drawn.find("<circle cx=\"1200.0\" cy=\"1200.0\""), std::string::npos) << drawn;
-  EXPECT_NE(drawn.find("<path d=\"M0.0 0.0L1200.0 0.0\"/>"), std::string::npos) << drawn;
+  // The 4 x 4 extent with a margin of 0.2 on every side, 1200 pixels wide: (0,0) at the
+  // bottom left, (4,0) bottom right, the line along the top.
+  EXPECT_NE(drawn.find("width=\"1200\" height=\"1200\""), std::string::npos) << drawn;
+  EXPECT_NE(drawn.find("<circle cx=\"54.5\" cy=\"1145.5\""), std::string::npos) << drawn;
+  EXPECT_NE(drawn.find("<circle cx=\"1145.5\" cy=\"1145.5\""), std::string::npos) << drawn;
+  EXPECT_NE(drawn.find("<path d=\"M54.5 54.5L1145.5 54.5\"/>"), std::string::npos) << drawn;
+  // A layer of one point is drawn at the middle, one of a horizontal line in a drawing of some
+  // height (a tenth of its width, and the margins): not one pixel high.
+  std::ofstream(points) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[3,4]}}]})";
+  ASSERT_EQ(run_loci("draw " + points + " -q -o " + dots).status, 0);
+  EXPECT_NE(read_text(dots).find("<circle cx=\"600.0\" cy=\"600.0\""), std::string::npos)
+      << read_text(dots);
+  std::ofstream(points) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,4],[10,4]]}}]})";
+  ASSERT_EQ(run_loci("draw " + points + " -q -o " + dots).status, 0);
+  // 11 x 2 units at 1200 pixels: 219 high, the line from (0.5, 1) to (10.5, 1) units in.
+  EXPECT_NE(read_text(dots).find("width=\"1200\" height=\"219\""), std::string::npos)
+      << read_text(dots);
+  EXPECT_NE(read_text(dots).find("<path d=\"M54.5 109.1L1145.5 109.1\"/>"), std::string::npos)
+      << read_text(dots);
   fs::remove(points);
   fs::remove(dots);
 }
