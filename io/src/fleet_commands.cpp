@@ -731,6 +731,14 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
   const double span = o.tick * double(o.ticks) + o.horizon;
   if (!(std::abs(l.now + span) <= kMaxCoordinate))
     throw InvalidArgument("--ticks x --tick + --horizon carry the simulation's clock beyond 1e150");
+  // Each tick must move the clock: a tick within rounding of the clock's times would run every
+  // tick at one time (two units in the last place of the latest time, so that no two ticks
+  // round together).
+  const double latest = std::max(std::abs(l.now), std::abs(l.now + o.tick * double(o.ticks)));
+  if (o.ticks > 0 &&
+      !(o.tick >= 2 * (std::nextafter(latest, std::numeric_limits<double>::infinity()) - latest)))
+    throw InvalidArgument("--tick " + num(o.tick) + " is too small for the clock at " + num(l.now) +
+                          ": the ticks would not advance it");
   for (std::size_t i = 0; i < motions.size(); ++i) {
     const Motion2& m = motions[i];
     const Point2 p = position(m, l.now);

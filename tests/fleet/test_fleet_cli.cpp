@@ -566,6 +566,21 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
                " --ticks 3 --within 1 --horizon 1 --tick 1e300 -o " + shell_quote(path("sim.csv"))),
       "--ticks x --tick + --horizon carry the simulation's clock beyond 1e150");
   EXPECT_FALSE(fs::exists(path("sim.csv")));
+  // A tick within rounding of the clock (epoch seconds) would run every tick at one time; at
+  // a clock of 0 the same tick advances it.
+  const std::string epoch =
+      write("epoch.csv", "id,t,x,y,vx,vy\n1,1700000000,0,0,1,0\n2,1700000000,5,0,-1,0\n");
+  expect_one_line_error(
+      run_loci("fleet simulate " + shell_quote(epoch) +
+               " --ticks 3 --within 1 --horizon 1 --tick 1e-7 -o " + shell_quote(path("sim.csv"))),
+      "--tick 1e-07 is too small for the clock at 1.7e+09: the ticks would not advance it");
+  EXPECT_FALSE(fs::exists(path("sim.csv")));
+  const CliRun fine = run_loci("fleet simulate " + shell_quote(epoch) +
+                               " --ticks 3 --within 1 --horizon 1 --tick 1e-6 -q");
+  EXPECT_EQ(fine.status, 0) << fine.err;
+  const CliRun tiny = run_loci("fleet simulate " + shell_quote(good) +
+                               " --ticks 3 --within 1 --horizon 1 --tick 1e-300 -q");
+  EXPECT_EQ(tiny.status, 0) << tiny.err;
   // An object that would leave the range is named by its id (not its place in the input), and
   // the options that carry it there are named, --horizon among them.
   const std::string mover = write("mover.csv",
