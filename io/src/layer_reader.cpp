@@ -280,7 +280,7 @@ LayerSummary summarize_layer(const std::string& path, const std::string& layer,
       ++types["(none)"];
       continue;
     }
-    const std::string type = OGRGeometryTypeToName(wkbFlatten(g->getGeometryType()));
+    const std::string type = OGRGeometryTypeToName(g->getGeometryType());
     if (g->IsEmpty()) {  // a geometry without points (POINT EMPTY): counted apart, no extent
       ++types[type + " (empty)"];
       continue;

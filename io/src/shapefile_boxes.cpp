@@ -173,6 +173,12 @@ Kind kind_of(std::uint32_t type) {
 bool is_polygon_type(std::uint32_t type) {
   return type == 5 || type == 15 || type == 25;
 }
+bool has_z(std::uint32_t type) {
+  return type == 11 || type == 13 || type == 15 || type == 18;
+}
+bool may_have_m(std::uint32_t type) {
+  return has_z(type) || type == 21 || type == 23 || type == 25 || type == 28;
+}
 
 // The .shp and .shx headers of one shapefile checked against each other (file codes, version,
 // the same shape type, an .shx of whole entries): its shape type and record count, or nullopt.
@@ -284,6 +290,7 @@ struct RecordRead {
   bool null = false;  // a null shape: no geometry
   Box2 box = Box2::empty();
   std::uint64_t segments = 0;
+  std::uint64_t length = 0;  // of the record's content, in bytes
 };
 
 // Shapelib, inside GDAL, takes a record of more points or parts than these for a corrupt one.
@@ -292,6 +299,7 @@ constexpr std::uint64_t kMaxPoints = 50'000'000, kMaxParts = 10'000'000;
 RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32_t file_type,
                        const std::string& path, std::int64_t fid) {
   RecordRead r;
+  r.length = length;
   if (length < 4) return r;
   const std::uint32_t type = le32(c);
   if (type == 0) {
@@ -299,16 +307,21 @@ RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32
     return r;
   }
   if (type != file_type) return r;
+  // A record of a Z type must hold its Z values (GDAL takes one without them for corrupt); its
+  // M values are optional, as for the M types.
+  const std::uint64_t z_point = has_z(type) ? 8 : 0;
   switch (kind_of(type)) {
     case Kind::point:
-      if (length < 20) return r;
+      if (length < 20 + z_point) return r;
       add_points(c + 4, 1, r.box, path, fid);
       r.segments = 1;  // an isolated point is one zero-length segment
       break;
     case Kind::multipoint: {
       if (length < 40) return r;
       const std::uint64_t n = le32(c + 36);
-      if (n == 0 || n > kMaxPoints || n > (length - 40) / 16) return r;
+      if (n == 0 || n > kMaxPoints || n > (length - 40) / 16 ||
+          40 + 16 * n + (z_point ? 16 + 8 * n : 0) > length)
+        return r;
       add_points(c + 40, n, r.box, path, fid);
       r.segments = n;
       break;
@@ -317,7 +330,7 @@ RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32
       if (length < 44) return r;
       const std::uint64_t parts = le32(c + 36), n = le32(c + 40);
       if (parts == 0 || n == 0 || parts > n || n > kMaxPoints || parts > kMaxParts ||
-          44 + 4 * parts + 16 * n > length)
+          44 + 4 * parts + 16 * n + (z_point ? 16 + 8 * n : 0) > length)
         return r;
       // Parts start at 0 and each holds at least one point.
       // A part of one point counts as one segment (of length zero), the others one fewer
@@ -340,6 +353,25 @@ RecordRead read_record(const unsigned char* c, std::uint64_t length, std::uint32
   check_box(r.box, detail::where(path, fid).c_str());
   r.ok = true;
   return r;
+}
+
+// Whether a record that read_record took (not null) carries M values and one of them is above
+// -1e38, below which shapefiles write "no data": what GDAL looks for in a layer's first record
+// to give the layer, and so every geometry of it, measures.
+bool uses_measures(const unsigned char* c, std::uint64_t length, std::uint32_t type) {
+  if (!may_have_m(type)) return false;
+  const std::uint64_t z_point = has_z(type) ? 8 : 0;
+  std::uint64_t n = 1, m_at = 20 + z_point;  // a point: its M right after x, y (and z)
+  if (kind_of(type) != Kind::point) {
+    n = le32(c + (kind_of(type) == Kind::multipoint ? 36 : 40));
+    const std::uint64_t xy = kind_of(type) == Kind::multipoint ? 40 : 44 + 4 * le32(c + 36);
+    // after the points (and the Z range and values): the M range, then the values
+    m_at = xy + 16 * n + (z_point ? 16 + 8 * n : 0) + 16;
+  }
+  if (m_at + 8 * n > length) return false;
+  for (std::uint64_t i = 0; i < n; ++i)
+    if (le_double(c + m_at + 8 * i) > -1e38) return true;
+  return false;
 }
 
 // Checks that the shapefile at `path` is one this reader takes and calls `begin(file_type,
@@ -748,14 +780,16 @@ std::optional<ShapefileSummary> read_shapefile_summary(const std::string& path,
   ShapefileSummary out;
   LayerItems items;
   std::map<std::string, std::int64_t> types;
-  bool placed = true;
+  bool placed = true, measured = false, z = false;
   const bool read = scan_shapefile(
       path, layer, progress, items,
       [&](std::uint32_t, std::uint64_t records, std::uint64_t) {
         out.records = std::int64_t(records);
       },
-      [&](const RecordRead& r, std::int64_t, const unsigned char* c, std::uint32_t file_type) {
+      [&](const RecordRead& r, std::int64_t fid, const unsigned char* c, std::uint32_t file_type) {
         out.extent.expand(r.box);
+        if (fid == 0) measured = uses_measures(c, r.length, file_type);
+        z = has_z(file_type);
         const char* type = "Point";
         if (kind_of(file_type) == Kind::multipoint) {
           type = "Multi Point";
@@ -774,9 +808,15 @@ std::optional<ShapefileSummary> read_shapefile_summary(const std::string& path,
         ++types[type];
       });
   if (!read || !placed) return std::nullopt;
+  // Named as GDAL names them: every geometry of a Z type is 3D, and measured when the first
+  // record (not a null one) uses measures.
+  const std::string prefix = std::string(z ? "3D " : "") + (measured ? "Measured " : "");
+  std::map<std::string, std::int64_t> named;
+  for (const auto& [type, count] : types)
+    named[prefix + type] = count;
   if (const std::int64_t none = out.records - std::int64_t(items.features); none > 0)
-    types["(none)"] = none;
-  out.geometry_types.assign(types.begin(), types.end());
+    named["(none)"] = none;
+  out.geometry_types.assign(named.begin(), named.end());
   return out;
 }
 

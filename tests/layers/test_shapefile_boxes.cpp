@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -938,6 +939,183 @@ TEST(ShapefileBoxes, MeasuredShapesAndOnePointParts) {
   unsigned char header[36];
   shp.read(reinterpret_cast<char*>(header), sizeof header);
   EXPECT_EQ(header[32], 23);  // PolyLineM
+}
+
+// One shape record's content as the format stores it (little-endian): `points` (x, y) as a
+// point, a multipoint or a line of one part, by `type`; Z values when `z`; then M values
+// when `m` is not empty (one per point).
+std::string shape_record(std::int32_t type, const std::vector<std::pair<double, double>>& points,
+                         bool z, const std::vector<double>& m) {
+  static_assert(std::endian::native == std::endian::little);
+  std::string c;
+  const auto i32 = [&](std::int32_t v) { c.append(reinterpret_cast<const char*>(&v), 4); };
+  const auto f64 = [&](double v) { c.append(reinterpret_cast<const char*>(&v), 8); };
+  const auto n = std::int32_t(points.size());
+  i32(type);
+  const bool point = type % 10 == 1, multipoint = type % 10 == 8;
+  if (!point) {
+    for (const double v : {0.0, 0.0, 10.0, 10.0})
+      f64(v);
+    if (!multipoint) i32(1);
+    i32(n);
+    if (!multipoint) i32(0);
+  }
+  for (const auto& [x, y] : points)
+    f64(x), f64(y);
+  if (z) {
+    if (!point) f64(0.5), f64(0.5);  // the range, then the values
+    for (std::size_t i = 0; i < points.size(); ++i)
+      f64(0.5);
+  }
+  if (!m.empty()) {
+    if (!point) f64(-1), f64(7);
+    for (const double v : m)
+      f64(v);
+  }
+  return c;
+}
+
+// Replaces a shapefile's .shp and .shx by `records` of shape `type` (the .dbf, which must
+// hold as many records, is kept).
+void write_shapes(const std::string& shp, std::int32_t type,
+                  const std::vector<std::string>& records) {
+  const auto be32 = [](std::string& s, std::uint32_t v) {
+    for (int k = 3; k >= 0; --k)
+      s.push_back(char(v >> (8 * k) & 0xff));
+  };
+  std::string body, index;
+  std::uint32_t offset = 50;  // in 16-bit words, after the header
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const auto words = std::uint32_t(records[i].size() / 2);
+    be32(body, std::uint32_t(i + 1));
+    be32(body, words);
+    body += records[i];
+    be32(index, offset);
+    be32(index, words);
+    offset += 4 + words;
+  }
+  const auto write = [&](const std::string& path, const std::string& content) {
+    std::string h;
+    be32(h, 9994);
+    for (int k = 0; k < 5; ++k)
+      be32(h, 0);
+    be32(h, std::uint32_t((100 + content.size()) / 2));
+    const std::int32_t version = 1000;
+    h.append(reinterpret_cast<const char*>(&version), 4);
+    h.append(reinterpret_cast<const char*>(&type), 4);
+    for (const double v : {0.0, 0.0, 10.0, 10.0, 0.0, 0.0, 0.0, 0.0})
+      h.append(reinterpret_cast<const char*>(&v), 8);
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << h << content;
+  };
+  write(shp, body);
+  write(fs::path(shp).replace_extension(".shx").string(), index);
+}
+
+TEST(ShapefileBoxes, GeometryTypesNameZAndMAsGdalDoes) {
+  // GDAL gives a layer measures when its first record (fid 0) carries M values and one of
+  // them is above -1e38 (shapefiles' "no data"); then every geometry has them, a record
+  // without them reading as M = 0. A Z type is 3D throughout, and a record of a Z type
+  // without its Z values is corrupt.
+  const std::vector<std::pair<double, double>> line{{1, 2}, {2, 3}, {3, 4}},
+      ring{{0, 0}, {0, 1}, {1, 1}, {0, 0}};
+  const std::vector<double> m7(4, 7.0), none(4, -1e39), mixed{-1e39, 5, -1e39, -1e39},
+      nan(4, std::numeric_limits<double>::quiet_NaN());
+  const std::string null_record("\0\0\0\0", 4);
+  const auto m_of = [](const std::vector<double>& m, std::size_t n) {
+    return std::vector<double>(m.begin(), m.begin() + std::ptrdiff_t(n));
+  };
+  struct Case {
+    const char* name;
+    std::int32_t type;
+    std::vector<std::string> records;
+    std::vector<std::pair<std::string, std::int64_t>> types;
+  };
+  const std::vector<Case> cases{
+      {"m_first",
+       23,
+       {shape_record(23, line, false, m_of(m7, 3)), shape_record(23, line, false, {})},
+       {{"Measured Line String", 2}}},
+      {"m_no_data",
+       23,
+       {shape_record(23, line, false, m_of(none, 3)), shape_record(23, line, false, m_of(m7, 3))},
+       {{"Line String", 2}}},
+      {"m_mixed",
+       23,
+       {shape_record(23, line, false, m_of(mixed, 3)), shape_record(23, line, false, {})},
+       {{"Measured Line String", 2}}},
+      {"m_nan",
+       23,
+       {shape_record(23, line, false, m_of(nan, 3)), shape_record(23, line, false, m_of(m7, 3))},
+       {{"Line String", 2}}},
+      {"m_absent_first",
+       23,
+       {shape_record(23, line, false, {}), shape_record(23, line, false, m_of(m7, 3))},
+       {{"Line String", 2}}},
+      {"m_null_first",
+       23,
+       {null_record, shape_record(23, line, false, m_of(m7, 3))},
+       {{"(none)", 1}, {"Line String", 1}}},
+      {"zm_line",
+       13,
+       {shape_record(13, line, true, m_of(m7, 3)), shape_record(13, line, true, {})},
+       {{"3D Measured Line String", 2}}},
+      {"z_line",
+       13,
+       {shape_record(13, line, true, {}), shape_record(13, line, true, m_of(m7, 3))},
+       {{"3D Line String", 2}}},
+      {"zm_polygon", 15, {shape_record(15, ring, true, m7)}, {{"3D Measured Polygon", 1}}},
+      {"m_polygon", 25, {shape_record(25, ring, false, m_of(none, 4))}, {{"Polygon", 1}}},
+      {"zm_multipoint",
+       18,
+       {shape_record(18, line, true, m_of(m7, 3)), shape_record(18, line, true, {})},
+       {{"3D Measured Multi Point", 2}}},
+      {"m_multipoint",
+       28,
+       {shape_record(28, line, false, m_of(m7, 3))},
+       {{"Measured Multi Point", 1}}},
+      {"z_point",
+       11,
+       {shape_record(11, {{1, 2}}, true, {}), shape_record(11, {{1, 2}}, true, {7})},
+       {{"3D Point", 2}}},
+      {"zm_point",
+       11,
+       {shape_record(11, {{1, 2}}, true, {7}), shape_record(11, {{1, 2}}, true, {})},
+       {{"3D Measured Point", 2}}},
+      {"m_point",
+       21,
+       {shape_record(21, {{1, 2}}, false, {7}), shape_record(21, {{1, 2}}, false, {})},
+       {{"Measured Point", 2}}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = write_shapefile(
+        c.name, wkbPoint, int(c.records.size()),
+        [](int, std::mt19937_64&) { return std::make_unique<OGRPoint>(0, 0); }, 0);
+    write_shapes(path, c.type, c.records);
+    const auto direct = loci::io::read_shapefile_summary(path);
+    ASSERT_TRUE(direct);
+    EXPECT_EQ(direct->geometry_types, c.types);
+    expect_summary_like_gdal(path);
+  }
+  // A Z record without its Z values: the direct readers hand the file to GDAL, which refuses
+  // it as corrupt (as it did before any direct read).
+  for (const auto& [type, record] : {std::pair{13, shape_record(13, line, false, {})},
+                                     std::pair{18, shape_record(18, line, false, {})},
+                                     std::pair{11, shape_record(11, {{1, 2}}, false, {})}}) {
+    SCOPED_TRACE(type);
+    const std::string path = write_shapefile(
+        "z_missing", wkbPoint, 2,
+        [](int, std::mt19937_64&) { return std::make_unique<OGRPoint>(0, 0); }, 0);
+    write_shapes(
+        path, type,
+        {shape_record(type, type == 11 ? std::vector<std::pair<double, double>>{{1, 2}} : line,
+                      true, {}),
+         record});
+    EXPECT_FALSE(loci::io::read_shapefile_summary(path));
+    EXPECT_FALSE(loci::io::read_shapefile_boxes(path));
+    EXPECT_FALSE(loci::io::read_shapefile_segments(path));
+    EXPECT_THROW(loci::io::read_items(path, "", Per::feature), loci::Error);
+  }
 }
 
 TEST(ShapefileBoxes, BadCoordinatesAreRefusedAsGdalRefusesThem) {
