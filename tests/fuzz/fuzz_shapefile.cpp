@@ -1,7 +1,8 @@
 // Fuzz target: a shapefile (.shp, .shx and .dbf from the input's bytes) read by the direct
 // reader that `loci index`, `loci info` and the answers' geometries use, against GDAL's own
-// reading of the same files. Input: one flag byte, the .shx's and the .dbf's lengths (two
-// bytes each, little-endian; cut to what is there), those files' bytes, then the .shp's.
+// reading of the same files (the summary of `loci info` too, type names included). Input: one flag
+// byte, the .shx's and the .dbf's lengths (two bytes each, little-endian; cut to what is there),
+// those files' bytes, then the .shp's.
 //
 // What the direct reader takes it must read as GDAL does (the boxes of the features GDAL
 // gives, the polygons GDAL builds, byte for byte); what it cannot read as GDAL does it must
@@ -14,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,7 @@ std::vector<unsigned char> wkb_of(const OGRGeometry& g) {
 struct GdalFeature {
   GIntBig fid;
   loci::Box2 box;
+  const char* type;  // GDAL's name of the geometry's type
 };
 bool gdal_features(OGRLayer& layer, std::vector<GdalFeature>& out) {
   layer.ResetReading();
@@ -46,7 +49,9 @@ bool gdal_features(OGRLayer& layer, std::vector<GdalFeature>& out) {
     if (!g || g->IsEmpty()) continue;
     OGREnvelope e;
     g->getEnvelope(&e);
-    out.push_back({f->GetFID(), {{e.MinX, e.MinY}, {e.MaxX, e.MaxY}}});
+    out.push_back({f->GetFID(),
+                   {{e.MinX, e.MinY}, {e.MaxX, e.MaxY}},
+                   OGRGeometryTypeToName(g->getGeometryType())});
   }
   return CPLGetLastErrorType() < CE_Failure;
 }
@@ -122,6 +127,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         for (const auto& f : ref)
           extent.expand(f.box);
         check(ref.empty() || summary->extent == extent, "extent");
+        std::map<std::string, std::int64_t> types,
+            named(summary->geometry_types.begin(), summary->geometry_types.end());
+        for (const auto& f : ref)
+          ++types[f.type];
+        named.erase("(none)");
+        check(named == types, "geometry type names");
       }
     }
     if (gdal_read && (flags & 4)) {
