@@ -15,6 +15,7 @@
 #include <exception>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -782,6 +783,7 @@ void print_fleet_help() {
 
 Args parse(const Command& c, int first, int argc, char** argv) {
   Args a;
+  std::set<std::string> given;  // options with a value seen so far, by long name
   for (int i = first; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg.size() < 2 || arg[0] != '-') {
@@ -799,6 +801,10 @@ Args parse(const Command& c, int first, int argc, char** argv) {
       continue;
     }
     if (i + 1 >= argc) throw UsageError(arg + " needs a value: " + flag->value);
+    // An option's value is taken once: a second one would silently replace the first (two
+    // --bbox are not two windows).
+    if (!given.insert(flag->name).second)
+      throw UsageError(arg + " is given twice; loci " + c.name + " takes one " + flag->name);
     if (argv[i + 1][0] == '\0')  // `-o ""` would otherwise mean stdout or a default
       throw UsageError(arg + " needs a value: " + flag->value + ", not an empty one");
     // `-o -` is stdout, as usual, where the output is text that may go there; a command that

@@ -992,6 +992,13 @@ TEST_F(LayersCli, ReportsBadInput) {
   expect_error("query " + polys, "exactly one of");
   expect_error("query " + polys + " --bbox 0,0,1,1 --frobnicate", "unknown option --frobnicate");
   expect_error("query " + polys + " --bbox 0,0,1,1 -f xml", "unknown format 'xml'");
+  // A value option given twice is refused rather than the last one taken, under either name.
+  expect_error("query " + polys + " --bbox 0,0,1,1 --bbox 2,2,3,3",
+               "--bbox is given twice; loci query takes one --bbox");
+  expect_error("query " + polys + " --nearest 1,1 -k 2 -k 3", "-k is given twice");
+  expect_error("query " + polys + " --bbox 0,0,1,1 --format ids -f csv", "-f is given twice");
+  expect_error("index " + polys + " -o " + path("a.loci") + " --output -",
+               "--output is given twice");
   expect_error("index " + polys + " --structure rstar", "built in memory only");
   expect_error("frobnicate", "unknown command");
   expect_error("join " + polys + " " + polys + " --closest --predicate intersects", "not both");
