@@ -661,7 +661,9 @@ const std::vector<Command>& commands() {
        "closest approach",
        {{"--within", nullptr, "D", "the distance (planar units; metres for AIS input)"},
         {"--horizon", nullptr, "H", "how far ahead (time units; seconds for AIS input)"},
-        {"--at", nullptr, "T", "now (default: the latest report time)"},
+        {"--at", nullptr, "T",
+         "now (default: the latest report time; reports after it within the horizon are "
+         "followed)"},
         {"--format", "-f", "csv|geojson",
          "CSV id_a,id_b,tcpa,dcpa,t_enter,t_exit,... (default) or GeoJSON lines between the "
          "two positions at tcpa"},

@@ -145,6 +145,99 @@ std::vector<Piece> pieces_during(std::span<const FleetReport> sorted, double t1,
   return out;
 }
 
+// A conflict, with the reports of its two objects in force at its closest approach (for the
+// positions shown).
+struct FoundConflict {
+  Conflict c;
+  Motion2 ma, mb;
+};
+
+// The conflicts over [now, now + H] (DESIGN.md section 5: a report holds until the next one
+// of its id, so a report within the horizon changes what follows it; conflicts before the
+// latest reports are answered from the reports in force at each time, as windows over an
+// interval are), sorted by (a, b). Without such reports: one find_conflicts over the reports
+// in force at now. With them: every pair of pieces of two objects whose times overlap gets
+// the closest approach over the overlap (candidates from the pieces' swept boxes grown by
+// D/2), and a pair's answer is its least distance over them all (the earliest such time),
+// entered at its first entry and left at its last exit.
+std::vector<FoundConflict> conflicts_of(const Loaded& l, double within, double horizon) {
+  const std::vector<FleetReport>& reports = l.data.reports;
+  const double now = l.now, end = now + horizon;
+  std::vector<FoundConflict> out;
+  const bool changes = std::any_of(reports.begin(), reports.end(), [&](const FleetReport& r) {
+    return r.m.t > now && r.m.t <= end;
+  });
+  if (!changes) {
+    const auto in = in_force(reports, now);
+    std::vector<Id> ids;
+    std::vector<Motion2> motions;
+    for (const FleetReport& r : in) {
+      ids.push_back(r.id);
+      motions.push_back(r.m);
+    }
+    check_conflict_objects<2>(std::span<const Motion2>(motions), now, horizon,
+                              [&](std::size_t i) { return "id " + std::to_string(ids[i]); });
+    // By index into the reports (sorted by id, one per id), in the order of (id_a, id_b).
+    std::vector<std::pair<std::uint64_t, Approach>> found;
+    find_conflicts<2>(std::span<const Motion2>(motions), within, now, horizon,
+                      [&](std::uint32_t i, std::uint32_t j, const Approach& ap) {
+                        if (j < i) std::swap(i, j);
+                        found.push_back({std::uint64_t(i) << 32 | j, ap});
+                        return true;
+                      });
+    std::sort(found.begin(), found.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
+    out.reserve(found.size());
+    for (const auto& [key, ap] : found) {
+      const std::size_t a = std::size_t(key >> 32), b = std::uint32_t(key);
+      out.push_back({{ids[a], ids[b], ap}, motions[a], motions[b]});
+    }
+    return out;
+  }
+  const std::vector<Piece> pieces = pieces_during(reports, now, end);
+  std::vector<Box2> boxes;
+  boxes.reserve(pieces.size());
+  for (const Piece& p : pieces) {
+    check_conflict_objects<2>(std::span<const Motion2>(&p.m, 1), p.lo, p.hi - p.lo,
+                              [&](std::size_t) { return "id " + std::to_string(p.id); });
+    boxes.push_back(loci::detail::grown_sweep(p.m, p.lo, p.hi, 0.5 * within));
+  }
+  const PackedRTree<2> tree = PackedRTree<2>::build(boxes);
+  for (std::size_t i = 0; i < pieces.size(); ++i)
+    tree.query(boxes[i], [&](Id k, const Box2&) {
+      const Piece *p = &pieces[i], *q = &pieces[k];
+      if (k <= i || p->id == q->id) return true;
+      if (q->id < p->id) std::swap(p, q);
+      const double s0 = std::max(p->lo, q->lo), s1 = std::min(p->hi, q->hi);
+      if (!(s0 <= s1)) return true;
+      // To the horizon's end as find_conflicts measures it (from now), not a rounded sum.
+      const double h = s1 == end ? std::max(0.0, horizon - (s0 - now)) : s1 - s0;
+      if (const auto ap = closest_approach(p->m, q->m, s0, h, within))
+        out.push_back({{p->id, q->id, *ap}, p->m, q->m});
+      return true;
+    });
+  std::sort(out.begin(), out.end(), [](const FoundConflict& x, const FoundConflict& y) {
+    if (x.c.a != y.c.a) return x.c.a < y.c.a;
+    if (x.c.b != y.c.b) return x.c.b < y.c.b;
+    return x.c.approach.tcpa < y.c.approach.tcpa;
+  });
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (n > 0 && out[n - 1].c.a == out[i].c.a && out[n - 1].c.b == out[i].c.b) {
+      FoundConflict& kept = out[n - 1];
+      const double enter = std::min(kept.c.approach.t_enter, out[i].c.approach.t_enter),
+                   exit = std::max(kept.c.approach.t_exit, out[i].c.approach.t_exit);
+      if (out[i].c.approach.dcpa < kept.c.approach.dcpa) kept = out[i];
+      kept.c.approach.t_enter = enter;
+      kept.c.approach.t_exit = exit;
+    } else {
+      out[n++] = out[i];
+    }
+  }
+  out.resize(n);
+  return out;
+}
+
 struct Hit {
   Id id;
   double t;  // when it is in the window (the first time, for an interval)
@@ -349,30 +442,7 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
     throw InvalidArgument("conflicts are written as csv or geojson, not ids");
   refuse_overwriting(o.out_path, o.path, "input fleet");
   const Loaded l = load(o.path, o.at);
-  const auto now = in_force(l.data.reports, l.now);
-  std::vector<Id> ids;
-  std::vector<Motion2> motions;
-  for (const FleetReport& r : now) {
-    ids.push_back(r.id);
-    motions.push_back(r.m);
-  }
-  // By index into the reports (sorted by id, one per id), so that a pair's reports are at
-  // hand for its positions, not looked up by id; in the order of (id_a, id_b).
-  struct Found {
-    std::uint64_t key;  // the indices of a and b, a's high
-    Approach approach;
-  };
-  std::vector<Found> found;
-  check_conflict_objects<2>(std::span<const Motion2>(motions), l.now, o.horizon,
-                            [&](std::size_t i) { return "id " + std::to_string(ids[i]); });
-  find_conflicts<2>(std::span<const Motion2>(motions), o.within, l.now, o.horizon,
-                    [&](std::uint32_t i, std::uint32_t j, const Approach& ap) {
-                      if (j < i) std::swap(i, j);
-                      found.push_back({std::uint64_t(i) << 32 | j, ap});
-                      return true;
-                    });
-  std::sort(found.begin(), found.end(),
-            [](const Found& x, const Found& y) { return x.key < y.key; });
+  const std::vector<FoundConflict> found = conflicts_of(l, o.within, o.horizon);
   const bool ais = l.ais();
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
@@ -386,11 +456,10 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   else
     row += "{\"type\":\"FeatureCollection\",\"features\":[";
   for (std::size_t i = 0; i < found.size(); ++i) {
-    const std::size_t ia = std::size_t(found[i].key >> 32), ib = std::uint32_t(found[i].key);
-    const Conflict c{ids[ia], ids[ib], found[i].approach};
+    const Conflict& c = found[i].c;
     const Approach& ap = c.approach;
-    const Point2 a = shown(l, position(motions[ia], ap.tcpa));
-    const Point2 b = shown(l, position(motions[ib], ap.tcpa));
+    const Point2 a = shown(l, position(found[i].ma, ap.tcpa));
+    const Point2 b = shown(l, position(found[i].mb, ap.tcpa));
     if (!csv)
       row += i ? ",\n{\"type\":\"Feature\",\"properties\":{"
                : "\n{\"type\":\"Feature\",\"properties\":{";
@@ -829,8 +898,8 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
     ids.push_back(r.id);
     motions.push_back(r.m);
   }
-  std::vector<Conflict> found;
-  if (o.within) found = find_conflicts<2>(ids, motions, *o.within, l.now, *o.horizon);
+  std::vector<FoundConflict> found;
+  if (o.within) found = conflicts_of(l, *o.within, *o.horizon);
   std::vector<Point2> at(motions.size()), to(motions.size());
   Box2 world = Box2::empty();
   for (std::size_t i = 0; i < motions.size(); ++i) {
@@ -844,8 +913,13 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
   auto index_of = [&](Id id) {
     return std::size_t(std::lower_bound(ids.begin(), ids.end(), id) - ids.begin());
   };
-  for (const Conflict& c : found)
-    conflicting[index_of(c.a)] = conflicting[index_of(c.b)] = true;
+  // An object that first reports after now is in no dot (it is not there yet).
+  const auto mark = [&](Id id) {
+    const std::size_t i = index_of(id);
+    if (i < ids.size() && ids[i] == id) conflicting[i] = true;
+  };
+  for (const FoundConflict& fc : found)
+    mark(fc.c.a), mark(fc.c.b);
 
   OutputFile out(o.out_path, fallback);
   std::FILE* svg = out.stream();
@@ -866,9 +940,10 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
     std::fprintf(svg, "</g>\n");
   }
   std::fprintf(svg, "<g stroke=\"#d62728\" stroke-width=\"1.2\">\n");
-  for (const Conflict& c : found) {
-    const Point2 a = shown(l, position(motions[index_of(c.a)], c.approach.tcpa));
-    const Point2 b = shown(l, position(motions[index_of(c.b)], c.approach.tcpa));
+  for (const FoundConflict& fc : found) {
+    const Conflict& c = fc.c;
+    const Point2 a = shown(l, position(fc.ma, c.approach.tcpa));
+    const Point2 b = shown(l, position(fc.mb, c.approach.tcpa));
     std::fprintf(svg,
                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"><title>%llu %llu: "
                  "dcpa %s at %s</title></line>\n",

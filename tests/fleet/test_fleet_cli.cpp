@@ -252,13 +252,35 @@ TEST_F(FleetCli, ConflictsMatchAllPairsAtTheLatestTimeAndBefore) {
     const auto got = csv_rows(r.out);
     ASSERT_FALSE(got.empty());
     EXPECT_EQ(lines(r.out)[0].rfind("id_a,id_b,tcpa,dcpa,t_enter,t_exit", 0), 0u);
-    const auto fleet = brute_in_force(rows, at);
+    // Each pair over [at, at + 30] cut at every report time of either object: over each
+    // part the reports in force at its start; the least distance of all parts.
+    std::map<Id, std::vector<Motion2>> by_id;
+    for (const Row& row : rows)
+      by_id[row.id].push_back(row.m);
     std::vector<std::vector<std::string>> want;
-    for (auto a = fleet.begin(); a != fleet.end(); ++a)
-      for (auto b = std::next(a); b != fleet.end(); ++b)
-        if (const auto ap = closest_approach(a->second, b->second, at, 30.0, 15.0))
+    for (auto a = by_id.begin(); a != by_id.end(); ++a)
+      for (auto b = std::next(a); b != by_id.end(); ++b) {
+        std::set<double> cuts{at, at + 30};
+        for (const auto* reports : {&a->second, &b->second})
+          for (const Motion2& m : *reports)
+            if (m.t > at && m.t < at + 30) cuts.insert(m.t);
+        std::optional<Approach> best;
+        for (auto c = cuts.begin(); std::next(c) != cuts.end(); ++c) {
+          const auto in = [&](const std::vector<Motion2>& reports) {
+            std::optional<Motion2> m;
+            for (const Motion2& r : reports)
+              if (r.t <= *c && (!m || m->t < r.t)) m = r;
+            return m;
+          };
+          const auto ma = in(a->second), mb = in(b->second);
+          if (!ma || !mb) continue;
+          const auto ap = closest_approach(*ma, *mb, *c, *std::next(c) - *c, 15.0);
+          if (ap && (!best || ap->dcpa < best->dcpa)) best = ap;
+        }
+        if (best)
           want.push_back({std::to_string(a->first), std::to_string(b->first),
-                          std::to_string(ap->tcpa), std::to_string(ap->dcpa)});
+                          std::to_string(best->tcpa), std::to_string(best->dcpa)});
+      }
     ASSERT_GT(want.size(), 3u);
     ASSERT_EQ(got.size(), want.size() + 1);
     for (std::size_t i = 0; i < want.size(); ++i) {
@@ -271,6 +293,45 @@ TEST_F(FleetCli, ConflictsMatchAllPairsAtTheLatestTimeAndBefore) {
       EXPECT_GE(std::stod(g[5]), std::stod(g[2]));
     }
   }
+}
+
+// Conflicts before the latest reports follow them: a turn within the horizon takes an
+// object off its collision course, and an object that first reports within it is in its
+// conflicts from then (DESIGN.md section 5: a report holds until the next one).
+TEST_F(FleetCli, ConflictsBeforeTheLatestReportsFollowThem) {
+  const std::string turn =
+      write("turn.csv", "id,t,x,y,vx,vy\n1,0,0,0,1,0\n1,10,10,0,0,1\n2,0,30,0,0,0\n");
+  CliRun r = run_loci("fleet conflicts " + shell_quote(turn) + " --within 1 --horizon 60 --at 0");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lines(r.out).size(), 1u) << r.out;  // the header only: 1 turned north at t = 10
+  r = run_loci("fleet conflicts " + shell_quote(turn) + " --within 21 --horizon 60 --at 0");
+  ASSERT_EQ(r.status, 0) << r.err;
+  // After the turn 1 runs north from (10, 0): nearest 2 at once, 20 away, and within 21 from
+  // t = 10 until its distance sqrt(400 + (t - 10)^2) is 21, at t = 10 + sqrt(41).
+  auto got = csv_rows(r.out);
+  ASSERT_EQ(got.size(), 2u) << r.out;
+  EXPECT_EQ(got[1][0], "1");
+  EXPECT_EQ(got[1][1], "2");
+  EXPECT_DOUBLE_EQ(std::stod(got[1][2]), 10);  // tcpa
+  EXPECT_DOUBLE_EQ(std::stod(got[1][3]), 20);  // dcpa
+  EXPECT_DOUBLE_EQ(std::stod(got[1][4]), 9);   // entered before the turn, at x = 9
+  EXPECT_NEAR(std::stod(got[1][5]), 10 + std::sqrt(41.0), 1e-9);
+  EXPECT_EQ(got[1][6] + "," + got[1][7], "10,0");  // positions at tcpa
+  const std::string late = write("late.csv", "id,t,x,y,vx,vy\n1,0,0,0,1,0\n5,20,30,0,0,0\n");
+  r = run_loci("fleet conflicts " + shell_quote(late) + " --within 1 --horizon 60 --at 0");
+  ASSERT_EQ(r.status, 0) << r.err;
+  got = csv_rows(r.out);
+  ASSERT_EQ(got.size(), 2u) << r.out;
+  EXPECT_EQ(got[1][0] + "," + got[1][1] + "," + got[1][2] + "," + got[1][3], "1,5,30,0");
+  EXPECT_EQ(got[1][4] + "," + got[1][5], "29,31");
+  // Its drawing shows the same pair, and only the object in force at --at as a dot.
+  r = run_loci("fleet draw " + shell_quote(late) + " --within 1 --horizon 60 --at 0 -o " +
+               shell_quote(path("late.svg")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(path("late.svg"));
+  const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(svg.find("<title>1 5: dcpa 0 at 30</title>"), std::string::npos) << svg;
+  EXPECT_EQ(svg.find("<title>5</title>"), std::string::npos) << svg;
 }
 
 TEST_F(FleetCli, ConflictsAsGeoJsonForAMap) {
