@@ -243,7 +243,22 @@ struct Hit {
   double t;  // when it is in the window (the first time, for an interval)
   Point2 p;  // where, in the frame
   double distance = 0;
+  std::optional<Point2> lonlat;  // AIS: where, as reported, when it has not moved from it
 };
+
+// An AIS object's report's own lon/lat when at time t it is where that report put it (at the
+// report's time, or at rest): a window's edge through it then holds it exactly, and it is
+// shown as reported. nullopt otherwise, and for planar input.
+std::optional<Point2> reported_lonlat(const Loaded& l, Id id, const Motion2& m, double t) {
+  if (!l.ais() || (t != m.t && (m.v[0] != 0 || m.v[1] != 0))) return std::nullopt;
+  const std::vector<FleetReport>& r = l.data.reports;
+  const auto it = std::lower_bound(r.begin(), r.end(), std::pair{id, m.t},
+                                   [](const FleetReport& a, const std::pair<Id, double>& k) {
+                                     return a.id != k.first ? a.id < k.first : a.m.t < k.second;
+                                   });
+  if (it == r.end() || it->id != id || it->m.t != m.t) return std::nullopt;
+  return l.data.lonlat[std::size_t(it - r.begin())];
+}
 
 std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
   // AIS windows are lon/lat boxes; objects move in the local frame. A position is in the
@@ -288,7 +303,9 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
     const FleetIndex ix = index_of(now);
     ix.query(MovingWindow<2>::at(box, l.now), [&](Id id, const Motion2& m) {
       const Point2 p = position(m, l.now);
-      if (in_window(p)) hits.push_back({id, l.now, p});
+      const auto ll = reported_lonlat(l, id, m, l.now);
+      if (ll ? intersects(o.box, Box2::of_point(*ll)) : in_window(p))
+        hits.push_back({id, l.now, p, 0, ll});
       return true;
     });
   } else {
@@ -302,6 +319,11 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
       const LinearSpan s = meets(m, MovingWindow<2>::during(box, pc.lo, pc.hi));
       if (s.empty()) return true;
       double t = s.lo;
+      if (const auto ll = reported_lonlat(l, pc.id, m, pc.lo); ll && m.v == Point2{}) {
+        // At rest over the piece: where it was reported, all along.
+        if (intersects(o.box, Box2::of_point(*ll))) hits.push_back({pc.id, pc.lo, m.p, 0, ll});
+        return true;
+      }
       if (poly && !inverted) {
         const Segment2 path{position(m, pc.lo), position(m, pc.hi)};
         if (!meets(*poly, path)) return true;
@@ -317,7 +339,7 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
           return true;
         }
       }
-      hits.push_back({pc.id, t, position(m, t)});
+      hits.push_back({pc.id, t, position(m, t), 0, reported_lonlat(l, pc.id, m, t)});
       return true;
     });
   }
@@ -343,7 +365,7 @@ std::vector<Hit> nearest_hits(const Loaded& l, const FleetQueryOptions& o) {
   const FleetIndex ix = index_of(in_force(l.data.reports, l.now));
   std::vector<Hit> hits;
   ix.nearest(q, l.now, o.k, [&](Id id, const Motion2& m, double d) {
-    hits.push_back({id, l.now, position(m, l.now), d});
+    hits.push_back({id, l.now, position(m, l.now), d, reported_lonlat(l, id, m, l.now)});
     return true;
   });
   return hits;
@@ -382,7 +404,7 @@ void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, For
       row += ',';
       detail::append_num(row, h.t);
       if (ais) row += "," + format_utc(h.t);
-      const Point2 p = shown(l, h.p);
+      const Point2 p = h.lonlat ? *h.lonlat : shown(l, h.p);
       row += ',';
       detail::append_nums(row, {p[0], p[1]});
       row += '\n';
@@ -394,7 +416,7 @@ void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, For
   row += "{\"type\":\"FeatureCollection\",\"features\":[";
   for (std::size_t i = 0; i < hits.size(); ++i) {
     const Hit& h = hits[i];
-    const Point2 p = shown(l, h.p);
+    const Point2 p = h.lonlat ? *h.lonlat : shown(l, h.p);
     row += i ? ",\n{\"type\":\"Feature\",\"properties\":{\"id\":"
              : "\n{\"type\":\"Feature\",\"properties\":{\"id\":";
     detail::append_int(row, h.id);

@@ -662,6 +662,7 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
     throw;
   }
   out.reports.reserve(n);
+  out.lonlat.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     Row& r = rows[i];
     const Raw& w = raw[std::size_t(r.r.m.p[0])];
@@ -669,6 +670,7 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
     r.r.m.v =
         along_course(unit_north(r.r.m.p, {nx[i], ny[i]}, north_step(w.lat)), w.sog * kKnot, w.cog);
     out.reports.push_back(r.r);
+    out.lonlat.push_back({w.lon, w.lat});
   }
   return out;
 }

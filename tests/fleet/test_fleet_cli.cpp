@@ -334,6 +334,54 @@ TEST_F(FleetCli, ConflictsBeforeTheLatestReportsFollowThem) {
   EXPECT_EQ(svg.find("<title>5</title>"), std::string::npos) << svg;
 }
 
+// A lon/lat window is closed: a vessel on one of its edges, at rest or at its report's time,
+// is in it and shown where it was reported (the frame's round trip moved such a vessel off
+// the east and south edges by an ulp, out of the window).
+TEST_F(FleetCli, AisWindowEdgesHoldVesselsOnThem) {
+  const std::string f = write("edges.csv",
+                              "MMSI,BaseDateTime,LAT,LON,SOG,COG,Heading\n"
+                              "111,2023-01-01T00:00:00,56.0,10.0,10,90,511\n"
+                              "222,2023-01-01T00:00:00,56.0,10.1,10,270,511\n"
+                              "333,2023-01-01T00:00:00,56.05,10.05,0,360,511\n"
+                              "444,2022-12-31T23:50:00,55.93,10.17,0,0,511\n");
+  // Each vessel with each edge of a window through it (xmin, ymin, xmax, ymax).
+  const std::vector<std::tuple<std::string, double, double>> vessels{
+      {"111", 10.0, 56.0}, {"222", 10.1, 56.0}, {"333", 10.05, 56.05}, {"444", 10.17, 55.93}};
+  for (const auto& [id, lon, lat] : vessels)
+    for (int edge = 0; edge < 4; ++edge) {
+      double b[4] = {lon - 0.01, lat - 0.01, lon + 0.01, lat + 0.01};
+      b[edge] = edge % 2 ? lat : lon;
+      const std::string bbox = num(b[0]) + "," + num(b[1]) + "," + num(b[2]) + "," + num(b[3]);
+      SCOPED_TRACE(id + " on the window " + bbox);
+      for (const char* during : {"", " --during 1672530000,1672531200"}) {
+        const CliRun r =
+            run_loci("fleet query " + shell_quote(f) + " --bbox " + bbox + during + " -f csv -q");
+        ASSERT_EQ(r.status, 0) << r.err;
+        const auto got = csv_rows(r.out);
+        bool found = false;
+        for (std::size_t i = 1; i < got.size(); ++i)
+          if (got[i][0] == id) {
+            found = true;
+            // A vessel at its report's time or at rest is where it was reported.
+            EXPECT_EQ(std::stod(got[i][3]), lon);
+            EXPECT_EQ(std::stod(got[i][4]), lat);
+          }
+        EXPECT_TRUE(found) << during << "\n" << r.out;
+      }
+    }
+  // Nearest-n shows them as reported too.
+  const CliRun r = run_loci("fleet query " + shell_quote(f) + " --nearest 10,56 -k 4 -f csv -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto got = csv_rows(r.out);
+  ASSERT_EQ(got.size(), 5u);
+  for (std::size_t i = 1; i < got.size(); ++i)
+    for (const auto& [id, lon, lat] : vessels)
+      if (got[i][0] == id) {
+        EXPECT_EQ(std::stod(got[i][5]), lon) << id;
+        EXPECT_EQ(std::stod(got[i][6]), lat) << id;
+      }
+}
+
 TEST_F(FleetCli, ConflictsAsGeoJsonForAMap) {
   const auto rows = make_rows(200, 61, 0, 100, 1000, 3);
   const std::string f = write("fleet.csv", csv_of(rows));

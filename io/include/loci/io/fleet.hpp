@@ -135,6 +135,9 @@ struct FleetData {
   // over ground gives the motion).
   std::size_t heading_not_available = 0;
   std::optional<LocalFrame> frame;  // AIS: the frame positions and velocities are in
+  // AIS: each report's position as read (lon, lat), by index into `reports`: where the object
+  // is while it has not moved from it, exactly (the frame's round trip is not).
+  std::vector<Point2> lonlat;
 
   // Distinct ids.
   std::size_t objects() const;
