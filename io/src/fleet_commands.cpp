@@ -480,8 +480,10 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   for (std::size_t i = 0; i < found.size(); ++i) {
     const Conflict& c = found[i].c;
     const Approach& ap = c.approach;
-    const Point2 a = shown(l, position(found[i].ma, ap.tcpa));
-    const Point2 b = shown(l, position(found[i].mb, ap.tcpa));
+    const Point2 a = reported_lonlat(l, c.a, found[i].ma, ap.tcpa)
+                         .value_or(shown(l, position(found[i].ma, ap.tcpa)));
+    const Point2 b = reported_lonlat(l, c.b, found[i].mb, ap.tcpa)
+                         .value_or(shown(l, position(found[i].mb, ap.tcpa)));
     if (!csv)
       row += i ? ",\n{\"type\":\"Feature\",\"properties\":{"
                : "\n{\"type\":\"Feature\",\"properties\":{";
