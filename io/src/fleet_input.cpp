@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <fstream>
@@ -484,6 +485,15 @@ std::string FleetData::summary() const {
   if (heading_not_available)
     s += "; " + std::to_string(heading_not_available) +
          " kept with Heading 511 (not available; heading is not used)";
+  if (const double stretch = reach > 1e-9 ? reach / std::sin(reach) - 1 : 0; stretch > 1e-3) {
+    char b[160];
+    std::snprintf(b, sizeof b,
+                  "; the reports lie up to %.0f km from the local frame's centre, where "
+                  "distances are stretched by up to %.1f%% (split the file by region for "
+                  "exact ones)",
+                  reach * 6371.0088, std::min(stretch, 99.9) * 100);
+    s += b;
+  }
   return s;
 }
 
@@ -635,6 +645,16 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
   }
   const double lon0 = std::atan2(sy, sx) * 180 / std::numbers::pi;
   out.frame.emplace(lon0, slat / double(rows.size()));
+  // The farthest report from the centre, as an angle on the sphere.
+  const double rad = std::numbers::pi / 180, phi0 = out.frame->lat0() * rad;
+  double least_cos = 1;
+  for (const Row& r : rows) {
+    const Raw& w = raw[std::size_t(r.r.m.p[0])];
+    least_cos = std::min(
+        least_cos, std::sin(phi0) * std::sin(w.lat * rad) +
+                       std::cos(phi0) * std::cos(w.lat * rad) * std::cos((w.lon - lon0) * rad));
+  }
+  out.reach = std::acos(std::clamp(least_cos, -1.0, 1.0));
   // Positions, and points a step north of them for the direction of north, projected as two
   // arrays.
   const std::size_t n = rows.size();

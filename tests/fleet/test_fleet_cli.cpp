@@ -549,6 +549,29 @@ TEST_F(FleetCli, AisSampleSentinelsSummarisedOnStderr) {
   EXPECT_EQ(ids_of(r.out), (std::vector<Id>{219000001, 219000003, 219000008, 219000016}));
 }
 
+// The local frame keeps distances from its centre and stretches those across: a file that
+// spans more than about 500 km says by how much, the bundled sample (about 200 km) does not.
+TEST_F(FleetCli, AisFilesSpanningWideAreasSayHowMuchDistancesStretch) {
+  CliRun r = run_loci("fleet query " + shell_quote(kSample) + " --nearest 10,56 -k 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("stretched"), std::string::npos) << r.err;
+  // Two vessels 624 m apart in Denmark and one near New Zealand: the frame's centre lies far
+  // from both, and the pair's distance comes out about 5% long (not an exact answer).
+  const std::string f = write("wide.csv",
+                              "MMSI,BaseDateTime,LAT,LON,SOG,COG\n"
+                              "111,2023-01-01T00:00:00,56.0,10.0,0,360\n"
+                              "222,2023-01-01T00:00:00,56.0,10.01,0,360\n"
+                              "333,2023-01-01T00:00:00,-40.0,170,0,360\n");
+  r = run_loci("fleet query " + shell_quote(f) + " --nearest 10,56 -k 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("; the reports lie up to "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("km from the local frame's centre, where distances are stretched by up "
+                       "to "),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(lines(r.err).size(), 2u) << r.err;  // the summary, then the units
+}
+
 TEST_F(FleetCli, CommittedSampleHasConflicts) {
   const CliRun r =
       run_loci("fleet conflicts " + shell_quote(kSample) + " --within 926 --horizon 1200 -q");

@@ -138,6 +138,10 @@ struct FleetData {
   // AIS: each report's position as read (lon, lat), by index into `reports`: where the object
   // is while it has not moved from it, exactly (the frame's round trip is not).
   std::vector<Point2> lonlat;
+  // AIS: how far the reports lie from the frame's centre (an angle, in radians, on the
+  // sphere): the azimuthal frame keeps distances from its centre but stretches those across
+  // them by up to reach / sin(reach), which summary() says when it passes 0.1%.
+  double reach = 0;
 
   // Distinct ids.
   std::size_t objects() const;
