@@ -186,6 +186,8 @@ int run_query(const Args& a) {
     throw UsageError(
         "loci query needs exactly one of --bbox, --bbox-file, --nearest, "
         "--nearest-file, --within, --segment, --point, --point-file");
+  if (a.has("-k") && !a.has("--nearest") && !a.has("--nearest-file"))
+    throw UsageError("-k counts the neighbours of --nearest or --nearest-file");
   const std::size_t k = a.has("-k") ? parse_count("-k", a.get("-k"), 1, kMaxK) : 1;
   Query q;
   q.k = k;
@@ -387,6 +389,7 @@ int run_fleet_query(const Args& a) {
     if (a.has("--during"))
       throw UsageError("--nearest answers at one time: use --at, not --during");
   }
+  if (a.has("-k") && !a.has("--nearest")) throw UsageError("-k counts the neighbours of --nearest");
   if (a.has("-k")) o.k = parse_count("-k", a.get("-k"), 1, kMaxK);
   o.at = at_flag(a);
   if (a.has("--during"))

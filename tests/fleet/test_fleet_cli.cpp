@@ -686,6 +686,8 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
                         "no such file");
   expect_one_line_error(run_loci("fleet query " + shell_quote(dir_.string()) + q),
                         "is a directory");
+  expect_one_line_error(run_loci("fleet query " + shell_quote(good) + q + " -k 3"),
+                        "-k counts the neighbours of --nearest");
   const std::string g = "fleet conflicts " + shell_quote(good);
   expect_one_line_error(run_loci(g + " --within -1 --horizon 5"), "--within");
   expect_one_line_error(run_loci(g + " --within x --horizon 5"), "--within");

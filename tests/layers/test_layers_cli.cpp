@@ -996,6 +996,7 @@ TEST_F(LayersCli, ReportsBadInput) {
   expect_error("query " + polys + " --bbox 0,0,1,1 --bbox 2,2,3,3",
                "--bbox is given twice; loci query takes one --bbox");
   expect_error("query " + polys + " --nearest 1,1 -k 2 -k 3", "-k is given twice");
+  expect_error("query " + polys + " --bbox 0,0,1,1 -k 3", "-k counts the neighbours of --nearest");
   expect_error("query " + polys + " --bbox 0,0,1,1 --format ids -f csv", "-f is given twice");
   expect_error("index " + polys + " -o " + path("a.loci") + " --output -",
                "--output is given twice");
