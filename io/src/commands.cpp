@@ -156,6 +156,18 @@ std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& pa
   return out;
 }
 
+namespace {
+// A name in a list of names separated by spaces: as it is, or in single quotes (a quote
+// doubled) when it holds a space, a colon, a comma or a quote, or is empty.
+std::string listed(const std::string& name) {
+  if (!name.empty() && name.find_first_of(" \t:,'\"") == std::string::npos) return name;
+  std::string q = "'";
+  for (const char c : name)
+    q += c == '\'' ? std::string("''") : std::string(1, c);
+  return q + "'";
+}
+}  // namespace
+
 std::string describe_layer(const std::string& layer_path, const std::string& layer_name,
                            const Progress& progress) {
   const LayerSummary s = summarize_layer(layer_path, layer_name, progress);
@@ -164,7 +176,7 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   if (s.layer_names.size() > 1) {
     o << "layers:   ";
     for (const auto& n : s.layer_names)
-      o << ' ' << n;
+      o << ' ' << listed(n);
     o << '\n';
   }
   o << "features:  " << s.feature_count << '\n';
@@ -180,7 +192,7 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   o << "fields:   ";
   if (s.fields.empty()) o << " (none)";
   for (const auto& [name, type] : s.fields)
-    o << ' ' << name << ':' << type;
+    o << ' ' << listed(name) << ':' << type;
   o << '\n';
   const std::string sidecar = default_sidecar_path(layer_path);
   o << "index:     ";

@@ -631,6 +631,19 @@ TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
   r = run_loci("info " + two + " --layer beta");
   EXPECT_NE(r.out.find(": fresh"), std::string::npos) << r.out;
   fs::remove(two + ".loci");
+  // Names that hold spaces (and the like) are quoted in the lists, so that each reads apart.
+  ASSERT_EQ(std::system(("ogr2ogr -update " + two + " " + layer + " -nln \"my roads\"").c_str()),
+            0);
+  const std::string named = path("named.geojson");
+  std::ofstream(named) << (R"({"type":"FeatureCollection","features":[{"type":"Feature",)"
+                           R"("properties":{"Country Name":"x","it's":1,"plain":2},)"
+                           R"("geometry":{"type":"Point","coordinates":[1,2]}}]})");
+  r = run_loci("info " + two);
+  EXPECT_NE(r.out.find("layers:    alpha beta 'my roads'\n"), std::string::npos) << r.out;
+  r = run_loci("info " + named);
+  EXPECT_NE(r.out.find("fields:    'Country Name':String 'it''s':Integer plain:Integer\n"),
+            std::string::npos)
+      << r.out;
 }
 
 // A feature without a geometry and one whose geometry has no points are told apart, and
