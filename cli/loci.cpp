@@ -265,7 +265,11 @@ int run_intersections(const Args& a) {
   IntersectionsOptions o;
   o.layer_path = a.positional[0];
   o.layer_name = a.get("--layer");
-  if (a.positional.size() == 2) o.other_path = a.positional[1];
+  // --layer2 without LAYER2 names the second layer of LAYER's own dataset.
+  if (a.positional.size() == 2)
+    o.other_path = a.positional[1];
+  else if (a.has("--layer2"))
+    o.other_path = o.layer_path;
   o.other_name = a.get("--layer2");
   o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
   o.pairs_only = a.has("--pairs-only");
@@ -593,9 +597,11 @@ const std::vector<Command>& commands() {
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         {"--jobs", "-j", "N", "threads (default: one per core; the rows do not depend on it)"},
         kLayer,
-        {"--layer2", nullptr, "NAME", "layer of LAYER2 (default: its first)"},
+        {"--layer2", nullptr, "NAME",
+         "layer of LAYER2 (default: its first); without LAYER2, a layer of LAYER's dataset"},
         kQuiet},
        "  loci intersections roads.shp rivers.shp -f csv\n"
+       "  loci intersections map.gpkg --layer roads --layer2 rivers\n"
        "  loci intersections coastline.geojson --pairs-only\n",
        run_intersections},
       {"join",

@@ -856,7 +856,9 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
         });
     if (best_fid >= 0) {
       const double length = std::hypot(s.b[0] - s.a[0], s.b[1] - s.a[1]);
-      out.push_back({number, best_fid, best_t * length,
+      // + 0.0: a segment starting on the feature has met it at 0, never at -0 (a parameter
+      // rounded from a negative direction).
+      out.push_back({number, best_fid, best_t * length + 0.0,
                      candidates_only ? Point2{kNaN, kNaN} : point_at(s, best_t)});
     }
     return;

@@ -163,6 +163,29 @@ TEST(IntersectionsCli, RandomLayersOneAndTwo) {
     pairs2.insert({row.a, row.b});
   EXPECT_EQ(pairs2, geos_pairs(sa, &sb));
   expect_points_on_linework(rows2, sa, sb);
+  // The two layers in one GeoPackage: --layer2 without LAYER2 names the second of its own
+  // dataset (it was taken for the layer against itself), and an unknown name is refused.
+  const fs::path gpkg = dir / "two.gpkg";
+  ASSERT_EQ(
+      std::system(("ogr2ogr -q " + shell_quote(gpkg.string()) + " " + shell_quote(a.string()) +
+                   " -nln roads && ogr2ogr -q -update " + shell_quote(gpkg.string()) + " " +
+                   shell_quote(b.string()) + " -nln rivers")
+                      .c_str()),
+      0);
+  const CliRun in_one =
+      run_loci("intersections " + shell_quote(gpkg.string()) + " --layer roads --layer2 rivers");
+  ASSERT_EQ(in_one.status, 0) << in_one.err;
+  std::set<std::pair<long long, long long>> pairs_in_one;
+  for (const Row& row : parse_rows(in_one.out))
+    pairs_in_one.insert({row.a, row.b});
+  // The GeoPackage numbers features from 1 where the GeoJSON layers number them from 0.
+  std::set<std::pair<long long, long long>> shifted;
+  for (const auto& [x, y] : pairs2)
+    shifted.insert({x + 1, y + 1});
+  EXPECT_EQ(pairs_in_one, shifted);
+  const CliRun unknown = run_loci("intersections " + shell_quote(a.string()) + " --layer2 nope");
+  EXPECT_EQ(unknown.status, 1) << unknown.out;
+  EXPECT_NE(unknown.err.find("nope"), std::string::npos) << unknown.err;
   fs::remove_all(dir);
 }
 

@@ -421,6 +421,19 @@ TEST_F(LayersCli, SegmentFirstHitMatchesGeos) {
       EXPECT_GT(hits, 5) << name << " " << per;
     }
   }
+  // A segment that starts on a feature and runs towards smaller x and y met it at 0, not -0.
+  const std::string box = path("corner.geojson");
+  std::ofstream(box) << R"({"type":"FeatureCollection","features":[{"type":"Feature",)"
+                        R"("properties":{},"geometry":{"type":"Polygon","coordinates":)"
+                        R"([[[12,2],[14,2],[14,4],[12,4],[12,2]]]}}]})";
+  for (const char* per : {"feature", "segment"})
+    for (const char* seg : {"14,4,0,0", "13,2,13,-5", "12,3,0,3"}) {
+      const CliRun r = run_loci("query " + shell_quote(box) + " --segment " + seg + " --per " +
+                                per + " --first -f csv");
+      ASSERT_EQ(r.status, 0) << r.err;
+      ASSERT_EQ(lines(r.out).size(), 2u) << r.out;
+      EXPECT_EQ(lines(r.out)[1].rfind("0,0,", 0), 0u) << seg << " " << per << ": " << r.out;
+    }
 }
 
 TEST_F(LayersCli, CandidatesAreASupersetOfTheExactAnswer) {
