@@ -88,36 +88,48 @@ double parameter(const Segment2& s, const Point2& x) {
 }
 }  // namespace
 
-std::optional<double> first_meet(const Segment2& e, const Segment2& s) {
+std::optional<Meet> first_meeting(const Segment2& e, const Segment2& s) {
   const SegmentIntersection x = intersection(e, s);
   switch (x.kind) {
     case SegmentMeet::none:
       return std::nullopt;
     case SegmentMeet::point:
-      return parameter(s, x.a);
-    default:
-      return std::min(parameter(s, x.a), parameter(s, x.b));
+      return Meet{parameter(s, x.a), x.a};
+    default: {
+      const double ta = parameter(s, x.a), tb = parameter(s, x.b);
+      return tb < ta ? Meet{tb, x.b} : Meet{ta, x.a};
+    }
   }
 }
 
-std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s) {
+std::optional<Meet> first_meeting(const FlatGeometry& g, const Segment2& s) {
   if (g.empty()) return std::nullopt;
-  std::optional<double> best;
-  auto offer = [&](std::optional<double> t) {
-    if (t && (!best || *t < *best)) best = t;
+  std::optional<Meet> best;
+  auto offer = [&](std::optional<Meet> m) {
+    if (m && (!best || m->t < best->t)) best = m;
   };
   for (const Part& part : g.parts) {
     if (part.end - part.begin == 1 || part.kind == PartKind::point) {
       for (std::uint32_t i = part.begin; i < part.end; ++i)
-        offer(first_meet(Segment2{g.points[i], g.points[i]}, s));
+        offer(first_meeting(Segment2{g.points[i], g.points[i]}, s));
       continue;
     }
     for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-      offer(first_meet(Segment2{g.points[i], g.points[i + 1]}, s));
+      offer(first_meeting(Segment2{g.points[i], g.points[i + 1]}, s));
   }
-  if (best && *best == 0) return best;
-  if (inside_polygon(g, s.a)) return 0.0;
+  if (best && best->t == 0) return best;
+  if (inside_polygon(g, s.a)) return Meet{0.0, s.a};
   return best;
+}
+
+std::optional<double> first_meet(const Segment2& e, const Segment2& s) {
+  const auto m = first_meeting(e, s);
+  return m ? std::optional<double>(m->t) : std::nullopt;
+}
+
+std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s) {
+  const auto m = first_meeting(g, s);
+  return m ? std::optional<double>(m->t) : std::nullopt;
 }
 
 namespace {

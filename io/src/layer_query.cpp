@@ -220,10 +220,8 @@ Region region_of(const Query& q) {
       r.search = s.box();
       r.probe = s.a;
       r.box_ok = [s](const Box2& b) { return intersects(b, s); };
-      // The parameter of the first point of s in the segment or feature (turned into that
-      // point when the answers are made).
-      r.segment_ok = [s](const Segment2& e) { return first_meet(e, s); };
-      r.feature_ok = [s](const FlatGeometry& g, const Box2&) { return first_meet(g, s); };
+      // Segments and features qualify by first_meeting, which gives the first point of s in
+      // them as well (the answers carry it).
       break;
     }
     default: {
@@ -835,22 +833,24 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     const Segment2 s = q.segment;
     double best_t = std::numeric_limits<double>::infinity();
     std::int64_t best_fid = -1;
-    auto offer = [&](std::int64_t fid, double t) {
-      if (t < best_t || (t == best_t && fid < best_fid)) best_t = t, best_fid = fid;
+    Point2 best_at{kNaN, kNaN};
+    auto offer = [&](std::int64_t fid, const Meet& m) {
+      if (m.t < best_t || (m.t == best_t && fid < best_fid))
+        best_t = m.t, best_fid = fid, best_at = m.at;
     };
     if (per_segment)
       for (const auto fid : containing_polygons(index_, s.a))
-        offer(fid, 0.0);
+        offer(fid, {0.0, s.a});
     index_.ordered(
         s.box(), [&](const Box2& b) { return entry_parameter(s, b); },
         [&](const ItemRecord& r, const Box2& b, double key) {
           if (key > best_t) return false;
           if (candidates_only) {
-            offer(r.fid, key);
+            offer(r.fid, {key, {kNaN, kNaN}});
           } else if (per_segment) {
-            if (auto t = first_meet(segment_of(b, r.flags), s)) offer(r.fid, *t);
-          } else if (auto t = first_meet(geometries_->get(r.fid), s)) {
-            offer(r.fid, *t);
+            if (auto m = first_meeting(segment_of(b, r.flags), s)) offer(r.fid, *m);
+          } else if (auto m = first_meeting(geometries_->get(r.fid), s)) {
+            offer(r.fid, *m);
           }
           return true;
         });
@@ -858,8 +858,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       const double length = std::hypot(s.b[0] - s.a[0], s.b[1] - s.a[1]);
       // + 0.0: a segment starting on the feature has met it at 0, never at -0 (a parameter
       // rounded from a negative direction).
-      out.push_back({number, best_fid, best_t * length + 0.0,
-                     candidates_only ? Point2{kNaN, kNaN} : point_at(s, best_t)});
+      out.push_back({number, best_fid, best_t * length + 0.0, best_at});
     }
     return;
   }
@@ -879,15 +878,24 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
 
   const Region region = region_of(q);
   std::unordered_map<std::int64_t, double> hits;
+  // A segment query's first point in each feature, by fid (see first_meeting).
+  const bool meeting = q.kind == Query::Kind::segment && !candidates_only;
+  std::unordered_map<std::int64_t, Point2> first_at;
   auto hit = [&](std::int64_t fid, double d) {
     auto [it, fresh] = hits.try_emplace(fid, d);
     if (!fresh && d < it->second) it->second = d;
+  };
+  auto met = [&](std::int64_t fid, const Meet& m) {
+    auto [it, fresh] = hits.try_emplace(fid, m.t);
+    if (fresh || m.t < it->second) it->second = m.t, first_at[fid] = m.at;
   };
   if (per_segment) {
     index_.window(region.search, [&](const ItemRecord& r, const Box2& b) {
       if (candidates_only) {
         if (region.box_ok(b))
           hit(r.fid, region.with_distance ? std::sqrt(squared_distance(q.point, b)) : kNaN);
+      } else if (meeting) {
+        if (auto m = first_meeting(segment_of(b, r.flags), q.segment)) met(r.fid, *m);
       } else if (auto d = region.segment_ok(segment_of(b, r.flags))) {
         hit(r.fid, *d);
       }
@@ -895,9 +903,12 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
     });
     // Polygons holding the query (whose segments' boxes it may not meet), for candidates too:
     // they are part of the exact answer.
-    for (const auto fid : containing_polygons(index_, region.probe))
-      hit(fid, region.with_distance || (q.kind == Query::Kind::segment && !candidates_only) ? 0.0
-                                                                                            : kNaN);
+    for (const auto fid : containing_polygons(index_, region.probe)) {
+      if (meeting)
+        met(fid, {0.0, q.segment.a});
+      else
+        hit(fid, region.with_distance ? 0.0 : kNaN);
+    }
   } else {
     std::vector<std::pair<std::int64_t, Box2>> candidates;
     index_.window(region.search, [&](const ItemRecord& r, const Box2& b) {
@@ -912,6 +923,8 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       }
       if (candidates_only) {
         hit(fid, region.with_distance ? std::sqrt(squared_distance(q.point, b)) : kNaN);
+      } else if (meeting) {
+        if (auto m = first_meeting(geometries_->get(fid), q.segment)) met(fid, *m);
       } else if (auto d = region.feature_ok(geometries_->get(fid), b)) {
         hit(fid, *d);
       }
@@ -919,8 +932,8 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
   }
   const std::size_t first = out.size();
   for (const auto& [fid, d] : hits) {
-    if (q.kind == Query::Kind::segment && !candidates_only)
-      out.push_back({number, fid, kNaN, point_at(q.segment, d)});  // d: where s meets fid
+    if (meeting)
+      out.push_back({number, fid, kNaN, first_at.at(fid)});
     else
       out.push_back({number, fid, d});
   }

@@ -15,6 +15,7 @@
 #include <tuple>
 
 #include "layers/cli_support.hpp"
+#include "loci/geom/segment_intersection.hpp"
 
 namespace fs = std::filesystem;
 using namespace loci::test;
@@ -434,6 +435,53 @@ TEST_F(LayersCli, SegmentFirstHitMatchesGeos) {
       ASSERT_EQ(lines(r.out).size(), 2u) << r.out;
       EXPECT_EQ(lines(r.out)[1].rfind("0,0,", 0), 0u) << seg << " " << per << ": " << r.out;
     }
+}
+
+// Where a query segment crosses a line it reports the true crossing rounded to the nearest
+// doubles, as loci intersections does (it rounded a point recomputed from the parameter: off
+// by an ulp in most crossings).
+TEST_F(LayersCli, SegmentPointsAreTheTrueCrossingsRounded) {
+  const loci::Segment2 line{{0.0730383438336979, 0.6294549122340242},
+                            {0.7785108586766508, 0.2697755868501427}};
+  const std::string layer = path("one.geojson");
+  {
+    std::ofstream o(layer);
+    o.precision(17);
+    o << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
+      << R"("geometry":{"type":"LineString","coordinates":[[)" << line.a[0] << ',' << line.a[1]
+      << "],[" << line.b[0] << ',' << line.b[1] << "]]}}]}";
+  }
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  int crossings = 0;
+  for (int q = 0; q < 12; ++q) {
+    const loci::Segment2 s{{u(rng), u(rng)}, {u(rng), u(rng)}};
+    const loci::SegmentIntersection want = loci::intersection(line, s);
+    if (want.kind != loci::SegmentMeet::point) continue;
+    ++crossings;
+    char seg[120];
+    std::snprintf(seg, sizeof seg, " --segment %.17g,%.17g,%.17g,%.17g", s.a[0], s.a[1], s.b[0],
+                  s.b[1]);
+    for (const char* per : {"feature", "segment"})
+      for (const char* first : {"", " --first"}) {
+        const CliRun r =
+            run_loci("query " + shell_quote(layer) + seg + " --per " + per + first + " -f csv");
+        ASSERT_EQ(r.status, 0) << r.err;
+        const auto rows = lines(r.out);
+        ASSERT_EQ(rows.size(), 2u) << r.out;
+        std::vector<std::string> f;
+        std::stringstream in(rows[1]);
+        for (std::string x; std::getline(in, x, ',');)
+          f.push_back(x);
+        const std::size_t at = *first ? 2 : 1;  // after fid (and distance)
+        ASSERT_GT(f.size(), at + 1) << rows[1];
+        EXPECT_EQ(std::stod(f[at]), want.a[0]) << per << first << ": " << rows[1];
+        EXPECT_EQ(std::stod(f[at + 1]), want.a[1]) << per << first << ": " << rows[1];
+      }
+  }
+  EXPECT_GE(crossings, 3);
+  fs::remove(layer);
+  fs::remove(layer + ".loci");
 }
 
 TEST_F(LayersCli, CandidatesAreASupersetOfTheExactAnswer) {

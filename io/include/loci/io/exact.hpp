@@ -64,6 +64,15 @@ bool within_distance(const FlatGeometry& g, const Point2& p, double d);
 std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s);
 // The same for one segment e of linework.
 std::optional<double> first_meet(const Segment2& e, const Segment2& s);
+// first_meet's parameter with the point itself: an input point where s starts on g or meets it
+// at a vertex or along an overlap, else the true crossing rounded to the nearest doubles (as
+// loci intersections reports it), not s.a + t (s.b - s.a) rounded again.
+struct Meet {
+  double t;
+  Point2 at;
+};
+std::optional<Meet> first_meeting(const FlatGeometry& g, const Segment2& s);
+std::optional<Meet> first_meeting(const Segment2& e, const Segment2& s);
 
 // True when the geometries share at least one point (closed: touching counts). Their edges
 // (isolated points as edges of length zero) are joined by sort-and-sweep on their boxes and
