@@ -122,11 +122,6 @@ std::optional<Meet> first_meeting(const FlatGeometry& g, const Segment2& s) {
   return best;
 }
 
-std::optional<double> first_meet(const Segment2& e, const Segment2& s) {
-  const auto m = first_meeting(e, s);
-  return m ? std::optional<double>(m->t) : std::nullopt;
-}
-
 std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s) {
   const auto m = first_meeting(g, s);
   return m ? std::optional<double>(m->t) : std::nullopt;

@@ -62,8 +62,6 @@ bool within_distance(const FlatGeometry& g, const Point2& p, double d);
 // and where they meet is decided exactly (the meeting point of two segments is rounded to
 // doubles); t is computed from that point in floating point.
 std::optional<double> first_meet(const FlatGeometry& g, const Segment2& s);
-// The same for one segment e of linework.
-std::optional<double> first_meet(const Segment2& e, const Segment2& s);
 // first_meet's parameter with the point itself: an input point where s starts on g or meets it
 // at a vertex or along an overlap, else the true crossing rounded to the nearest doubles (as
 // loci intersections reports it), not s.a + t (s.b - s.a) rounded again.
@@ -72,6 +70,7 @@ struct Meet {
   Point2 at;
 };
 std::optional<Meet> first_meeting(const FlatGeometry& g, const Segment2& s);
+// The same for one segment e of linework.
 std::optional<Meet> first_meeting(const Segment2& e, const Segment2& s);
 
 // True when the geometries share at least one point (closed: touching counts). Their edges
