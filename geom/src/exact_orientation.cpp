@@ -5,8 +5,8 @@
 // exact rounding error (TwoDiff), each product of such pairs into four exact products of two
 // doubles each (TwoProduct with a fused multiply-add), and the sixteen terms are summed into a
 // nonoverlapping expansion whose largest component carries the sign of the exact sum. That is
-// exact as long as no product underflows; for inputs small enough to risk it, CGAL's exact
-// kernel decides instead.
+// exact as long as no product underflows or overflows; for inputs small or large enough to
+// risk it, CGAL's exact kernel decides instead.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
 
@@ -41,11 +41,13 @@ Orientation orientation_exact(double ax, double ay, double bx, double by, double
     return Orientation::collinear;
   const Pair dx1 = two_diff(bx, ax), dy2 = two_diff(cy, ay);
   const Pair dy1 = two_diff(by, ay), dx2 = two_diff(cx, ax);
-  // Rounding errors of products below 2^-969 may be lost to underflow: leave such inputs to
-  // the slow exact kernel (coordinates are bounded above, so products cannot overflow).
-  constexpr double kTiny = 0x1p-480;
+  // Rounding errors of products below 2^-969 may be lost to underflow, and products of
+  // differences beyond 2^500 (or a difference of coordinates near the largest double, which
+  // overflows) would overflow: leave such inputs to the slow exact kernel.
+  constexpr double kTiny = 0x1p-480, kHuge = 0x1p+500;
   for (const Pair& d : {dx1, dy2, dy1, dx2})
-    if ((d.hi != 0 && std::fabs(d.hi) < kTiny) || (d.lo != 0 && std::fabs(d.lo) < kTiny))
+    if ((d.hi != 0 && std::fabs(d.hi) < kTiny) || (d.lo != 0 && std::fabs(d.lo) < kTiny) ||
+        !(std::fabs(d.hi) <= kHuge))
       return cgal_orientation(ax, ay, bx, by, cx, cy);
   std::array<double, 16> terms;
   int n = 0;

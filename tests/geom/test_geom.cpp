@@ -109,14 +109,14 @@ TEST(Orientation, MatchesExactOnRandomInput) {
 }
 
 TEST(Orientation, ExactAtEveryScale) {
-  // Points on (or a few ulps off) a line at scales from 1e-300 to 1e140, where the floating
+  // Points on (or a few ulps off) a line at scales from 1e-300 to 1e300, where the floating
   // filter gives up and the exact path decides (by expansions, or the exact kernel for inputs
-  // so small that products underflow).
+  // so small that products underflow or so large that they overflow).
   std::mt19937_64 rng(13);
   std::uniform_real_distribution<double> u(-1, 1);
   std::uniform_int_distribution<int> ulps(-3, 3);
   int collinear = 0;
-  for (const double scale : {1e-300, 1e-150, 1e-6, 1.0, 1e6, 1e140}) {
+  for (const double scale : {1e-300, 1e-150, 1e-6, 1.0, 1e6, 1e140, 1e155, 1e300}) {
     for (int i = 0; i < 4000; ++i) {
       const double ox = u(rng) * 1e3 * scale, oy = u(rng) * 1e3 * scale;
       const Point2 a{ox + u(rng) * scale, oy + u(rng) * scale};
@@ -133,6 +133,14 @@ TEST(Orientation, ExactAtEveryScale) {
     }
   }
   EXPECT_GT(collinear, 1000);
+  // Differences of coordinates that overflow a double.
+  constexpr double kMax = std::numeric_limits<double>::max();
+  const Point2 w{-kMax, 0}, e{kMax, 0}, n{0, kMax}, s{0, -kMax};
+  EXPECT_EQ(orientation(w, e, n), Orientation::counterclockwise);
+  EXPECT_EQ(orientation(w, e, s), Orientation::clockwise);
+  EXPECT_EQ(orientation(w, e, Point2{kMax / 3, 0}), Orientation::collinear);
+  EXPECT_EQ(orientation(s, n, e), Orientation::clockwise);
+  EXPECT_EQ(orientation(e, w, Point2{0, 0x1p-1074}), Orientation::clockwise);
 }
 
 // The side of a line on which the crossing of a segment with another line lies, the crossing
@@ -237,10 +245,13 @@ TEST(Segment, BoxIntersectionIsExact2D) {
   std::uniform_int_distribution<int> grid(0, 10);
   int hits = 0, total = 0;
   for (int i = 0; i < 20000; ++i) {
-    // Half on a coarse grid, where touching corners and collinear edges are common.
-    auto coord = [&] { return i % 2 ? double(grid(rng)) : u(rng); };
+    // Half on a coarse grid, where touching corners and collinear edges are common; a
+    // quarter scaled by 2^600 (the same answers: every product of differences overflows).
+    const double scale = i % 4 < 2 ? 1 : 0x1p600;
+    auto coord = [&] { return scale * (i % 2 ? double(grid(rng)) : u(rng)); };
     Box2 box{{coord(), coord()}, {0, 0}};
-    box.max = {box.min[0] + std::floor(u(rng) / 2), box.min[1] + std::floor(u(rng) / 2)};
+    box.max = {box.min[0] + scale * std::floor(u(rng) / 2),
+               box.min[1] + scale * std::floor(u(rng) / 2)};
     const Segment2 s{{coord(), coord()}, {coord(), coord()}};
     const bool expected = exact_box_segment(box, s);
     ASSERT_EQ(intersects(box, s), expected)

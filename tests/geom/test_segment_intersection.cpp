@@ -118,7 +118,7 @@ TEST(SegmentIntersection, RandomSegmentsCrossAtTheNearestDouble) {
 
 TEST(SegmentIntersection, NearParallelAtLargeAndSmallScales) {
   std::mt19937_64 rng(7);
-  for (double scale : {1e6, 1e-6, 1.0}) {
+  for (double scale : {1e6, 1e-6, 1.0, 1e155, 1e300}) {
     std::uniform_int_distribution<int> ulps(-4, 4);
     for (int i = 0; i < 5000; ++i) {
       // t is s moved by a few ulps at one or both ends: parallel, crossing, or touching
