@@ -92,10 +92,12 @@ class PackedRTree {
 
   // Builds from boxes; box i gets id i. Throws InvalidGeometry on a bad box.
   static PackedRTree build(std::span<const Box<D>> boxes, Packing packing = Packing::hilbert) {
-    Builder b(boxes.size());
-    for (const auto& box : boxes)
-      b.add(box);
-    return std::move(b).finish(packing);
+    // Checked in place and packed from the caller's array: no copy of the boxes is made.
+    if (boxes.size() > std::numeric_limits<std::uint32_t>::max())
+      throw InvalidArgument("PackedRTree holds at most 2^32 - 2 boxes");
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+      if (!is_valid(boxes[i])) check_box(boxes[i], ("box " + std::to_string(i)).c_str());
+    return PackedRTree(boxes, packing);
   }
 
   // Wraps arrays laid out as blocks() and item_indices() return them (for instance from a
