@@ -32,6 +32,10 @@ template <int D>
 struct TightTree : DynamicAabbTree<D> {
   TightTree() : DynamicAabbTree<D>(AabbTreeOptions{0, 0, 0}) {}
 };
+template <int D>
+struct UnpredictedTree : DynamicAabbTree<D> {
+  UnpredictedTree() : DynamicAabbTree<D>(AabbTreeOptions{0, 0.1, 0}) {}
+};
 
 enum class Scene { mixed, identical, sizes, line, points, sparse_ids };
 
@@ -230,7 +234,7 @@ class BroadPhaseTest : public ::testing::Test {};
 using Structures = ::testing::Types<SweepPrune<2>, SweepPrune<3>, StripedSweep<2>, StripedSweep<3>,
                                     IncrementalSweepPrune<2>, IncrementalSweepPrune<3>,
                                     UniformGrid<2>, UniformGrid<3>, FineGrid<2>, DynamicAabbTree<2>,
-                                    DynamicAabbTree<3>, TightTree<2>>;
+                                    DynamicAabbTree<3>, TightTree<2>, UnpredictedTree<2>>;
 TYPED_TEST_SUITE(BroadPhaseTest, Structures);
 
 TYPED_TEST(BroadPhaseTest, RandomMotion) {
@@ -343,6 +347,29 @@ TYPED_TEST(BroadPhaseTest, ExtentsBeyondTheLargestDouble) {
   bp.remove(1);
   std::erase_if(expected, [](const IdPair& p) { return p.a <= 1; });
   EXPECT_EQ(sorted(bp.pairs()), expected);
+  bp.validate();
+}
+
+// A move across the whole range of doubles (its displacement overflows): with a prediction of
+// 0 the tree's fat box became NaN (0 * inf), and queries and pairs missed the proxy.
+TYPED_TEST(BroadPhaseTest, MoveWhoseDisplacementOverflows) {
+  constexpr int D = TypeParam::dimension;
+  Box<D> west, east, small;
+  for (int k = 0; k < D; ++k) {
+    west.min[k] = west.max[k] = k == 0 ? -1e308 : 0;
+    east.min[k] = east.max[k] = k == 0 ? 1e308 : 0;
+    small.min[k] = -5, small.max[k] = -4;
+  }
+  TypeParam bp;
+  bp.add(1, west);
+  bp.add(3, small);
+  bp.update([](Id, Id) { return true; }, [](Id, Id) { return true; });
+  bp.move(1, east);
+  bp.add(2, east);
+  EXPECT_EQ(sorted(bp.pairs()), (std::vector<IdPair>{{1, 2}}));
+  auto got = bp.query(east);
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, (std::vector<Id>{1, 2}));
   bp.validate();
 }
 

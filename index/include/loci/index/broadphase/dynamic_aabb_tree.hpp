@@ -196,11 +196,13 @@ class DynamicAabbTree {
     double e = 0;
     for (int a = 0; a < D; ++a)
       e = std::max(e, b.extent(a));
-    return opt_.margin + opt_.margin_fraction * e;
+    // A fraction of 0 adds nothing, also to an extent that overflows (0 * inf is NaN).
+    return opt_.margin_fraction == 0 ? opt_.margin : opt_.margin + opt_.margin_fraction * e;
   }
 
   // b grown by the margin and stretched along the displacement from `before` (a jump of more
-  // than a few box sizes is a teleport and predicts nothing).
+  // than a few box sizes is a teleport and predicts nothing; so does a displacement that
+  // overflows, which a prediction of 0 would turn into NaN).
   Box<D> fatten(const Box<D>& b, const Box<D>& before) const {
     const double m = margin_of(b);
     Box<D> f = b;
@@ -211,7 +213,7 @@ class DynamicAabbTree {
       const double d = opt_.prediction * (b.min[a] - before.min[a]);
       f.min[a] -= m;
       f.max[a] += m;
-      if (std::abs(d) > reach) continue;
+      if (!(std::abs(d) <= reach)) continue;
       if (d < 0)
         f.min[a] += d;
       else
@@ -436,6 +438,9 @@ void DynamicAabbTree<D>::validate() const {
         throw Error(who + ": node " + std::to_string(n) + " reached twice or free");
       seen[n] = true;
       const Node& x = pool_[n];
+      for (int a = 0; a < D; ++a)
+        if (!(x.box.min[a] <= x.box.max[a]))
+          throw Error(who + ": node " + std::to_string(n) + " has a NaN or inverted box");
       if (x.leaf()) {
         ++leaves;
         const std::uint32_t s = x.child2;
