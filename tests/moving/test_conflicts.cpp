@@ -5,8 +5,10 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "loci/index/moving/conflicts.hpp"
@@ -200,6 +202,31 @@ TEST(Conflicts, ByIdsSortedAndChecked) {
   EXPECT_THROW(find_conflicts<2>(ids, fleet, 1, 0, std::nan("")), InvalidArgument);
   EXPECT_TRUE(
       find_conflicts<2>(std::span<const Id>(), std::span<const Motion2>(), 1, 0, 1).empty());
+}
+
+// Reports that check_motion refuses everywhere else are refused in its words: a NaN was
+// called a position "beyond 1e150 in the time searched", and a time of 1e300 was taken.
+TEST(Conflicts, InvalidReportsAreRefusedAsReports) {
+  const double nan = std::nan(""), inf = INFINITY;
+  const std::vector<std::pair<Motion2, std::string>> cases{
+      {{nan, {1, 0}, {0, 0}}, "conflicts: id 42 has a NaN or infinite time"},
+      {{inf, {1, 0}, {0, 0}}, "conflicts: id 42 has a NaN or infinite time"},
+      {{1e300, {1, 0}, {0, 0}}, "conflicts: id 42 has a time beyond 1e150"},
+      {{0, {nan, 0}, {0, 0}}, "conflicts: id 42 has a NaN or infinite coordinate"},
+      {{0, {1, 0}, {0, nan}}, "conflicts: id 42 has a NaN or infinite coordinate"},
+      {{0, {1, 0}, {0, 2e150}}, "conflicts: id 42 has a velocity beyond 1e150"},
+      // Beyond the range at its report, back in it at the time searched: a report refused.
+      {{0, {2e150, 0}, {-1e150, 0}}, "conflicts: id 42 has a position or velocity beyond 1e150"},
+  };
+  for (const auto& [m, want] : cases) {
+    const std::vector<Motion2> fleet{{0, {0, 0}, {0, 0}}, m};
+    try {
+      find_conflicts<2>(std::vector<Id>{7, 42}, fleet, 2, 1, 1);
+      ADD_FAILURE() << want << ": taken";
+    } catch (const InvalidArgument& e) {
+      EXPECT_EQ(std::string(e.what()).substr(0, want.size()), want);
+    }
+  }
 }
 
 // Objects whose positions leave +-1e150 during the horizon would overflow the closest

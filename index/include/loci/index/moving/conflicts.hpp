@@ -259,15 +259,26 @@ template <int D>
 
 // Throws InvalidArgument, naming the object as who(i) does, for the first object a conflict
 // search refuses: a velocity beyond 1e150 (as check_motion refuses it in a report: the relative
-// velocity of two objects could overflow, even over a horizon of 0), or a position leaving
-// +-1e150 during [now, now + horizon]. Every object is checked, however few.
+// velocity of two objects could overflow, even over a horizon of 0), any other report
+// check_motion refuses (a NaN or infinite value, a time or position beyond 1e150; in its
+// words), or a position leaving +-1e150 during [now, now + horizon]. Every object is checked,
+// however few.
 template <int D, class Name>
 void check_conflict_objects(std::span<const Motion<D>> objects, double now, double horizon,
                             Name&& who) {
   for (std::size_t i = 0; i < objects.size(); ++i) {
-    if (!within_coordinate_range(objects[i].v))
-      throw InvalidArgument("conflicts: " + who(i) + " has a velocity beyond 1e150");
-    if (!detail::stays_in_range(objects[i], now, now + horizon)) detail::out_of_range(who(i));
+    const Motion<D>& m = objects[i];
+    if (!within_coordinate_range(m.v) || !(std::abs(m.t) <= kMaxCoordinate) ||
+        !within_coordinate_range(m.p)) [[unlikely]] {
+      if (std::isfinite(m.t) && is_finite(m.p) && is_finite(m.v) && !within_coordinate_range(m.v))
+        throw InvalidArgument("conflicts: " + who(i) + " has a velocity beyond 1e150");
+      try {
+        check_motion(m, ("conflicts: " + who(i)).c_str());
+      } catch (const InvalidGeometry& e) {
+        throw InvalidArgument(e.what());
+      }
+    }
+    if (!detail::stays_in_range(m, now, now + horizon)) detail::out_of_range(who(i));
   }
 }
 
