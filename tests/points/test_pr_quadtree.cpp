@@ -5,6 +5,8 @@
 
 #include <limits>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "loci/index/pr_quadtree.hpp"
 #include "support/brute_force.hpp"
@@ -275,6 +277,22 @@ TEST(PrQuadtree, ARefusedFarPointChangesNothing) {
   empty.insert({2, 3}, 2);
   empty.validate();
   EXPECT_EQ(sorted(empty.query(Box2{{0, 0}, {5, 5}})), (std::vector<Id>{1, 2}));
+
+  // build() names the point as insert() does (it spoke of an infinite region never given).
+  const std::vector<Point2> with_big{{0, 0}, {1, 2}, {3, big}};
+  try {
+    PrQuadtree2::build(with_big);
+    ADD_FAILURE() << "a point at the largest double was taken";
+  } catch (const InvalidGeometry& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("point 2 too far from the quadtree's region: (3", 0), 0u)
+        << e.what();
+  }
+  // Far apart, both within reach: taken, and answered.
+  const std::vector<Point2> apart{{-1.7e308, 0}, {1.7e308, 0}, {0, 0}};
+  const PrQuadtree2 wide = PrQuadtree2::build(apart);
+  wide.validate();
+  EXPECT_EQ(sorted(wide.query(Box2{{1e308, -1}, {big, 1}})), (std::vector<Id>{1}));
+  EXPECT_EQ(sorted(wide.query(Box2{{-big, -1}, {big, 1}})), (std::vector<Id>{0, 1, 2}));
 }
 
 // The shared churn harness (tests/support/churn.hpp) on points.

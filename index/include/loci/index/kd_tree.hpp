@@ -96,6 +96,8 @@ class KdTree {
   std::size_t size() const { return root_ == kNone ? 0 : nodes_[root_].size; }
   bool empty() const { return size() == 0; }
   KdSplit split() const { return split_; }
+  // A box holding every point: their bounding box after a build, conservative after erases
+  // (as the nodes' boxes are) until the next rebuild.
   Box<D> bounds() const { return empty() ? Box<D>::empty() : nodes_[root_].box; }
   int height() const { return root_ == kNone ? 0 : height_of(root_); }
   std::size_t memory_bytes() const { return nodes_.memory_bytes() + leaves_.memory_bytes(); }

@@ -99,8 +99,14 @@ class PrQuadtree {
       check_point(points[i], ("point " + std::to_string(i)).c_str());
       region.expand(points[i]);
     }
-    for (int a = 0; a < D && !points.empty(); ++a)  // the root is open at the top
+    for (int a = 0; a < D && !points.empty(); ++a) {  // the root is open at the top
       region.max[a] = std::nextafter(region.max[a], std::numeric_limits<double>::infinity());
+      if (std::isinf(region.max[a]))  // a point at the largest double, named as insert does
+        for (std::size_t i = 0; i < points.size(); ++i)
+          if (points[i][a] == std::numeric_limits<double>::max())
+            throw InvalidGeometry("point " + std::to_string(i) +
+                                  " too far from the quadtree's region: " + to_string(points[i]));
+    }
     PrQuadtree t =
         points.empty() ? PrQuadtree(bucket, max_depth) : PrQuadtree(region, bucket, max_depth);
     t.entries_.reserve(points.size());
