@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 namespace loci::sqlite {
 
@@ -116,9 +117,16 @@ Op op_of(char c) {
   }
 }
 
+// The rows a query matched, taken at xFilter. Should the same connection write to the table
+// (or roll back) while the cursor is still being stepped, the rows not yet returned are looked
+// up again as xNext reaches them: a row deleted since, or no longer in the window, is skipped,
+// and one updated is returned as it is now (never its old box beside its new aux values).
 struct Cursor : sqlite3_vtab_cursor {
   std::vector<Hit> hits;
   std::size_t at = 0;
+  std::uint64_t changes = 0;  // the table's count of changes when the hits were taken
+  bool windowed = false;      // the hits answer `window`
+  Window window;
 };
 
 RTreeTable& table_of(sqlite3_vtab* v) {
@@ -292,9 +300,12 @@ int x_filter(sqlite3_vtab_cursor* cur, int plan, const char* codes, int argc,
              sqlite3_value** argv) {
   Cursor& c = *static_cast<Cursor*>(cur);
   return guarded(cur->pVtab, [&] {
-    RTreeIndex& index = table_of(cur->pVtab).current();
+    RTreeTable& t = table_of(cur->pVtab);
+    RTreeIndex& index = t.current();
     c.hits.clear();
     c.at = 0;
+    c.changes = t.changes;
+    c.windowed = false;
     if (plan == plan_rowid) {
       RowId id;
       if (argc == 1 && row_id(argv[0], id)) {
@@ -306,10 +317,13 @@ int x_filter(sqlite3_vtab_cursor* cur, int plan, const char* codes, int argc,
       Window w;
       for (int i = 0; i < argc && codes && codes[2 * i]; ++i)
         add_constraint(w, codes[2 * i + 1] - '0', op_of(codes[2 * i]), argv[i]);
-      if (w.unbounded() && !w.empty())
+      if (w.unbounded() && !w.empty()) {
         index.scan(c.hits);
-      else
+      } else {
         index.window(w, c.hits);
+        c.windowed = true;
+        c.window = w;
+      }
     } else {
       index.scan(c.hits);
     }
@@ -318,8 +332,21 @@ int x_filter(sqlite3_vtab_cursor* cur, int plan, const char* codes, int argc,
 }
 
 int x_next(sqlite3_vtab_cursor* cur) {
-  ++static_cast<Cursor*>(cur)->at;
-  return SQLITE_OK;
+  Cursor& c = *static_cast<Cursor*>(cur);
+  ++c.at;
+  RTreeTable& t = table_of(cur->pVtab);
+  if (c.changes == t.changes || c.at >= c.hits.size()) return SQLITE_OK;
+  return guarded(cur->pVtab, [&] {  // written to since the hits were taken
+    RTreeIndex& index = t.current();
+    for (; c.at < c.hits.size(); ++c.at) {
+      Hit& h = c.hits[c.at];
+      const std::optional<Box2> now = index.find(h.id);
+      if (!now || (c.windowed && !c.window.matches(*now))) continue;
+      h.box = *now;
+      break;
+    }
+    return SQLITE_OK;
+  });
 }
 int x_eof(sqlite3_vtab_cursor* cur) {
   const Cursor& c = *static_cast<Cursor*>(cur);
@@ -357,6 +384,7 @@ int x_rowid(sqlite3_vtab_cursor* cur, sqlite_int64* id) {
 
 int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_rowid) {
   RTreeTable& t = table_of(v);
+  ++t.changes;
   return guarded(v, [&] {
     RTreeIndex& index = t.current();
     RowId old_id = 0;
@@ -637,6 +665,7 @@ RTreeIndex& RTreeTable::current() {
                                 naming_shadows(e.what(), name).c_str())};
     }
     generation = g;
+    ++changes;
   }
   return *index;
 }

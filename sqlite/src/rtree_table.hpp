@@ -17,6 +17,7 @@
 // again.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,7 +33,10 @@ struct RTreeTable : ShadowTable {
   int aux_count = 0;
 
   std::unique_ptr<RTreeIndex> index;  // null until read
-  std::vector<Hit> spare_hits;        // a cursor's buffer, kept between queries
+  // Writes through the table and readings of its index, counted: an open cursor compares it
+  // with the count it started at.
+  std::uint64_t changes = 0;
+  std::vector<Hit> spare_hits;  // a cursor's buffer, kept between queries
 
   Statement read_node, write_node, clear_node, read_delta, put_delta, drop_delta, clear_delta,
       read_dead, put_dead, clear_dead, get_aux, put_aux, drop_aux;
@@ -45,6 +49,7 @@ struct RTreeTable : ShadowTable {
   // Forgets the in-memory index (after a rollback).
   void forget() {
     index.reset();
+    ++changes;
     forget_version();
   }
   // Reads the stored index afresh, without touching the in-memory one. Throws loci::Error or

@@ -392,6 +392,72 @@ TEST(SqliteRtreeSql, RandomWritesFollowRollbackAndSavepoints) {
   EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
 }
 
+// Writes on the same connection while a query's cursor is still stepped: each row it still
+// returns is the row as it is then (present, in the window, its box and aux values current),
+// never a deleted row or an old box beside new aux values; at most once each.
+TEST(SqliteRtreeSql, ACursorSteppedAcrossWritesReturnsRowsAsTheyAre) {
+  for (const bool rollback : {false, true}) {
+    Db db;
+    db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy, +a)");
+    db.exec(
+        "CREATE TABLE m(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, miny REAL, maxy REAL, a)");
+    std::mt19937_64 rng(rollback ? 41 : 40);
+    for (int i = 1; i <= 300; ++i) {
+      const std::string x = std::to_string(rng() % 100), y = std::to_string(rng() % 100);
+      db.exec_on({"t", "m"}, "INSERT INTO $T VALUES(" + std::to_string(i) + ", " + x + ", " + x +
+                                 " + 1, " + y + ", " + y + " + 1, 'v" + std::to_string(i) + "')");
+    }
+    if (rollback) db.exec("BEGIN; SAVEPOINT s");
+    const char* window = " WHERE minx >= 10 AND maxx <= 80 AND miny >= 0 AND maxy <= 90";
+    sqlite3_stmt* q = nullptr;
+    ASSERT_EQ(
+        sqlite3_prepare_v2(
+            db.get(), (std::string("SELECT id, minx, maxx, miny, maxy, a FROM t") + window).c_str(),
+            -1, &q, nullptr),
+        SQLITE_OK);
+    std::set<std::string> seen;
+    int returned = 0, writes = 0;
+    while (sqlite3_step(q) == SQLITE_ROW) {
+      Row got;
+      for (int c = 0; c < 6; ++c)
+        got.push_back(Db::text(q, c));
+      ASSERT_TRUE(seen.insert(got[0]).second) << "id " << got[0] << " returned twice";
+      // The row as the plain table holds it now, and in the window now.
+      EXPECT_EQ(db.rows("SELECT id, minx, maxx, miny, maxy, a FROM m WHERE id = " + got[0] +
+                        " AND " + (window + 7)),
+                (std::vector<Row>{got}));
+      ++returned;
+      // Then writes: rows deleted, moved (in or out of the window), their aux changed.
+      for (int w = 0; w < 3; ++w, ++writes) {
+        const std::string id = std::to_string(1 + rng() % 300), x = std::to_string(rng() % 100);
+        switch (rng() % 3) {
+          case 0:
+            db.exec_on({"t", "m"}, "DELETE FROM $T WHERE id = " + id);
+            break;
+          case 1:
+            db.exec_on({"t", "m"}, "UPDATE $T SET minx = " + x + ", maxx = " + x +
+                                       " + 2, a = 'moved' WHERE id = " + id);
+            break;
+          default:
+            db.exec_on({"t", "m"}, "UPDATE $T SET a = 'renamed' WHERE id = " + id);
+        }
+      }
+      if (rollback && returned % 5 == 0) {
+        // Back to the savepoint on both: the rows not yet returned are those of the start.
+        db.exec("ROLLBACK TO s");
+      }
+    }
+    sqlite3_finalize(q);
+    if (rollback) db.exec("COMMIT");
+    EXPECT_GT(returned, 20);
+    EXPECT_GT(writes, 60);
+    EXPECT_EQ(all(db, "t"), all(db, "m"));
+    EXPECT_EQ(db.rows("SELECT id, a FROM t ORDER BY id"),
+              db.rows("SELECT id, a FROM m ORDER BY id"));
+    EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+  }
+}
+
 // Loading the extension again on a connection (a script that loads it twice) keeps the
 // tables made before usable by the functions it registers anew.
 TEST(SqliteRtreeSql, LoadingTwiceKeepsEarlierTablesVisible) {
