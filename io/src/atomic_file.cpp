@@ -12,6 +12,7 @@
 #include <cctype>
 #include <cerrno>
 #include <climits>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -134,6 +135,22 @@ bool is_special_path(const std::string& path) {
   return path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
 }
 
+// A file whose first bytes are those of an SQLite database (a GeoPackage) or a TIFF: one that
+// may hold several layers or raster data, which an output written over it would lose. Other
+// files are replaced without asking GDAL (a sidecar index being rewritten, a text output).
+bool may_hold_layers(const std::string& path) {
+  unsigned char head[16] = {};
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  const std::size_t n = std::fread(head, 1, sizeof head, f);
+  std::fclose(f);
+  const bool sqlite = n == 16 && std::memcmp(head, "SQLite format 3", 16) == 0;
+  const bool tiff =
+      n >= 4 && (std::memcmp(head, "II*", 4) == 0 || std::memcmp(head, "MM\0*", 4) == 0 ||
+                 std::memcmp(head, "II+", 4) == 0 || std::memcmp(head, "MM\0+", 4) == 0);
+  return sqlite || tiff;
+}
+
 }  // namespace
 
 AtomicFile::AtomicFile(const std::string& path) : path_(path) {
@@ -162,6 +179,7 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
     if (fd_ < 0) throw cannot_write(path, errno);
     return;
   }
+  if (fs::is_regular_file(st) && may_hold_layers(path_)) refuse_replacing_layers(path_);
   mode_t mode = new_file_mode();
   struct stat old {};
   if (::stat(path_.c_str(), &old) == 0) mode = old.st_mode & 07777;
@@ -324,6 +342,7 @@ bool same_file(const std::string& a, const std::string& b) {
 void refuse_replacing_layers(const std::string& out) {
   std::error_code ec;
   if (!fs::is_regular_file(fs::status(out, ec))) return;
+  GDALAllRegister();  // also where the command has read nothing through GDAL
   CPLPushErrorHandler(CPLQuietErrorHandler);
   // A format of one layer (GeoJSON, a shapefile, CSV) is replaced without being read: opening
   // a big GeoJSON would parse all of it.
