@@ -45,10 +45,19 @@ void ReadCheck::fail(const std::string& where) const {
 
 void ReadCheck::feature(std::int64_t fid) const {
   if (read_failed()) fail("feature " + std::to_string(fid) + ": ");
+  if (!fids_.empty() && fid <= fids_.back()) increasing_ = false;
+  fids_.push_back(fid);
 }
 
 void ReadCheck::finish() const {
   if (read_failed()) fail("");
+  if (increasing_) return;
+  std::sort(fids_.begin(), fids_.end());
+  const auto twice = std::adjacent_find(fids_.begin(), fids_.end());
+  if (twice != fids_.end())
+    throw Error(path_ + ": two features have FID " + std::to_string(*twice) +
+                " (in GeoJSON, their \"id\"); loci reads features back by FID, so each needs "
+                "its own");
 }
 
 }  // namespace detail

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "loci/io/exact.hpp"
 
@@ -91,6 +92,8 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what);
 // error state, feature after feature, and still hands out what it could read. A ReadCheck made
 // before reading resets that state; finish() after reading throws loci::Error naming the file
 // and carrying GDAL's message if anything failed, so a layer is read whole or refused.
+// finish() also refuses a layer whose features share a FID (GDAL gives GeoJSON features their
+// "id", repeated or not): loci reads features back by FID, which would fetch the wrong one.
 class ReadCheck {
  public:
   explicit ReadCheck(std::string path);
@@ -104,6 +107,9 @@ class ReadCheck {
   // Throws the failure GDAL's error state holds, `where` (say "feature 2: ") before its text.
   [[noreturn]] void fail(const std::string& where) const;
   std::string path_;
+  // The FIDs read, and whether they came in increasing order (then none repeats).
+  mutable std::vector<std::int64_t> fids_;
+  mutable bool increasing_ = true;
 };
 
 // A GDAL vector driver chosen from the output file name's extension (.geojson or .json, .shp,
