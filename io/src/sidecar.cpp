@@ -212,10 +212,10 @@ std::vector<std::string> layer_files(const std::string& layer_path) {
   }
   std::vector<std::string> files{layer_path};
   const std::string ext = layer_path.size() > 4 ? layer_path.substr(layer_path.size() - 4) : "";
-  if (lower(ext) == ".shp") {
-    // Its index (.shx) and its attributes (.dbf, which also marks deleted records).
-    const std::string stem = layer_path.substr(0, layer_path.size() - 4);
-    for (const auto& [lower_ext, upper_ext] : {std::pair{".shx", ".SHX"}, {".dbf", ".DBF"}})
+  const std::string stem = layer_path.substr(0, layer_path.size() - ext.size());
+  // The companions that hold part of the layer, each in lower or upper case when there.
+  const auto add = [&](std::initializer_list<std::pair<const char*, const char*>> exts) {
+    for (const auto& [lower_ext, upper_ext] : exts)
       for (const char* e : {lower_ext, upper_ext}) {
         struct stat s2 {};
         if (stat_file(stem + e, s2) && S_ISREG(s2.st_mode)) {
@@ -223,7 +223,22 @@ std::vector<std::string> layer_files(const std::string& layer_path) {
           break;
         }
       }
+  };
+  if (lower(ext) == ".shp") {
+    // Its index (.shx) and its attributes (.dbf, which also marks deleted records).
+    add({{".shx", ".SHX"}, {".dbf", ".DBF"}});
+  } else if (lower(ext) == ".csv") {
+    // The column types, which can make two columns the geometry's x and y.
+    add({{".csvt", ".CSVT"}});
+  } else if (lower(ext) == ".tab") {
+    // A MapInfo table: its geometries (.map, .id) and attributes (.dat).
+    add({{".map", ".MAP"}, {".id", ".ID"}, {".dat", ".DAT"}});
   }
+  // An SQLite database (a GeoPackage) in WAL mode keeps the changes committed since its last
+  // checkpoint in FILE-wal, which readers see: an edit there changes the layer too.
+  struct stat wal {};
+  if (stat_file(layer_path + "-wal", wal) && S_ISREG(wal.st_mode) && wal.st_size > 0)
+    files.push_back(layer_path + "-wal");
   return files;
 }
 

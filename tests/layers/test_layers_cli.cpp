@@ -1141,6 +1141,68 @@ TEST_F(LayersCli, ClipRefusesToReplaceAFileHoldingOtherLayers) {
   EXPECT_EQ(got.envelopes[0].MaxY, 2.0);
 }
 
+// Every command's -o refuses a GeoPackage holding other layers, as clip does (query, index,
+// draw and join wrote text, a sidecar or SVG over it); `draw` of a sidecar refuses its layer
+// as the output (it wrote the SVG over the layer the sidecar indexes).
+TEST_F(LayersCli, EveryOutputRefusesToReplaceAFileHoldingOtherLayers) {
+  const std::string u = path("sq2.geojson");
+  std::ofstream(u) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"n":1},"geometry":{"type":"Polygon","coordinates":
+[[[0,0],[6,0],[6,6],[0,6],[0,0]]]}}]})";
+  const std::string two = path("keep2.gpkg");
+  fs::remove(two);
+  ASSERT_EQ(std::system(("ogr2ogr -f GPKG " + two + " " + u + " -nln alpha && ogr2ogr -update " +
+                         two + " " + u + " -nln beta")
+                            .c_str()),
+            0);
+  const auto size = fs::file_size(two);
+  for (const std::string command :
+       {"query " + u + " --bbox 1,1,2,2", "index " + u + " -q", "draw " + u + " -q",
+        "join " + u + " " + u + " -p intersects -q", "intersections " + u + " -q"}) {
+    expect_error(command + " -o " + two,
+                 "holds 2 layers (alpha, beta), which writing the whole file would lose");
+    EXPECT_EQ(fs::file_size(two), size) << command;
+  }
+  EXPECT_EQ(read_with_ogr(two).geoms.size(), 1u);  // alpha, untouched
+  // The layer a sidecar indexes, given as draw's output through the sidecar.
+  const std::string layer = path("drawn.gpkg");
+  fs::remove(layer);
+  ASSERT_EQ(std::system(("ogr2ogr -f GPKG " + layer + " " + u + " -nln drawn").c_str()), 0);
+  ASSERT_EQ(run_loci("index -q " + layer).status, 0);
+  const auto layer_size = fs::file_size(layer);
+  expect_error("draw " + layer + ".loci -q -o " + layer, "is the input layer");
+  EXPECT_EQ(fs::file_size(layer), layer_size);
+  EXPECT_EQ(read_with_ogr(layer).geoms.size(), 1u);
+  const auto sidecar_size = fs::file_size(layer + ".loci");
+  expect_error("draw " + layer + ".loci -q -o " + layer + ".loci", "refusing to write");
+  EXPECT_EQ(fs::file_size(layer + ".loci"), sidecar_size);
+}
+
+// Features sharing a FID (GDAL gives GeoJSON features their "id", repeated or not) are refused:
+// loci reads features back by FID, and answered with the other feature's geometry and values.
+TEST_F(LayersCli, FeaturesSharingAFidAreRefused) {
+  const std::string d = path("dup.geojson");
+  std::ofstream(d) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","id":1,"properties":{"n":"a"},"geometry":{"type":"Point","coordinates":[0,0]}},
+{"type":"Feature","id":1,"properties":{"n":"b"},"geometry":{"type":"Point","coordinates":[20,20]}}]})";
+  for (const std::string command :
+       {"query " + d + " --bbox 19,19,21,21 -f csv", "query " + d + " --nearest 20,20 -k 1",
+        "index " + d + " -q -o " + path("dup.loci"),
+        "clip " + d + " --bbox 19,19,21,21 -q -o " + path("dup_clip.geojson"),
+        "join " + d + " " + d + " -p intersects"})
+    expect_error(command, "dup.geojson: two features have FID 1");
+  EXPECT_FALSE(fs::exists(path("dup.loci")));
+  EXPECT_FALSE(fs::exists(path("dup_clip.geojson")));
+  // Distinct ids, or none: read as before.
+  const std::string ok = path("nodup.geojson");
+  std::ofstream(ok) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","id":7,"properties":{"n":"a"},"geometry":{"type":"Point","coordinates":[0,0]}},
+{"type":"Feature","id":3,"properties":{"n":"b"},"geometry":{"type":"Point","coordinates":[20,20]}}]})";
+  const CliRun r = run_loci("query " + ok + " --bbox 19,19,21,21 -f ids");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "3\n");
+}
+
 TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
   const std::string u = path("u.geojson"), line = path("touch.geojson");
   std::ofstream(u) << R"({"type":"FeatureCollection","features":[
@@ -1552,6 +1614,59 @@ TEST_F(LayersCli, SeesEditsToAShapefilesAttributesAndToADirectoryOfShapefiles) {
   ASSERT_EQ(run_loci("index -q " + dir).status, 0);
   flip(dir + "/polys.shp", -8, 0x10);
   expect_error("query " + dir + " --bbox 0,0,9,9", "stale index");
+}
+
+// Files beside the one named that hold part of the layer are fingerprinted too: a CSV's
+// .csvt (its CoordX/CoordY types make the geometry), a MapInfo table's .map/.id/.dat, and a
+// GeoPackage's uncheckpointed WAL. Before, an index stayed "fresh" through edits to them and
+// answered from the old geometry.
+TEST_F(LayersCli, SeesEditsToTheFilesBesideALayer) {
+  const std::string csv = path("xy.csv"), csvt = path("xy.csvt");
+  std::ofstream(csv) << "id,x,y\n1,1,2\n2,5,6\n";
+  std::ofstream(csvt) << "Integer,CoordX,CoordY\n";
+  ASSERT_EQ(run_loci("index -q " + csv).status, 0);
+  const CliRun before = run_loci("query " + csv + " --bbox 0.5,1.5,1.5,2.5 -f ids");
+  ASSERT_EQ(before.status, 0) << before.err;
+  EXPECT_EQ(before.out, "1\n");
+  std::ofstream(csvt) << "Integer,CoordY,CoordX\n";  // x and y swapped, the .csv untouched
+  expect_error("query " + csv + " --bbox 0.5,1.5,1.5,2.5 -f ids", "stale index");
+  ASSERT_EQ(run_loci("index -q " + csv).status, 0);
+  const CliRun after = run_loci("query " + csv + " --bbox 1.5,0.5,2.5,1.5 -f ids");
+  ASSERT_EQ(after.status, 0) << after.err;
+  EXPECT_EQ(after.out, "1\n");
+
+  // MapInfo: a feature appended changes the .map and .dat, not the .tab.
+  const std::string tab = path("mi.tab");
+  for (const char* e : {".tab", ".map", ".id", ".dat"})
+    fs::remove(path(std::string("mi") + e));
+  const std::string pts = path("mi.csv");
+  std::ofstream(pts) << "id,WKT\n1,\"POINT (1 1)\"\n";
+  ASSERT_EQ(std::system(("ogr2ogr -q -f \"MapInfo File\" " + tab + " " + pts).c_str()), 0);
+  ASSERT_EQ(run_loci("index -q " + tab).status, 0);
+  std::ofstream(pts) << "id,WKT\n2,\"POINT (7 7)\"\n";
+  ASSERT_EQ(std::system(("ogr2ogr -q -update -append " + tab + " " + pts + " -nln mi").c_str()), 0);
+  expect_error("query " + tab + " --bbox 6,6,8,8 -f ids", "stale index");
+
+  // A GeoPackage in WAL mode with a writer still open: its committed changes sit in the WAL.
+  const std::string gpkg = path("w.gpkg");
+  fs::remove(gpkg);
+  ASSERT_EQ(std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + pts + " -nln w && sqlite3 " + gpkg +
+                         " 'PRAGMA journal_mode=WAL' > /dev/null")
+                            .c_str()),
+            0);
+  ASSERT_EQ(run_loci("index -q " + gpkg).status, 0);
+  GDALDatasetH writer =
+      GDALOpenEx(gpkg.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
+  ASSERT_NE(writer, nullptr);
+  GDALDatasetReleaseResultSet(
+      writer, GDALDatasetExecuteSQL(writer, "CREATE TABLE note(x)", nullptr, nullptr));
+  GDALDatasetReleaseResultSet(
+      writer, GDALDatasetExecuteSQL(writer, "INSERT INTO note VALUES (1)", nullptr, nullptr));
+  GDALFlushCache(writer);
+  ASSERT_TRUE(fs::exists(gpkg + "-wal") && fs::file_size(gpkg + "-wal") > 0);
+  const CliRun info = run_loci("info " + gpkg);
+  GDALClose(writer);
+  EXPECT_NE(info.out.find("stale"), std::string::npos) << info.out << info.err;
 }
 
 // A VRT's features live in its sources: an index of the VRT would stay "fresh" while they

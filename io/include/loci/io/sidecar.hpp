@@ -49,7 +49,8 @@
 // Fingerprint. The index is valid for the exact bytes it was built from: at index time the
 // source's size, modification time (nanoseconds), inode and a 64-bit XXH3 hash of its contents
 // (for a shapefile, of its .shp, .shx and .dbf, which hold every geometry, the record offsets
-// and the deletion marks; for a directory, of every file in it: layer_files()).
+// and the deletion marks; for a directory, of every file in it; the companions of a CSV, a
+// MapInfo table or a GeoPackage in WAL mode too: layer_files()).
 // At query time size, modification time and inode are compared, nothing read; only when they
 // differ (a touched, copied or rewritten layer) is the content hashed again, and the index is
 // fresh if size and hash still agree. Sizes, times and inodes are taken before the layer is
@@ -141,8 +142,10 @@ struct Fingerprint {
 };
 
 // The files a layer's fingerprint covers, in the order they are hashed: the path itself; for
-// a shapefile also its .shx and .dbf; for a directory (a dataset of several files) every
-// regular file in it, in name order.
+// a shapefile also its .shx and .dbf, for a CSV its .csvt, for a MapInfo .tab its .map, .id
+// and .dat, and for any file a non-empty FILE-wal (an SQLite database's, a GeoPackage's,
+// uncheckpointed changes); for a directory (a dataset of several files) every regular file in
+// it, in name order.
 std::vector<std::string> layer_files(const std::string& layer_path);
 
 // The full fingerprint, contents hashed (index time). Throws loci::Error when the layer's
