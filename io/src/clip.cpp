@@ -264,6 +264,14 @@ ClipResult clip_layer(const ClipOptions& options) {
       if (!rectangle &&
           !meets(detail::flatten(g, detail::where(options.load.layer_path, a.fid)), window_flat))
         continue;
+      // Triangles, TINs and polyhedral surfaces are cut as the polygons of their faces (GEOS
+      // takes no other surface).
+      std::unique_ptr<OGRGeometry> faces;
+      const auto type = wkbFlatten(g->getGeometryType());
+      if (type == wkbTriangle || type == wkbTIN || type == wkbPolyhedralSurface) {
+        faces.reset(OGRGeometryFactory::forceToMultiPolygon(g->clone()));
+        g = faces.get();
+      }
       const std::unique_ptr<OGRGeometry> near = near_window(*g, window_envelope);
       if (near) g = near.get();
       std::unique_ptr<OGRGeometry> valid;

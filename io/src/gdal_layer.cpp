@@ -139,12 +139,18 @@ void walk(const OGRGeometry* g, std::uint32_t& polygons,
     case wkbLinearRing:
       f(*g->toSimpleCurve(), false, 0);
       break;
-    case wkbPolygon: {
+    case wkbPolygon:
+    case wkbTriangle: {
       const std::uint32_t id = polygons++;
       for (const auto* ring : *g->toPolygon())
         f(*ring, true, id);
       break;
     }
+    case wkbPolyhedralSurface:
+    case wkbTIN:  // faces (triangles of a TIN, a MultiPatch shapefile's 3D surfaces) as polygons
+      for (const auto* face : *g->toPolyhedralSurface())
+        walk(face, polygons, f);
+      break;
     case wkbMultiLineString:
     case wkbMultiPolygon:
     case wkbGeometryCollection:

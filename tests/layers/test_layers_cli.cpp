@@ -1178,6 +1178,46 @@ TEST_F(LayersCli, EveryOutputRefusesToReplaceAFileHoldingOtherLayers) {
   EXPECT_EQ(fs::file_size(layer + ".loci"), sidecar_size);
 }
 
+// Triangles, TINs and polyhedral surfaces (a MultiPatch shapefile's 3D buildings are TINs to
+// GDAL) are surfaces: found by points and windows inside them and by nearest-n at 0, and cut
+// by clip. Before, the exact tests took them for empty: only a window holding the whole
+// feature found it, and clip failed.
+TEST_F(LayersCli, TrianglesTinsAndPolyhedralSurfacesAreSurfaces) {
+  const std::string csv = path("tin.csv"), gpkg = path("tin.gpkg");
+  std::ofstream(csv) << "id,WKT\n"
+                        "1,\"TRIANGLE ((0 0, 10 0, 0 10, 0 0))\"\n"
+                        "2,\"TIN (((20 0, 30 0, 20 10, 20 0)),((30 0, 30 10, 20 10, 30 0)))\"\n"
+                        "3,\"POLYHEDRALSURFACE Z (((40 0 0, 50 0 0, 40 10 0, 40 0 0)))\"\n";
+  fs::remove(gpkg);
+  ASSERT_EQ(std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + csv +
+                         " -nln tin -oo GEOM_POSSIBLE_NAMES=WKT -oo KEEP_GEOM_COLUMNS=NO "
+                         "-nlt GEOMETRYZ 2> /dev/null")
+                            .c_str()),
+            0);
+  for (const auto& [query, want] : std::vector<std::pair<std::string, std::string>>{
+           {"--point 1,1", "1\n"},
+           {"--point 29,9", "2\n"},
+           {"--point 41,1", "3\n"},
+           {"--point 9,9", ""},  // beyond the triangle's long side
+           {"--bbox 1,1,2,2", "1\n"},
+           {"--bbox 24,4,26,6", "2\n"},
+           {"--nearest 41,1 -k 1", "3\n"}}) {
+    const CliRun r = run_loci("query " + gpkg + " " + query + " -f ids");
+    EXPECT_EQ(r.status, 0) << query << r.err;
+    EXPECT_EQ(r.out, want) << query;
+  }
+  const std::string cut = path("tin_cut.geojson");
+  fs::remove(cut);
+  const CliRun c = run_loci("clip " + gpkg + " --bbox 5,-1,45,5 -q -o " + cut);
+  ASSERT_EQ(c.status, 0) << c.err;
+  const OgrFeatureSet got = read_with_ogr(cut);
+  ASSERT_EQ(got.geoms.size(), 3u);
+  double area = 0;
+  for (const auto& g : got.geoms)
+    area += OGR_G_Area(OGRGeometry::ToHandle(g.get()));
+  EXPECT_DOUBLE_EQ(area, 12.5 + 50 + 25);
+}
+
 // Features sharing a FID (GDAL gives GeoJSON features their "id", repeated or not) are refused:
 // loci reads features back by FID, and answered with the other feature's geometry and values.
 TEST_F(LayersCli, FeaturesSharingAFidAreRefused) {
