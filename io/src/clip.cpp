@@ -287,6 +287,9 @@ ClipResult clip_layer(const ClipOptions& options) {
         throw Error(options.load.layer_path + ": feature " + std::to_string(a.fid) +
                     " cannot be cut to the window (" + CPLGetLastErrorMsg() + ")");
       if (piece->IsEmpty()) continue;
+      // Measures are not carried through the cut (GEOS keeps x, y and z): none, rather than
+      // a made-up 0 at every vertex.
+      piece->setMeasured(FALSE);
       if (piece->getDimension() < f->GetGeometryRef()->getDimension()) {
         if (!mixed_ok) {
           ++result.dropped;
@@ -315,7 +318,8 @@ ClipResult clip_layer(const ClipOptions& options) {
     // window cuts into several parts: forced back to one polygon, the parts would turn into
     // holes of the first. Such a layer is written as MultiPolygon (likewise for lines and
     // points).
-    OGRwkbGeometryType type = degenerate ? wkbUnknown : source_type;
+    OGRwkbGeometryType type =
+        degenerate ? wkbUnknown : OGR_GT_SetModifier(source_type, OGR_GT_HasZ(source_type), FALSE);
     if (wkbFlatten(type) != wkbUnknown &&
         !OGR_GT_IsSubClassOf(wkbFlatten(type), wkbGeometryCollection))
       for (const Piece& p : pieces)

@@ -1218,6 +1218,30 @@ TEST_F(LayersCli, TrianglesTinsAndPolyhedralSurfacesAreSurfaces) {
   EXPECT_DOUBLE_EQ(area, 12.5 + 50 + 25);
 }
 
+// A clip keeps Z (interpolated along the cut) and writes no M (GEOS does not carry measures:
+// every vertex got M = 0, values no one measured), as ogr2ogr -clipsrc does.
+TEST_F(LayersCli, ClipKeepsZAndWritesNoMadeUpMeasures) {
+  const std::string csv = path("zm.csv"), gpkg = path("zm.gpkg"), cut = path("zm_cut.gpkg");
+  std::ofstream(csv) << "id,WKT\n1,\"LINESTRING ZM (0 1 100 5, 10 1 200 15)\"\n";
+  fs::remove(gpkg);
+  fs::remove(cut);
+  ASSERT_EQ(std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + csv +
+                         " -oo GEOM_POSSIBLE_NAMES=WKT -oo KEEP_GEOM_COLUMNS=NO -nlt LINESTRINGZM")
+                            .c_str()),
+            0);
+  const CliRun r = run_loci("clip " + gpkg + " --bbox 2,-1,8,2 -q -o " + cut);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const OgrFeatureSet got = read_with_ogr(cut);
+  ASSERT_EQ(got.geoms.size(), 1u);
+  const OGRGeometry& g = *got.geoms[0];
+  EXPECT_TRUE(g.Is3D());
+  EXPECT_FALSE(g.IsMeasured());
+  char* wkt = nullptr;
+  g.exportToWkt(&wkt, wkbVariantIso);
+  EXPECT_STREQ(wkt, "LINESTRING Z (2 1 120,8 1 180)");
+  CPLFree(wkt);
+}
+
 // Features sharing a FID (GDAL gives GeoJSON features their "id", repeated or not) are refused:
 // loci reads features back by FID, and answered with the other feature's geometry and values.
 TEST_F(LayersCli, FeaturesSharingAFidAreRefused) {
