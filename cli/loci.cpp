@@ -318,6 +318,7 @@ int run_draw(const Args& a) {
   DrawOptions o;
   o.path = layer_arg(a, "draw");
   o.layer_name = a.get("--layer");
+  o.index_path = a.get("--index");
   if (!a.has("--output")) throw UsageError("loci draw needs -o OUT.svg");
   o.out_path = a.get("--output");
   if (a.has("--levels")) o.max_levels = int(parse_count("--levels", a.get("--levels"), 1, 64));
@@ -627,7 +628,8 @@ const std::vector<Command>& commands() {
        "  loci join ports.shp coast.shp --predicate dwithin:0.05 -f csv\n",
        run_join},
       {"draw",
-       "loci draw LAYER|FILE.loci -o OUT.svg [--levels N | --cells L] [--width PX]",
+       "loci draw LAYER|LAYER.loci -o OUT.svg [--index FILE] [--levels N | --cells L] "
+       "[--width PX]",
        "SVG of the layer's linework and the packed index's nodes, one colour per level, or "
        "its region quadtree cells",
        {{"--output", "-o", "OUT.svg", "the drawing"},
@@ -637,6 +639,7 @@ const std::vector<Command>& commands() {
          "draw the layer's region quadtree cut L times (0 to 12) instead: polygon interiors, "
          "the cells the linework runs through (MX cells), empty blocks"},
         {"--width", nullptr, "PX", "width in pixels (16 to 100000, default 1200)"},
+        kIndex,
         kPer,
         kLayer,
         kQuiet},

@@ -70,14 +70,19 @@ std::size_t write_cells(std::FILE* o, const Frame& f, const RegionQuadtree& cell
 
 std::size_t draw_index(const DrawOptions& options) {
   LoadOptions load;
-  if (detail::ends_with(options.path, ".loci")) {
+  if (!options.index_path.empty()) {
+    load.layer_path = options.path;
+    load.index_path = options.index_path;
+  } else if (detail::ends_with(options.path, ".loci")) {
     load.layer_path = options.path.substr(0, options.path.size() - 5);
     load.index_path = options.path;
     struct stat st {};
     if (::stat(options.path.c_str(), &st) == 0 && ::stat(load.layer_path.c_str(), &st) != 0 &&
         load.layer_path.rfind("/vsi", 0) != 0)
       throw Error(options.path + ": its layer " + load.layer_path +
-                  " is missing (an index is drawn over the layer it was built from)");
+                  " is missing (an index is drawn over the layer it was built from: loci draw "
+                  "LAYER --index " +
+                  options.path + ")");
   } else {
     load.layer_path = options.path;
   }

@@ -1141,6 +1141,22 @@ TEST_F(LayersCli, ClipRefusesToReplaceAFileHoldingOtherLayers) {
   EXPECT_EQ(got.envelopes[0].MaxY, 2.0);
 }
 
+// A sidecar written elsewhere with -o is drawn with --index (draw took the layer from the
+// sidecar's name and refused it as missing, with no way to name it).
+TEST_F(LayersCli, DrawTakesASidecarNamedByIndex) {
+  const std::string sidecar = path("elsewhere.loci"), out = path("elsewhere.svg");
+  ASSERT_EQ(run_loci("index -q " + path("lines.shp") + " -o " + sidecar).status, 0);
+  expect_error("draw " + sidecar + " -q -o " + out, "loci draw LAYER --index " + sidecar);
+  EXPECT_FALSE(fs::exists(out));
+  const CliRun r = run_loci("draw " + path("lines.shp") + " --index " + sidecar + " -q -o " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(read_text(out).find("<rect x="), std::string::npos);
+  // The sidecar of another layer is refused, as queries refuse it.
+  const CliRun other =
+      run_loci("draw " + path("polys.shp") + " --index " + sidecar + " -q -o " + out);
+  EXPECT_EQ(other.status, 1) << other.err;
+}
+
 // Every command's -o refuses a GeoPackage holding other layers, as clip does (query, index,
 // draw and join wrote text, a sidecar or SVG over it); `draw` of a sidecar refuses its layer
 // as the output (it wrote the SVG over the layer the sidecar indexes).

@@ -129,6 +129,7 @@ ClipResult clip_layer(const ClipOptions& options);
 struct DrawOptions {
   std::string
       path;  // a layer, or a .loci sidecar (then the layer is the sidecar's name minus .loci)
+  std::string index_path;  // the sidecar of the layer at `path`, when not path + ".loci"
   std::string layer_name;
   std::string out_path;
   int width = 1200;
