@@ -21,6 +21,7 @@
 
 #include "bench.hpp"
 #include "loci/geom/error.hpp"
+#include "loci/io/atomic_file.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/fleet_commands.hpp"
 #include "loci/io/intersections.hpp"
@@ -209,6 +210,9 @@ int run_query(const Args& a) {
   }
   if (a.has("--first") && !a.has("--segment"))
     throw UsageError("--first goes with --segment (the feature the segment meets first)");
+  for (const char* file : {"--bbox-file", "--nearest-file", "--point-file"})
+    if (a.has(file) && a.has("--output"))
+      refuse_overwriting(a.get("--output"), a.get(file), "query file");
   if (a.has("--bbox-file")) {
     o.queries = read_query_file(a.get("--bbox-file"), Query::Kind::bbox, k);
     o.numbered = true;

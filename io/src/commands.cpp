@@ -137,6 +137,8 @@ std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& pa
   std::vector<std::pair<std::size_t, Query>> out;
   std::string line;
   for (std::size_t n = 1; std::getline(in, line); ++n) {
+    // A UTF-8 byte order mark, as editors on some systems write it, is not part of the text.
+    if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
     while (!line.empty() && (line.back() == '\r' || line.back() == ' '))
       line.pop_back();

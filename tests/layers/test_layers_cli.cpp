@@ -1157,6 +1157,23 @@ TEST_F(LayersCli, DrawTakesASidecarNamedByIndex) {
   EXPECT_EQ(other.status, 1) << other.err;
 }
 
+// A query file may start with a UTF-8 byte order mark (it was refused, quoting a line that
+// looked right), and -o onto the query file itself is refused (it was overwritten).
+TEST_F(LayersCli, QueryFilesTakeAByteOrderMarkAndAreNeverOverwritten) {
+  const std::string q = path("bom.txt");
+  std::ofstream(q, std::ios::binary) << "\xEF\xBB\xBF"
+                                     << "0,0,100,100\r\n";
+  const CliRun plain = run_loci("query " + path("lines.shp") + " --bbox 0,0,100,100 -f ids");
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  const CliRun r = run_loci("query " + path("lines.shp") + " --bbox-file " + q + " -f ids");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out, "");
+  const std::string before = read_text(q);
+  expect_error("query " + path("lines.shp") + " --bbox-file " + q + " -f ids -o " + q,
+               "it is the query file");
+  EXPECT_EQ(read_text(q), before);
+}
+
 // Every command's -o refuses a GeoPackage holding other layers, as clip does (query, index,
 // draw and join wrote text, a sidecar or SVG over it); `draw` of a sidecar refuses its layer
 // as the output (it wrote the SVG over the layer the sidecar indexes).
