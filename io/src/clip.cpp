@@ -267,8 +267,7 @@ ClipResult clip_layer(const ClipOptions& options) {
       // Triangles, TINs and polyhedral surfaces are cut as the polygons of their faces (GEOS
       // takes no other surface).
       std::unique_ptr<OGRGeometry> faces;
-      const auto type = wkbFlatten(g->getGeometryType());
-      if (type == wkbTriangle || type == wkbTIN || type == wkbPolyhedralSurface) {
+      if (detail::of_faces(g->getGeometryType())) {
         faces.reset(OGRGeometryFactory::forceToMultiPolygon(g->clone()));
         g = faces.get();
       }

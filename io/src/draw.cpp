@@ -89,7 +89,7 @@ std::size_t draw_index(const DrawOptions& options) {
   load.layer_name = options.layer_name;
   load.progress = options.progress;
   refuse_overwriting(options.out_path, load.layer_path);  // the layer a sidecar names too
-  if (!load.index_path.empty()) refuse_overwriting(options.out_path, load.index_path, "index");
+  refuse_overwriting(options.out_path, sidecar_path_of(load), "index");  // LAYER.loci by default
   const bool cells = options.cell_levels >= 0;
   if (cells) load.per = Per::segment;
   const LayerIndex index = load_index(load);

@@ -88,6 +88,12 @@ void for_each_curve(const OGRGeometry* g,
 // Throws InvalidGeometry (naming `what`) on a NaN or infinite coordinate.
 FlatGeometry flatten(const OGRGeometry* g, const std::string& what);
 
+// A triangle, TIN or polyhedral surface: a surface made of polygon faces, read as those faces.
+inline bool of_faces(OGRwkbGeometryType type) {
+  type = wkbFlatten(type);
+  return type == wkbTriangle || type == wkbTIN || type == wkbPolyhedralSurface;
+}
+
 // GDAL reports a file it can read only in part (a truncated or garbled shapefile) through its
 // error state, feature after feature, and still hands out what it could read. A ReadCheck made
 // before reading resets that state; finish() after reading throws loci::Error naming the file

@@ -80,7 +80,7 @@ namespace {
 bool is_polygonal(const OGRGeometry* g) {
   const auto t = wkbFlatten(g->getGeometryType());
   return t == wkbPolygon || t == wkbMultiPolygon || t == wkbCurvePolygon || t == wkbMultiSurface ||
-         t == wkbGeometryCollection || t == wkbTriangle || t == wkbTIN || t == wkbPolyhedralSurface;
+         t == wkbGeometryCollection || detail::of_faces(t);
 }
 
 // Refuses a line or polygon feature with a coordinate out of range (NaN, infinite), without

@@ -1203,6 +1203,9 @@ TEST_F(LayersCli, DrawOfASidecarRefusesItsLayerAsTheOutput) {
   const auto sidecar_size = fs::file_size(layer + ".loci");
   expect_error("draw " + layer + ".loci -q -o " + layer + ".loci", "refusing to write");
   EXPECT_EQ(fs::file_size(layer + ".loci"), sidecar_size);
+  // Drawing the layer reads its default sidecar: that is refused as the output too.
+  expect_error("draw " + layer + " -q -o " + layer + ".loci", "refusing to write");
+  EXPECT_EQ(fs::file_size(layer + ".loci"), sidecar_size);
 }
 
 // Triangles, TINs and polyhedral surfaces (a MultiPatch shapefile's 3D buildings are TINs to
