@@ -285,6 +285,16 @@ class RTreeIndex {
       out.push_back({id, b});
   }
 
+  // Appends every row in ascending id order, as a rowid table is scanned: a statement that
+  // renumbers rows (UPDATE t SET id = id - 1) then meets the same conflicts as on any table.
+  void scan_by_id(std::vector<Hit>& out) const {
+    const std::size_t from = out.size();
+    scan(out);  // in packed order, read one after the other, then sorted: cheaper than
+                // reading the rows through by_id_ all over the arrays
+    std::sort(out.begin() + std::ptrdiff_t(from), out.end(),
+              [](const Hit& a, const Hit& b) { return a.id < b.id; });
+  }
+
   // The k rows nearest p (distance to the box, 0 inside), nearest first.
   void nearest(const Point2& p, std::size_t k, std::vector<Near>& out) {
     out.clear();

@@ -259,6 +259,9 @@ int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
     const RTreeTable& t = table_of(v);
     const double rows = t.index ? double(std::max<std::size_t>(t.index->size(), 1)) : 1e6;
     if (arg == 0) {
+      // A scan comes in ascending id order, as a rowid table's does.
+      if (info->nOrderBy == 1 && info->aOrderBy[0].iColumn <= col_id && !info->aOrderBy[0].desc)
+        info->orderByConsumed = 1;
       info->idxNum = plan_scan;
       info->estimatedCost = 2.0 * rows + 1e5;
       info->estimatedRows = sqlite3_int64(rows);
@@ -311,21 +314,21 @@ int x_filter(sqlite3_vtab_cursor* cur, int plan, const char* codes, int argc,
       if (argc == 1 && row_id(argv[0], id)) {
         if (auto b = index.find(id)) c.hits.push_back({id, *b});
       } else if (argc == 1 && sqlite3_value_type(argv[0]) != SQLITE_NULL) {
-        index.scan(c.hits);  // not an integer: SQLite's own comparison decides
+        index.scan_by_id(c.hits);  // not an integer: SQLite's own comparison decides
       }
     } else if (plan == plan_window) {
       Window w;
       for (int i = 0; i < argc && codes && codes[2 * i]; ++i)
         add_constraint(w, codes[2 * i + 1] - '0', op_of(codes[2 * i]), argv[i]);
       if (w.unbounded() && !w.empty()) {
-        index.scan(c.hits);
+        index.scan_by_id(c.hits);
       } else {
         index.window(w, c.hits);
         c.windowed = true;
         c.window = w;
       }
     } else {
-      index.scan(c.hits);
+      index.scan_by_id(c.hits);
     }
     return SQLITE_OK;
   });
