@@ -169,7 +169,7 @@ int run_index(const Args& a) {
 }
 
 int run_check(const Args& a) {
-  const std::string out = check_sidecar(layer_arg(a, "check", "FILE.loci"));
+  const std::string out = check_sidecar(layer_arg(a, "check", "FILE.loci | LAYER"));
   std::printf("%s\n", out.c_str());
   return 0;
 }
@@ -535,10 +535,12 @@ const std::vector<Command>& commands() {
        "  loci index countries.shp\n  loci index coastline.geojson --per segment -o coast.loci\n",
        run_index},
       {"check",
-       "loci check FILE.loci",
-       "verifies a sidecar index completely: every checksum and the tree's invariants",
+       "loci check FILE.loci | LAYER",
+       "verifies a sidecar index completely: every checksum and the tree's invariants, and that "
+       "the layer it is named after (FILE) has not changed since",
        {},
-       "  loci check countries.shp.loci\n",
+       "  loci check countries.shp.loci\n  loci check countries.shp      (its sidecar "
+       "countries.shp.loci)\n",
        run_check},
       {"query",
        "loci query LAYER (--bbox ... | --bbox-file F | --nearest X,Y [-k N] | ...) [-f FMT] [-o "

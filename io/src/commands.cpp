@@ -342,7 +342,21 @@ std::vector<std::size_t> run_order(const std::vector<std::pair<std::size_t, Quer
 
 }  // namespace
 
-std::string check_sidecar(const std::string& path) {
+std::string check_sidecar(const std::string& arg) {
+  // A layer given for its sidecar checks the sidecar; a sidecar beside the layer it is named
+  // after is checked against it too, as every query checks it.
+  std::string path = arg, layer;
+  const std::string beside = default_sidecar_path(arg);
+  if (!starts_as_sidecar(arg) && file_exists(arg)) {
+    if (!file_exists(beside))
+      throw Error(arg + ": not a loci index file, and " + beside +
+                  " does not exist; run 'loci index " + arg + "'");
+    path = beside;
+    layer = arg;
+  } else if (path.size() > 5 && path.ends_with(".loci") &&
+             file_exists(path.substr(0, path.size() - 5))) {
+    layer = path.substr(0, path.size() - 5);
+  }
   Sidecar sc = Sidecar::open(path);
   const SidecarInfo info = sc.info();
   const std::size_t chunks = sc.check().chunks();
@@ -362,6 +376,10 @@ std::string check_sidecar(const std::string& path) {
     if (what.rfind(path, 0) == 0) throw;
     throw Error(path + ": corrupt index file (" + what + "); run 'loci index' to rebuild it");
   }
+  Fingerprint now;
+  if (!layer.empty() && !still_fresh(layer, info.source, &now))
+    throw Error(path + ": intact but stale, " + layer + " changed since it was indexed (" +
+                stale_reason(info.source, now) + "); run 'loci index " + layer + "'");
   const auto& i = info;
   return path + ": ok, " + (i.packing == Packing::str ? "packed-str" : "packed-hilbert") + " per " +
          to_string(i.per) + ", layer " + i.layer_name + ", " + std::to_string(i.items) +

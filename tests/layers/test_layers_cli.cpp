@@ -1624,6 +1624,44 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
   fs::remove(sidecar);
 }
 
+// loci check of a sidecar beside the layer it is named after checks that the layer has not
+// changed since, as every query does (it said "ok" of a sidecar every query refused as stale),
+// and takes the layer itself for its sidecar.
+TEST_F(LayersCli, CheckSaysWhenTheLayerChangedSinceItWasIndexed) {
+  const std::string layer = path("checked.geojson");
+  fs::copy_file(std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson", layer,
+                fs::copy_options::overwrite_existing);
+  const std::string sidecar = layer + ".loci";
+  fs::remove(sidecar);
+  expect_error("check " + layer, "checked.geojson.loci does not exist; run 'loci index " + layer);
+  ASSERT_EQ(run_loci("index -q " + layer).status, 0);
+  for (const std::string& arg : {layer, sidecar}) {
+    const CliRun r = run_loci("check " + arg);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.rfind(sidecar + ": ok,", 0), 0u) << r.out;
+  }
+  fs::last_write_time(layer, fs::last_write_time(layer) + std::chrono::seconds(5));
+  EXPECT_EQ(run_loci("check " + layer).status, 0);  // touched, same content
+  std::string text = read_text(layer);
+  const std::size_t at = text.find("12.");
+  ASSERT_NE(at, std::string::npos);
+  text[at + 3] = text[at + 3] == '5' ? '6' : '5';  // one digit of one coordinate
+  { std::ofstream(layer, std::ios::binary) << text; }
+  for (const std::string& arg : {layer, sidecar})
+    expect_error("check " + arg, sidecar + ": intact but stale, " + layer +
+                                     " changed since it was indexed (contents changed); run "
+                                     "'loci index " +
+                                     layer + "'");
+  // A sidecar written elsewhere names no layer: its own checks only.
+  const std::string elsewhere = path("checked-copy.idx");
+  ASSERT_EQ(run_loci("index -q " + layer + " -o " + elsewhere).status, 0);
+  std::ofstream(layer, std::ios::app) << "\n";
+  const CliRun r = run_loci("check " + elsewhere);
+  EXPECT_EQ(r.status, 0) << r.err;
+  fs::remove(elsewhere);
+  fs::remove(sidecar);
+}
+
 // Without --per, loci index picks per segment for big features (the bundled sample: a few
 // multipolygons of thousands of segments) and per feature for small ones, and loci info says
 // which and why; an explicit --per is kept and not explained.

@@ -72,8 +72,10 @@ IndexReport index_layer(const IndexOptions& options);
 
 // Verifies a sidecar whole: header, every chunk's checksum, the tree's invariants (boxes are
 // the unions of their nodes, item indices a permutation). Returns a one-line summary; throws
-// loci::Error naming the file and the first problem found.
-std::string check_sidecar(const std::string& path);
+// loci::Error naming the file and the first problem found. Given a layer instead, checks its
+// sidecar LAYER.loci; either way, when the layer the sidecar is named after exists, a layer
+// changed since it was indexed is an error too (queries refuse that sidecar as stale).
+std::string check_sidecar(const std::string& path_or_layer);
 
 struct LoadOptions {
   std::string layer_path;
