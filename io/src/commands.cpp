@@ -347,7 +347,10 @@ std::string check_sidecar(const std::string& arg) {
   // after is checked against it too, as every query checks it.
   std::string path = arg, layer;
   const std::string beside = default_sidecar_path(arg);
-  if (!starts_as_sidecar(arg) && file_exists(arg)) {
+  std::error_code ec;
+  const bool plain = std::filesystem::is_regular_file(arg, ec) ||
+                     std::filesystem::is_directory(arg, ec);  // never opens a FIFO
+  if (plain && !starts_as_sidecar(arg)) {
     if (!file_exists(beside))
       throw Error(arg + ": not a loci index file, and " + beside +
                   " does not exist; run 'loci index " + arg + "'");
