@@ -379,6 +379,12 @@ bool covers(const FlatGeometry& a, const FlatGeometry& b) {
   return covers(PreparedGeometry(a), PreparedGeometry(b));
 }
 
+// The largest magnitude of a coordinate in b.
+static double reach(const Box2& b) {
+  return std::max(
+      {std::fabs(b.min[0]), std::fabs(b.min[1]), std::fabs(b.max[0]), std::fabs(b.max[1])});
+}
+
 std::optional<double> distance_within(const PreparedGeometry& pa, const PreparedGeometry& pb,
                                       double d) {
   const FlatGeometry& a = pa.geometry();
@@ -387,19 +393,35 @@ std::optional<double> distance_within(const PreparedGeometry& pa, const Prepared
   if (meets(pa, pb)) return 0.0;
   // Only edges within d of the other's envelope can come within d of its edges.
   const Edges ea(a, d, pb.envelope()), eb(b, 0, outset(pa.envelope(), d));
+  const std::span<const Box2> boxes_a(ea.boxes), boxes_b(eb.boxes);
   double best = std::numeric_limits<double>::infinity();
-  join(std::span<const Box2>(ea.boxes), std::span<const Box2>(eb.boxes), [&](Id i, Id j) {
+  join(boxes_a, boxes_b, [&](Id i, Id j) {
     const Segment2& s = ea.segs[i];
     const Segment2& t = eb.segs[j];
     // The segments do not meet: the nearest points include an end point of one of them.
-    const double d2 = std::min({squared_distance(s.a, t), squared_distance(s.b, t),
-                                squared_distance(t.a, s), squared_distance(t.b, s)});
+    const double d2 =
+        std::min({accurate_squared_distance(s.a, t), accurate_squared_distance(s.b, t),
+                  accurate_squared_distance(t.a, s), accurate_squared_distance(t.b, s)});
     best = std::min(best, d2);
     return true;
   });
   const double dist = std::sqrt(best);
-  if (dist <= d) return dist;
-  return std::nullopt;
+  // The distance is good to a bound of the coordinates' rounding (segment.hpp); within it of
+  // d, the end points decide exactly whether one comes within d.
+  const double margin =
+      1e-14 * 6 * std::max(reach(pa.envelope()), reach(pb.envelope())) + 1e-150 + 4e-16 * d;
+  if (dist > d + margin) return std::nullopt;
+  if (dist < d - margin) return dist;
+  bool within = false;
+  join(boxes_a, boxes_b, [&](Id i, Id j) {
+    const Segment2& s = ea.segs[i];
+    const Segment2& t = eb.segs[j];
+    within = compare_distance(s.a, t, d) <= 0 || compare_distance(s.b, t, d) <= 0 ||
+             compare_distance(t.a, s, d) <= 0 || compare_distance(t.b, s, d) <= 0;
+    return !within;
+  });
+  if (!within) return std::nullopt;
+  return std::min(dist, d);  // the true distance is at most d, so is its rounding
 }
 
 std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry& b, double d) {
@@ -424,7 +446,7 @@ double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bou
     for (const Point2& p : from.points)
       tree.browse(p, [&](Id k, const Box2&, double box_distance) {
         if (box_distance >= best) return false;
-        best = std::min(best, std::sqrt(squared_distance(p, edges.segs[k])));
+        best = std::min(best, std::sqrt(accurate_squared_distance(p, edges.segs[k])));
         return true;
       });
   };

@@ -4,6 +4,7 @@
 // on vertices, on edges and on the grid's cell borders; long diagonal edges that force a
 // coarser grid; flat envelopes. Also the pair tests on prepared geometries against their
 // definitions through brute-force point tests on lattice points.
+#include <gmpxx.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -319,6 +320,59 @@ TEST(PreparedGeometry, PairTestsAgreeWithPointTests) {
     EXPECT_NEAR(*d, gap, 1e-12) << trial;
     EXPECT_NEAR(distance(pa, pb, gap + 50), gap, 1e-12) << trial;
   }
+}
+
+// A point or the end of a line at D, give or take a hair, beside a long slanted segment, near
+// the origin and at coordinates of 1e7 and 1e12: whether it lies within D is decided exactly,
+// and the distance is good to 1e-12 (it was the projected point's, whose rounding at 1e7 is a
+// millionth of a distance of 1e-3: pairs beyond D were joined and pairs within D missed).
+TEST(PreparedGeometry, DistanceWithinIsExactNearD) {
+  std::mt19937_64 rng(53);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double D = 1e-3;
+  int in = 0, out = 0;
+  for (const double offset : {0.0, 1e7, 1e12}) {
+    for (int i = 0; i < 300; ++i) {
+      const Point2 a{offset + i * 1000.0 + u(rng), offset + u(rng) * 1000};
+      const double angle = u(rng) * 2 * M_PI, length = 10 + 490 * u(rng);
+      const Point2 b{a[0] + length * std::cos(angle), a[1] + length * std::sin(angle)};
+      const double t = 0.1 + 0.8 * u(rng);
+      const double gap = D + (u(rng) - 0.5) * 2e-9;
+      const Point2 n{-std::sin(angle), std::cos(angle)};
+      const Point2 p{a[0] + t * (b[0] - a[0]) + gap * n[0], a[1] + t * (b[1] - a[1]) + gap * n[1]};
+      FlatGeometry line, other;
+      line.points = {a, b};
+      line.parts.push_back({0, 2, PartKind::line, 0});
+      other.points = {p};
+      if (i % 3 == 0) {  // a line leaving the segment from p
+        other.points.push_back({p[0] + 50 * n[0], p[1] + 50 * n[1]});
+        other.parts.push_back({0, 2, PartKind::line, 0});
+      } else {
+        other.parts.push_back({0, 1, PartKind::point, 0});
+      }
+      // Exact: p is beside the segment, so its distance is that to the line.
+      const mpq_class vx = mpq_class(b[0]) - a[0], vy = mpq_class(b[1]) - a[1];
+      const mpq_class wx = mpq_class(p[0]) - a[0], wy = mpq_class(p[1]) - a[1];
+      const mpq_class dot = wx * vx + wy * vy, vv = vx * vx + vy * vy;
+      ASSERT_TRUE(dot > 0 && dot < vv) << i;
+      const mpq_class cross = wx * vy - wy * vx;
+      const mpq_class d2 = cross * cross / vv;
+      const bool want = d2 <= mpq_class(D) * mpq_class(D);
+      (want ? in : out)++;
+      const double exact = std::sqrt(d2.get_d());
+      const PreparedGeometry pl(line), po(other);
+      for (const auto& got : {distance_within(pl, po, D), distance_within(po, pl, D)}) {
+        ASSERT_EQ(got.has_value(), want) << offset << " " << i << " exact " << exact;
+        if (got) {
+          EXPECT_NEAR(*got, exact, 1e-12) << offset << " " << i;
+          EXPECT_LE(*got, D);
+        }
+      }
+      EXPECT_NEAR(distance(pl, po, 1), exact, 1e-12) << offset << " " << i;
+    }
+  }
+  EXPECT_GT(in, 200);
+  EXPECT_GT(out, 200);
 }
 
 TEST(PreparedGeometry, CoversWithHolesAgainstLatticeEvidence) {
