@@ -20,6 +20,7 @@
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/hilbert.hpp"
+#include "loci/io/atomic_file.hpp"
 #include "loci/io/sidecar.hpp"
 
 namespace loci::io {
@@ -254,6 +255,21 @@ IndexReport index_layer(const IndexOptions& options) {
   IndexReport r;
   r.path = options.out_path.empty() ? default_sidecar_path(options.layer_path) : options.out_path;
   refuse_overwriting(r.path, options.layer_path);
+  // An index given with -o replaces only an index (or an empty file): written over a dataset
+  // or a document it would lose it; a device or FIFO cannot be mapped by the queries to come.
+  // The default LAYER.loci is the layer's own, replaced whatever it holds.
+  {
+    std::error_code ec;
+    const auto st = std::filesystem::status(r.path, ec);
+    if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+      throw Error("refusing to write the index to " + r.path +
+                  ": not a regular file (queries map the index file)");
+    if (!options.out_path.empty()) refuse_replacing_layers(r.path);  // says which layers
+    if (!options.out_path.empty() && std::filesystem::is_regular_file(st) &&
+        std::filesystem::file_size(r.path, ec) > 0 && !starts_as_sidecar(r.path))
+      throw Error("refusing to write the index over " + r.path +
+                  ": it exists and is not a loci index file; remove it or choose another -o");
+  }
   // Sizes, times and inodes before reading and after: a layer changing while it is read must
   // not look fresh afterwards. The content hash comes from the reader when it had the bytes
   // (a shapefile read directly), else from a pass of its own.

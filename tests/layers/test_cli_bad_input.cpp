@@ -549,6 +549,36 @@ namespace {
 
 // Coordinates whose squared distances would overflow are refused, in layers and in queries,
 // rather than answered with infinite distances and a wrong ranking.
+// loci index -o replaces only an index or an empty file: it wrote its sidecar over a
+// GeoJSON or any other file named, and wrote a whole index into a FIFO or /dev/null before
+// failing on it as not a regular file. The default LAYER.loci is replaced whatever it holds.
+TEST_F(BadInput, IndexWithOutputReplacesOnlyAnIndex) {
+  const std::string l = lines_layer();
+  const std::string other = write("other.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1,2]}}]})");
+  const std::string before = read_text(other);
+  CliRun r = run_loci("index " + shell_quote(l) + " -o " + shell_quote(other));
+  expect_one_line_error(r);
+  EXPECT_NE(r.err.find("is not a loci index file"), std::string::npos) << r.err;
+  EXPECT_EQ(read_text(other), before);
+  const std::string fifo = path("index.fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& device : {fifo, std::string("/dev/null")}) {
+    r = run_loci("index " + shell_quote(l) + " -o " + shell_quote(device));
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << r.err;
+  }
+  const std::string index = path("lines.idx");
+  { std::ofstream(index).flush(); }  // empty: taken
+  ASSERT_EQ(run_loci("index -q " + shell_quote(l) + " -o " + shell_quote(index)).status, 0);
+  ASSERT_EQ(run_loci("index -q " + shell_quote(l) + " -o " + shell_quote(index)).status, 0);
+  const std::string beside = l + ".loci";
+  { std::ofstream(beside) << "not an index"; }
+  ASSERT_EQ(run_loci("index -q " + shell_quote(l)).status, 0);
+  EXPECT_EQ(run_loci("check " + shell_quote(beside)).status, 0);
+  fs::remove(beside);
+}
+
 TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {
   const std::string l = write("huge.geojson", R"({"type":"FeatureCollection","features":[
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}},
