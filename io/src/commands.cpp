@@ -440,9 +440,14 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
       throw Error(path + ": stale index, " + o.layer_path + " changed since it was indexed (" +
                   stale_reason(sc.info().source, now) + "); run 'loci index " + o.layer_path + "'");
     }
-    if (!o.layer_name.empty() && o.layer_name != sc.info().layer_name)
-      throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + o.layer_name +
-                  "'; give another index file with --index");
+    // --layer as GDAL finds it: a name it does not know is said so, and one differing only in
+    // case names the layer indexed.
+    if (!o.layer_name.empty() && o.layer_name != sc.info().layer_name) {
+      const std::string actual = detail::open_layer(o.layer_path, o.layer_name).layer->GetName();
+      if (actual != sc.info().layer_name)
+        throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + actual +
+                    "'; give another index file with --index");
+    }
     // No --layer means the dataset's first layer; a sidecar of another layer must not answer.
     if (o.layer_name.empty()) {
       const std::string first = default_layer_name(o.layer_path);

@@ -691,6 +691,16 @@ TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
   EXPECT_NE(r.out.find("not this layer's (it indexes layer 'beta'"), std::string::npos) << r.out;
   r = run_loci("info " + two + " --layer beta");
   EXPECT_NE(r.out.find(": fresh"), std::string::npos) << r.out;
+  // --layer as GDAL finds it: in another case it is the layer indexed (it was refused as
+  // another layer's index); a name GDAL does not know is said so (it was "indexes 'beta'").
+  const std::string all = " --bbox -1e9,-1e9,1e9,1e9 -f ids";
+  r = run_loci("query " + two + " --layer BETA" + all);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(r.out.empty());
+  EXPECT_EQ(r.out, run_loci("query " + two + " --layer beta" + all).out);
+  r = run_loci("query " + two + " --layer nope" + all);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("two.gpkg: no layer named 'nope'"), std::string::npos) << r.err;
   fs::remove(two + ".loci");
   // Names that hold spaces (and the like) are quoted in the lists, so that each reads apart.
   ASSERT_EQ(std::system(("ogr2ogr -update " + two + " " + layer + " -nln \"my roads\"").c_str()),
