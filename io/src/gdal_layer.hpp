@@ -46,6 +46,12 @@ std::string authority_code(const OGRSpatialReference& srs);
 // A layer's coordinate system as WKT, empty when it has none.
 std::string system_of(const OGRLayer& layer);
 
+// A layer as messages name it: the file, and the layer when one was named (two layers of one
+// GeoPackage read apart).
+inline std::string layer_label(const std::string& path, const std::string& layer) {
+  return layer.empty() ? path : path + " (layer '" + layer + "')";
+}
+
 // Throws loci::Error when two layers (files a and b, systems as system_of gives them) are in
 // different coordinate systems: their coordinates cannot be compared. A layer without a system
 // is taken to be in the other's.

@@ -74,7 +74,8 @@ std::vector<IntersectionRow> find_intersections(const IntersectionsOptions& o,
   std::string right_system;
   const Linework right(read_segments(o.other_path, o.other_name, o.progress, &right_system));
   check_has_linework(right, o.other_path, o.other_name);
-  detail::check_same_system(o.layer_path, left_system, o.other_path, right_system);
+  detail::check_same_system(detail::layer_label(o.layer_path, o.layer_name), left_system,
+                            detail::layer_label(o.other_path, o.other_name), right_system);
   return intersection_rows(left, &right, o.pairs_only, o.jobs);
 }
 

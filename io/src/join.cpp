@@ -172,7 +172,8 @@ std::vector<JoinRow> join_layers(const JoinOptions& o) {
   const JoinLayer left = read_join_layer(o.left_path, o.left_name);
   if (self) return join_layers(left, nullptr, o.predicate, o.distance, o.progress);
   const JoinLayer right = read_join_layer(o.right_path, o.right_name);
-  detail::check_same_system(left.path, left.system, right.path, right.system);
+  detail::check_same_system(detail::layer_label(left.path, o.left_name), left.system,
+                            detail::layer_label(right.path, o.right_name), right.system);
   return join_layers(left, &right, o.predicate, o.distance, o.progress);
 }
 

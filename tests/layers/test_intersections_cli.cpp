@@ -276,6 +276,22 @@ TEST(IntersectionsCli, HandCasesFormatsAndErrors) {
         << cmd << ": " << r.err;
   }
   EXPECT_FALSE(fs::exists(dir / "cw.geojson"));
+  // Two layers of one GeoPackage: the message names the layers (it named the file twice).
+  const std::string both = shell_quote((dir / "both.gpkg").string());
+  ASSERT_EQ(std::system(("ogr2ogr -q " + both + " " + hand + " -nln a && ogr2ogr -q -update " +
+                         both + " " + other + " -nln b")
+                            .c_str()),
+            0);
+  for (const std::string& cmd :
+       {"intersections " + both + " " + both + " --layer a --layer2 b",
+        "join " + both + " " + both + " --layer a --layer2 b -p intersects"}) {
+    const CliRun r = run_loci(cmd);
+    EXPECT_EQ(r.status, 1) << cmd;
+    EXPECT_NE(r.err.find("both.gpkg (layer 'a') and "), std::string::npos) << cmd << ": " << r.err;
+    EXPECT_NE(r.err.find("both.gpkg (layer 'b') are in different coordinate systems"),
+              std::string::npos)
+        << cmd << ": " << r.err;
+  }
   // A GeoPackage written from a layer without a system says "Undefined geographic SRS": no
   // system, so not refused.
   const fs::path none_csv = dir / "none.csv", none_gpkg = dir / "none.gpkg";
