@@ -208,12 +208,13 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
     const auto& i = sc.info();
     Fingerprint now;
     const bool fresh = still_fresh(layer_path, i.source, &now);
-    // A sidecar of the dataset's other layer is fresh, but not this layer's: queries refuse it.
+    // A sidecar of another layer (of this dataset, fresh, or of another file) is not this
+    // layer's, as queries say; one of this layer is fresh or stale.
     const std::string status =
-        !fresh ? "stale (" + stale_reason(i.source, now) + ")"
-        : i.layer_name != s.layer_name
+        i.layer_name != s.layer_name
             ? "not this layer's (it indexes layer '" + i.layer_name + "'; give --index)"
-            : "fresh";
+        : !fresh ? "stale (" + stale_reason(i.source, now) + ")"
+                 : "fresh";
     o << sidecar << ": " << status << ", "
       << (i.packing == Packing::str ? "packed-str" : "packed-hilbert") << " per "
       << to_string(i.per) << granularity_reason(i) << ", layer " << i.layer_name << ", " << i.items

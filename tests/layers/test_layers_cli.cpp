@@ -702,6 +702,21 @@ TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("two.gpkg: no layer named 'nope'"), std::string::npos) << r.err;
   fs::remove(two + ".loci");
+  // The index of another file's layer beside this one: info says whose, as queries do (it
+  // said "stale").
+  const std::string stranger = path("stranger.geojson");
+  std::ofstream(stranger)
+      << R"({"type":"FeatureCollection","features":[{"type":"Feature",)"
+         R"("properties":{},"geometry":{"type":"Point","coordinates":[3,4]}}]})";
+  const std::string lone = path("lone.geojson");
+  std::ofstream(lone) << R"({"type":"FeatureCollection","features":[{"type":"Feature",)"
+                         R"("properties":{},"geometry":{"type":"Point","coordinates":[1,2]}}]})";
+  ASSERT_EQ(run_loci("index -q " + stranger + " -o " + lone + ".loci").status, 0);
+  r = run_loci("info " + lone);
+  EXPECT_NE(r.out.find("lone.geojson.loci: not this layer's (it indexes layer 'stranger'"),
+            std::string::npos)
+      << r.out;
+  fs::remove(lone + ".loci");
   // Names that hold spaces (and the like) are quoted in the lists, so that each reads apart.
   ASSERT_EQ(std::system(("ogr2ogr -update " + two + " " + layer + " -nln \"my roads\"").c_str()),
             0);
