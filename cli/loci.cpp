@@ -164,6 +164,11 @@ int run_index(const Args& a) {
     std::fprintf(stderr, "loci: indexed %s of layer '%s' into %s (%llu bytes, %.2f s)%s\n",
                  what.c_str(), r.layer_name.c_str(), r.path.c_str(),
                  static_cast<unsigned long long>(r.bytes), r.seconds, skipped.c_str());
+    if (!r.replaced_layer.empty())
+      std::fprintf(stderr,
+                   "loci: %s held the index of layer '%s', now replaced (one index per file: "
+                   "give another with -o to keep both)\n",
+                   r.path.c_str(), r.replaced_layer.c_str());
   }
   return 0;
 }

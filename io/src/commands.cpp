@@ -307,6 +307,15 @@ IndexReport index_layer(const IndexOptions& options) {
   if (items.per == Per::segment)
     features = LayerIndex::build_features(&tree, items.per, items.records);
   const Hierarchies stored = features.stored();
+  // One sidecar per file: indexing another layer of a dataset replaces the first one's index,
+  // which the report says.
+  try {
+    if (starts_as_sidecar(r.path)) {
+      const std::string before = Sidecar::open(r.path).info().layer_name;
+      if (before != items.layer_name) r.replaced_layer = before;
+    }
+  } catch (const Error&) {  // unreadable: replaced as it is
+  }
   write_sidecar(r.path, tree, items.records, info, features.hierarchical ? &stored : nullptr);
   if (options.progress) options.progress(1.0);
   r.layer_name = items.layer_name;

@@ -701,6 +701,14 @@ TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
   r = run_loci("query " + two + " --layer nope" + all);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("two.gpkg: no layer named 'nope'"), std::string::npos) << r.err;
+  // Indexing the other layer replaces the file's one index, and says so.
+  r = run_loci("index " + two + " --layer alpha");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("two.gpkg.loci held the index of layer 'beta', now replaced"),
+            std::string::npos)
+      << r.err;
+  r = run_loci("index " + two + " --layer alpha");
+  EXPECT_EQ(r.err.find("now replaced"), std::string::npos) << r.err;
   fs::remove(two + ".loci");
   // The index of another file's layer beside this one: info says whose, as queries do (it
   // said "stale").

@@ -65,6 +65,7 @@ struct IndexReport {
   std::uint64_t without_geometry = 0;  // features skipped: no geometry, or an empty one
   std::uint64_t bytes = 0;
   double seconds = 0;
+  std::string replaced_layer;  // the layer whose index the file held before, when another
 };
 
 // Throws InvalidArgument for a structure that cannot be stored (the dynamic trees).
