@@ -130,6 +130,7 @@ struct Piece {
   Id id;
   Motion2 m;
   double lo, hi;
+  bool open = false;  // hi excluded: the object's next report holds from hi
 };
 
 // The pieces of every trajectory over [t1, t2]: each report in force at some time of it.
@@ -140,7 +141,8 @@ std::vector<Piece> pieces_during(std::span<const FleetReport> sorted, double t1,
     const double from = std::max(t1, sorted[i].m.t);
     const double to = last ? t2 : std::min(t2, sorted[i + 1].m.t);
     if (sorted[i].m.t > t2 || (!last && sorted[i + 1].m.t <= t1)) continue;
-    if (from <= to) out.push_back({sorted[i].id, sorted[i].m, from, to});
+    if (from <= to)
+      out.push_back({sorted[i].id, sorted[i].m, from, to, !last && sorted[i + 1].m.t <= t2});
   }
   return out;
 }
@@ -210,6 +212,10 @@ std::vector<FoundConflict> conflicts_of(const Loaded& l, double within, double h
       if (q->id < p->id) std::swap(p, q);
       const double s0 = std::max(p->lo, q->lo), s1 = std::min(p->hi, q->hi);
       if (!(s0 <= s1)) return true;
+      // Pieces meeting at one instant where one of them gives way to its object's next report
+      // do not overlap (a report and the one before it of another object, made at the same
+      // time, were paired at that instant).
+      if (s0 == s1 && ((p->open && p->hi == s1) || (q->open && q->hi == s1))) return true;
       // To the horizon's end as find_conflicts measures it (from now), not a rounded sum.
       const double h = s1 == end ? std::max(0.0, horizon - (s0 - now)) : s1 - s0;
       if (const auto ap = closest_approach(p->m, q->m, s0, h, within))

@@ -332,6 +332,21 @@ TEST_F(FleetCli, ConflictsBeforeTheLatestReportsFollowThem) {
   const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(svg.find("<title>1 5: dcpa 0 at 30</title>"), std::string::npos) << svg;
   EXPECT_EQ(svg.find("<title>5</title>"), std::string::npos) << svg;
+  // Reports of two objects at the same time: at t = 10 1 is at (100, 0) and 2 at (10, 5), 90
+  // apart; 1's report before, which would put it at (10, 0), no longer holds (it was paired
+  // with 2's new report at that instant, whether or not 2 reported before).
+  for (const char* before2 : {"", "2,0,0,100,0,0\n"}) {
+    const std::string same = write("same.csv", std::string("id,t,x,y,vx,vy\n1,0,0,0,1,0\n") +
+                                                   before2 + "1,10,100,0,0,0\n2,10,10,5,0,0\n");
+    r = run_loci("fleet conflicts " + shell_quote(same) + " --within 10 --horizon 20 --at 0");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(lines(r.out).size(), 1u) << before2 << r.out;
+    r = run_loci("fleet conflicts " + shell_quote(same) + " --within 91 --horizon 20 --at 0");
+    got = csv_rows(r.out);
+    ASSERT_EQ(got.size(), 2u) << r.out;
+    EXPECT_EQ(got[1][2], "10") << before2 << r.out;
+    EXPECT_DOUBLE_EQ(std::stod(got[1][3]), std::sqrt(90.0 * 90.0 + 25.0)) << r.out;
+  }
 }
 
 // A lon/lat window is closed: a vessel on one of its edges, at rest or at its report's time,
