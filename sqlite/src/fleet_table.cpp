@@ -254,6 +254,12 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
       throw SqlError{SQLITE_MISMATCH,
                      format_sql("loci_fleet %s: the id must be an integer", t.name.c_str())};
     const Motion2 m = motion_of(argv + 3, t, id);
+    // A report at a time the object already has one replaces it, unless OR IGNORE asks to
+    // keep what is there (an UPDATE rewriting the report in place is no such conflict).
+    if (sqlite3_vtab_on_conflict(t.db) == SQLITE_IGNORE && t.has_report(id, m.t)) {
+      const Motion2* at = has_old ? t.current().find(old_id) : nullptr;
+      if (!(has_old && old_id == id && at && at->t == m.t)) return SQLITE_OK;
+    }
     if (has_old) t.drop_current_report(old_id);
     t.add_report(id, m);
     if (!has_old) *new_rowid = id;
@@ -328,8 +334,9 @@ std::vector<const char*> FleetTable::shadow_suffixes() const {
 }
 
 void FleetTable::finalize_statements() {
-  for (Statement* s : {&get_generation, &set_generation, &put_report, &drop_report, &drop_history,
-                       &latest_report, &read_history, &put_current, &drop_current, &read_current})
+  for (Statement* s :
+       {&get_generation, &set_generation, &put_report, &drop_report, &drop_history, &latest_report,
+        &read_history, &put_current, &drop_current, &read_current, &find_report})
     s->finalize();
 }
 
@@ -340,6 +347,7 @@ void FleetTable::prepare_statements() {
   prepare_generation();
   put_report.prepare(db, sql("INSERT OR REPLACE INTO %s VALUES(?1, ?2, ?3, ?4, ?5, ?6)", "report"));
   drop_report.prepare(db, sql("DELETE FROM %s WHERE id = ?1 AND t = ?2", "report"));
+  find_report.prepare(db, sql("SELECT 1 FROM %s WHERE id = ?1 AND t = ?2", "report"));
   drop_history.prepare(db, sql("DELETE FROM %s WHERE id = ?1", "report"));
   latest_report.prepare(
       db,
@@ -407,6 +415,13 @@ void FleetTable::add_report(FleetId id, const Motion2& m) {
   wrote = true;
   const Motion2* now = s.find(id);
   if (!now || m.t >= now->t) store_current(id, m);
+}
+
+bool FleetTable::has_report(FleetId id, double t) {
+  find_report.bind(1, sqlite3_int64(id));
+  find_report.bind(2, t);
+  const ResetOnExit reset{find_report};
+  return find_report.step();
 }
 
 void FleetTable::drop_current_report(FleetId id) {

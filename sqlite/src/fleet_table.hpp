@@ -90,7 +90,7 @@ struct FleetTable : ShadowTable {
   bool wrote = false;               // this transaction wrote: bump 'generation' at commit
 
   Statement put_report, drop_report, drop_history, latest_report, read_history, put_current,
-      drop_current, read_current;
+      drop_current, read_current, find_report;
 
   // The in-memory state, read from %_current if needed and checked against changes made by
   // other connections. Throws SqlError.
@@ -102,6 +102,8 @@ struct FleetTable : ShadowTable {
 
   // Adds a report (INSERT; see the header for what becomes current).
   void add_report(FleetId id, const Motion2& m);
+  // Whether `id` has a report at time t.
+  bool has_report(FleetId id, double t);
   // Removes the current report of `id` from the history; the latest remaining one becomes
   // current (UPDATE's first half).
   void drop_current_report(FleetId id);

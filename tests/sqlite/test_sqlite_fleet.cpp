@@ -229,6 +229,17 @@ TEST(SqliteFleetSql, ReportsReplaceByTimeAndUpdateDeleteFollowTheirRules) {
   db.exec("INSERT INTO f VALUES (1, 12, 60, 0, 0, 0)");  // same time: replaces
   EXPECT_EQ(db.value("SELECT x FROM f WHERE id = 1"), "60");
   EXPECT_EQ(db.value("SELECT count(*) FROM f_report WHERE id = 1"), "3");
+  // OR IGNORE keeps a report already there (it was replaced); a new time is added as ever.
+  db.exec("INSERT OR IGNORE INTO f VALUES (1, 12, 99, 0, 0, 0), (1, 5, 99, 0, 0, 0)");
+  EXPECT_EQ(db.value("SELECT x FROM f WHERE id = 1"), "60");
+  EXPECT_EQ(db.value("SELECT x FROM f_report WHERE id = 1 AND t = 5"), "-100");
+  db.exec("UPDATE OR IGNORE f SET t = 5 WHERE id = 1");   // onto the report at 5: both kept
+  db.exec("UPDATE OR IGNORE f SET x = 60 WHERE id = 1");  // in place: no conflict
+  EXPECT_EQ(db.rows("SELECT t, x FROM f_report WHERE id = 1 ORDER BY t"),
+            (std::vector<Row>{{"5", "-100"}, {"10", "0"}, {"12", "60"}}));
+  db.exec("INSERT OR IGNORE INTO f VALUES (5, 0, 1, 1, 0, 0)");
+  EXPECT_EQ(db.value("SELECT count(*) FROM f WHERE id = 5"), "1");
+  db.exec("DELETE FROM f WHERE id = 5");
   // UPDATE rewrites the current report; moving it back in time makes the next one current.
   db.exec("UPDATE f SET x = 70 WHERE id = 1");
   EXPECT_EQ(db.rows("SELECT t, x FROM f WHERE id = 1"), (std::vector<Row>{{"12", "70"}}));
