@@ -260,7 +260,8 @@ const char* to_string(SkipReason reason) {
                                             "COG out of range",
                                             "bad date",
                                             "NaN",
-                                            "empty value"};
+                                            "empty value",
+                                            "MMSI out of range"};
   return names[std::size_t(reason)];
 }
 
@@ -576,12 +577,19 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
     std::optional<SkipReason> skip;
     // An empty MMSI is a missing value like any other (skipped and counted); one that is not a
     // number is a broken file.
-    const bool no_mmsi = trimmed(f[cm]).empty();
-    const auto mmsi = no_mmsi ? std::nullopt : whole_number(f[cm]);
+    // MMSIs are nine digits (leading zeros for coast stations and groups): 0, a negative one
+    // or a longer one names no vessel (skipped and counted, as the sentinels are).
+    const std::string_view mmsi_text = trimmed(f[cm]);
+    const bool no_mmsi = mmsi_text.empty();
+    const bool negative = mmsi_text.size() > 1 && mmsi_text[0] == '-';
+    const auto mmsi =
+        no_mmsi ? std::nullopt : whole_number(negative ? mmsi_text.substr(1) : mmsi_text);
     if (no_mmsi)
       skip = SkipReason::missing_value;
     else if (!mmsi)
       csv.fail("MMSI " + quoted(f[cm]) + " is not a whole number");
+    else if (negative || *mmsi == 0 || *mmsi > 999999999)
+      skip = SkipReason::mmsi_out_of_range;
     auto num = [&](int col, const char* name) {
       if (trimmed(f[col]).empty()) {
         if (!skip) skip = SkipReason::missing_value;

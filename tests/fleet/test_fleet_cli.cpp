@@ -557,7 +557,7 @@ TEST_F(FleetCli, AisSampleSentinelsSummarisedOnStderr) {
   const CliRun r =
       run_loci("fleet query " + shell_quote(kData + "/ais-sentinels.csv") + " --bbox 9,54,11,56");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("loci: read 6 AIS reports of 4 vessels; skipped 12 (1 duplicate, 1 LAT "
+  EXPECT_NE(r.err.find("loci: read 6 AIS reports of 4 vessels; skipped 13 (1 duplicate, 1 LAT "
                        "not available"),
             std::string::npos)
       << r.err;

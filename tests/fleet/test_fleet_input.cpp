@@ -146,16 +146,28 @@ TEST(FleetInForce, LatestReportAtOrBeforeTheTimeAndAbsentBeforeTheFirst) {
 TEST(FleetAis, EverySentinelBadDateNanAndDuplicateIsSkippedAndCounted) {
   const FleetData d = read_fleet_file(kData + "/ais-sentinels.csv");
   EXPECT_EQ(d.format, FleetFormat::ais);
-  EXPECT_EQ(d.rows, 18u);
+  EXPECT_EQ(d.rows, 19u);
   for (std::size_t r = 0; r < kSkipReasons; ++r)
     EXPECT_EQ(d.skipped.count[r], 1u) << to_string(SkipReason(r));
   EXPECT_EQ(d.reports.size(), 6u);
   EXPECT_EQ(d.objects(), 4u);
   EXPECT_EQ(d.summary(),
-            "read 6 AIS reports of 4 vessels; skipped 12 (1 duplicate, 1 LAT not available, 1 LON "
+            "read 6 AIS reports of 4 vessels; skipped 13 (1 duplicate, 1 LAT not available, 1 LON "
             "not available, 1 SOG not available, 1 COG not available, 1 LAT out of range, 1 LON "
             "out of range, 1 SOG out of range, 1 COG out of range, 1 bad date, 1 NaN, 1 empty "
-            "value); 1 kept with Heading 511 (not available; heading is not used)");
+            "value, 1 MMSI out of range); 1 kept with Heading 511 (not available; heading is not "
+            "used)");
+  // MMSI 0, a negative one and one of ten digits name no vessel: skipped and counted (two
+  // ships sent as MMSI 0 were one vessel, and -1 refused the file).
+  const std::string row = ",2023-01-01T00:00:00,55.0,10.0,10.0,90.0\n";
+  const FleetData odd =
+      read_fleet("MMSI,BaseDateTime,LAT,LON,SOG,COG\n0" + row + "0" + row + "-1" + row +
+                     "1000000000" + row + "999999999" + row + "000000001" + row,
+                 "odd.csv");
+  EXPECT_EQ(odd.skipped[SkipReason::mmsi_out_of_range], 4u);
+  ASSERT_EQ(odd.reports.size(), 2u);
+  EXPECT_EQ(odd.reports[0].id, 1u);
+  EXPECT_EQ(odd.reports[1].id, 999999999u);
   // Heading 511 is counted, not skipped: heading is not used, the course gives the motion.
   EXPECT_EQ(d.heading_not_available, 1u);
   // Sorted by (MMSI, time); of the two reports at 00:01:00, the later line is kept.

@@ -75,8 +75,9 @@ enum class SkipReason : std::uint8_t {
   bad_date,           // BaseDateTime unreadable or impossible
   not_a_number,       // NaN or infinite
   missing_value,      // an empty required field
+  mmsi_out_of_range,  // AIS MMSI 0, negative or of more than nine digits
 };
-inline constexpr std::size_t kSkipReasons = 12;
+inline constexpr std::size_t kSkipReasons = 13;
 
 // "COG not available", "duplicate", ...
 const char* to_string(SkipReason reason);
