@@ -359,14 +359,14 @@ int run_bench(const Args& a) {
 
 // ---- loci fleet ----
 
-// A real number given to `flag`, finite and >= 0.
-double parse_nonnegative(const char* flag, const std::string& text) {
+// A real number given to `flag`, finite and >= 0 (> 0 when `positive`).
+double parse_nonnegative(const char* flag, const std::string& text, bool positive = false) {
   double v = 0;
   const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
   if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() ||
-      !std::isfinite(v) || v < 0)
+      !std::isfinite(v) || v < 0 || (positive && v == 0))
     throw UsageError(std::string("bad ") + flag + " '" + text.substr(0, 40) +
-                     "': expected a finite number >= 0");
+                     "': expected a finite number " + (positive ? "> 0" : ">= 0"));
   return v;
 }
 
@@ -493,7 +493,7 @@ int run_fleet_simulate(const Args& a) {
   o.horizon = parse_nonnegative("--horizon", a.get("--horizon"));
   if (a.has("--update-fraction"))
     o.update_fraction = parse_nonnegative("--update-fraction", a.get("--update-fraction"));
-  if (a.has("--tick")) o.tick = parse_nonnegative("--tick", a.get("--tick"));
+  if (a.has("--tick")) o.tick = parse_nonnegative("--tick", a.get("--tick"), true);
   if (a.has("--seed")) o.seed = parse_count("--seed", a.get("--seed"), 0, std::size_t(-1) / 2);
   if (a.has("--slack")) o.slack = parse_nonnegative("--slack", a.get("--slack"));
   o.from_scratch = a.has("--from-scratch");
@@ -753,7 +753,7 @@ const std::vector<Command>& commands() {
         {"--seed", nullptr, "S", "random seed of the turns (default 1)"},
         {"--slack", nullptr, "S",
          "conflicts are kept up to date incrementally and recomputed in full once the clock "
-         "is S past the last full computation (default H/4)"},
+         "is more than S past the last full computation (default H/4)"},
         {"--from-scratch", nullptr, nullptr, "compute the conflicts from scratch every tick"},
         {"--output", "-o", "OUT", "write the per-tick CSV to OUT instead of stdout", true},
         kQuiet},

@@ -697,6 +697,10 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   const std::string q = " --bbox 0,0,1,1";
   expect_one_line_error(run_loci("fleet query " + shell_quote(nan) + q), "line 3: x is NaN");
   expect_one_line_error(run_loci("fleet query " + shell_quote(empty) + q), "empty file");
+  for (const char* tick : {"0", "-1"})  // -1 was told ">= 0", and 0 then refused
+    expect_one_line_error(run_loci("fleet simulate " + shell_quote(good) +
+                                   " --within 1 --horizon 5 --ticks 2 --tick " + tick),
+                          std::string("bad --tick '") + tick + "': expected a finite number > 0");
   expect_one_line_error(run_loci("fleet query " + shell_quote(path("none.csv")) + q),
                         "no such file");
   expect_one_line_error(run_loci("fleet query " + shell_quote(dir_.string()) + q),
