@@ -51,8 +51,7 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o, std::string& system
       throw InvalidGeometry(
           "--wkt: the window is not a valid polygon (rings that cross, a hole not inside its "
           "shell, or polygons that overlap or touch along an edge); give polygons apart from each "
-          "other, or use --window-layer, "
-          "which unites them");
+          "other, or use --window-layer, which unites them");
   } else if (!o.window_layer.empty()) {
     auto wl = detail::open_layer(o.window_layer, o.window_layer_name);
     system = detail::system_of(*wl.layer);
