@@ -379,12 +379,6 @@ bool covers(const FlatGeometry& a, const FlatGeometry& b) {
   return covers(PreparedGeometry(a), PreparedGeometry(b));
 }
 
-// The largest magnitude of a coordinate in b.
-static double reach(const Box2& b) {
-  return std::max(
-      {std::fabs(b.min[0]), std::fabs(b.min[1]), std::fabs(b.max[0]), std::fabs(b.max[1])});
-}
-
 std::optional<double> distance_within(const PreparedGeometry& pa, const PreparedGeometry& pb,
                                       double d) {
   const FlatGeometry& a = pa.geometry();
@@ -409,7 +403,7 @@ std::optional<double> distance_within(const PreparedGeometry& pa, const Prepared
   // The distance is good to a bound of the coordinates' rounding (segment.hpp); within it of
   // d, the end points decide exactly whether one comes within d.
   const double margin =
-      1e-14 * 6 * std::max(reach(pa.envelope()), reach(pb.envelope())) + 1e-150 + 4e-16 * d;
+      1e-14 * 6 * std::max(magnitude(pa.envelope()), magnitude(pb.envelope())) + 1e-150 + 4e-16 * d;
   if (dist > d + margin) return std::nullopt;
   if (dist < d - margin) return dist;
   bool within = false;

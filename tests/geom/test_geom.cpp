@@ -62,6 +62,14 @@ TEST(Box, ClosedSemantics) {
   EXPECT_DOUBLE_EQ(overlap(a, Box2{{1, 1}, {2, 2}}), 0.0);
 }
 
+TEST(Box, MagnitudeIsTheLargestCoordinateInAbsoluteValue) {
+  EXPECT_EQ(magnitude(Box2{{-7, 2}, {3, 5}}), 7.0);
+  EXPECT_EQ(magnitude(Box2{{1, -2}, {3, 9}}), 9.0);
+  EXPECT_EQ(magnitude(Box3{{0, 0, -1e300}, {0, 0, 0}}), 1e300);
+  EXPECT_EQ(magnitude(Box2{{0, 0}, {0, 0}}), 0.0);
+  EXPECT_EQ(magnitude(Box2::empty()), std::numeric_limits<double>::infinity());
+}
+
 TEST(Box, RejectsBadCoordinates) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();

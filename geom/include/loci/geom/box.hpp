@@ -183,6 +183,16 @@ std::string to_string(const Box<D>& b) {
   return "[" + to_string(b.min) + " .. " + to_string(b.max) + "]";
 }
 
+// The largest magnitude of a coordinate of b: the scale its coordinates' rounding is
+// relative to (infinite for the empty box).
+template <int D>
+inline double magnitude(const Box<D>& b) {
+  double m = 0;
+  for (int i = 0; i < D; ++i)
+    m = std::max({m, std::fabs(b.min[i]), std::fabs(b.max[i])});
+  return m;
+}
+
 // Finite coordinates and min <= max on every axis.
 template <int D>
 constexpr bool is_valid(const Box<D>& b) {

@@ -167,9 +167,7 @@ inline double distance_rounding(const Point<2>& p, const Segment<2>& s) {
 // The square of the distance below which accurate_squared_distance measures exactly, for p and
 // any segment within `extent`: a bound on its zone for all of them at once.
 inline double near_zone_squared(const Point<2>& p, const Box<2>& extent) {
-  const double reach = std::max({std::fabs(extent.min[0]), std::fabs(extent.min[1]),
-                                 std::fabs(extent.max[0]), std::fabs(extent.max[1])});
-  const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * reach) + 1e-146;
+  const double zone = 1e-10 * (std::fabs(p[0]) + std::fabs(p[1]) + 4 * magnitude(extent)) + 1e-146;
   return zone * zone;
 }
 

@@ -870,8 +870,7 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
   BspTree tree;
   tree.edges_ = edges.size();
   if (edges.empty()) return tree;
-  tree.reach_ = std::max({std::fabs(bounds.min[0]), std::fabs(bounds.min[1]),
-                          std::fabs(bounds.max[0]), std::fabs(bounds.max[1])});
+  tree.reach_ = magnitude(bounds);
   detail::BspPointLocator locator(all_edges, polygon, bounds);
 
   // The root cell: the layer's bounds with a wide margin (solid cells never reach it).
