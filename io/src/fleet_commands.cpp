@@ -141,8 +141,10 @@ std::vector<Piece> pieces_during(std::span<const FleetReport> sorted, double t1,
     const double from = std::max(t1, sorted[i].m.t);
     const double to = last ? t2 : std::min(t2, sorted[i + 1].m.t);
     if (sorted[i].m.t > t2 || (!last && sorted[i + 1].m.t <= t1)) continue;
-    if (from <= to)
-      out.push_back({sorted[i].id, sorted[i].m, from, to, !last && sorted[i + 1].m.t <= t2});
+    // A piece ending where the next report begins is open: that instant is the next one's.
+    const bool open = !last && sorted[i + 1].m.t <= t2;
+    if (from < to || (from == to && !open))
+      out.push_back({sorted[i].id, sorted[i].m, from, to, open});
   }
   return out;
 }
@@ -215,11 +217,14 @@ std::vector<FoundConflict> conflicts_of(const Loaded& l, double within, double h
       // Pieces meeting at one instant where one of them gives way to its object's next report
       // do not overlap (a report and the one before it of another object, made at the same
       // time, were paired at that instant).
-      if (s0 == s1 && ((p->open && p->hi == s1) || (q->open && q->hi == s1))) return true;
+      const bool open = (p->open && p->hi == s1) || (q->open && q->hi == s1);
+      if (s0 == s1 && open) return true;
       // To the horizon's end as find_conflicts measures it (from now), not a rounded sum.
       const double h = s1 == end ? std::max(0.0, horizon - (s0 - now)) : s1 - s0;
-      if (const auto ap = closest_approach(p->m, q->m, s0, h, within))
-        out.push_back({{p->id, q->id, *ap}, p->m, q->m});
+      const auto ap = closest_approach(p->m, q->m, s0, h, within);
+      // Within D only at the instant one of them gives way to its next report: not a conflict
+      // of these two pieces (that instant is the next report's).
+      if (ap && !(open && ap->t_enter >= s1)) out.push_back({{p->id, q->id, *ap}, p->m, q->m});
       return true;
     });
   std::sort(out.begin(), out.end(), [](const FoundConflict& x, const FoundConflict& y) {
@@ -345,6 +350,8 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
           return true;
         }
       }
+      // Only at the instant its next report takes over: the object is where that one puts it.
+      if (pc.open && t >= pc.hi) return true;
       hits.push_back({pc.id, t, position(m, t), 0, reported_lonlat(l, pc.id, m, t)});
       return true;
     });

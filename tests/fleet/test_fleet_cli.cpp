@@ -202,7 +202,11 @@ TEST_F(FleetCli, WindowOverAnIntervalMatchesBruteForce) {
       for (std::size_t k = 0; k < ms.size() && !hit; ++k) {
         const double lo = std::max(t1, ms[k].t);
         const double hi = k + 1 < ms.size() ? std::min(t2, ms[k + 1].t) : t2;
-        hit = lo <= hi && !meets(ms[k], MovingWindow<2>::during(box, lo, hi)).empty();
+        // The instant the next report takes over is that one's.
+        const bool open = k + 1 < ms.size() && hi == ms[k + 1].t;
+        if (!(lo <= hi)) continue;
+        const LinearSpan s = meets(ms[k], MovingWindow<2>::during(box, lo, hi));
+        hit = !s.empty() && (!open || s.lo < hi);
       }
       if (hit) want.push_back(id);
     }
@@ -216,6 +220,20 @@ TEST_F(FleetCli, WindowOverAnIntervalMatchesBruteForce) {
       EXPECT_TRUE(t >= t1 && t <= t2);
     }
     EXPECT_EQ(ids, want);
+  }
+  // 1 runs east and reaches the window at t = 10, the instant its next report puts it
+  // elsewhere: it is never in the window. 2 reaches it at t = 10 and stays (its report at
+  // t = 10 keeps it there): in it from t = 10.
+  const std::string turn = write("turn.csv",
+                                 "id,t,x,y,vx,vy\n1,0,0,0,1,0\n1,10,0,50,0,0\n"
+                                 "2,0,0,0.5,1,0\n2,10,10,0.5,0,0\n");
+  for (const char* during : {"0,20", "5,10", "10,10", "0,10"}) {
+    const CliRun r = run_loci("fleet query " + shell_quote(turn) +
+                              " -q -f csv --bbox 10,-1,20,1 --during " + during);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto got = csv_rows(r.out);
+    ASSERT_EQ(got.size(), 2u) << during << "\n" << r.out;
+    EXPECT_EQ(got[1][0] + "," + got[1][1], "2,10") << during;
   }
 }
 
@@ -332,6 +350,17 @@ TEST_F(FleetCli, ConflictsBeforeTheLatestReportsFollowThem) {
   const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(svg.find("<title>1 5: dcpa 0 at 30</title>"), std::string::npos) << svg;
   EXPECT_EQ(svg.find("<title>5</title>"), std::string::npos) << svg;
+  // 1 comes within 10 of 2 at t = 10, the instant its next report puts it 53.9 away: no
+  // conflict. Within 10.5 it is one from t = 9.5, nearest (10) as it reports.
+  const std::string touch =
+      write("touch.csv", "id,t,x,y,vx,vy\n1,0,0,0,1,0\n1,10,0,50,0,0\n2,0,20,0,0,0\n");
+  r = run_loci("fleet conflicts " + shell_quote(touch) + " --within 10 --horizon 60 --at 0");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lines(r.out).size(), 1u) << r.out;
+  r = run_loci("fleet conflicts " + shell_quote(touch) + " --within 10.5 --horizon 60 --at 0");
+  got = csv_rows(r.out);
+  ASSERT_EQ(got.size(), 2u) << r.out;
+  EXPECT_EQ(got[1][2] + "," + got[1][3] + "," + got[1][4] + "," + got[1][5], "10,10,9.5,10");
   // Reports of two objects at the same time: at t = 10 1 is at (100, 0) and 2 at (10, 5), 90
   // apart; 1's report before, which would put it at (10, 0), no longer holds (it was paired
   // with 2's new report at that instant, whether or not 2 reported before).
