@@ -27,8 +27,9 @@ const char* table_argument(sqlite3_value* v) {
 void fleet_window(sqlite3* db, const Registry& registry, std::span<sqlite3_value* const> args,
                   FunctionRows& rows) {
   const char* f = "loci_fleet_window";
-  const Box<2> box{{{number_argument(args[1], f, "xmin"), number_argument(args[2], f, "ymin")}},
-                   {{number_argument(args[3], f, "xmax"), number_argument(args[4], f, "ymax")}}};
+  const Box<2> box{
+      {{coordinate_argument(args[1], f, "xmin"), coordinate_argument(args[2], f, "ymin")}},
+      {{coordinate_argument(args[3], f, "xmax"), coordinate_argument(args[4], f, "ymax")}}};
   const double t = number_argument(args[5], f, "t");
   if (box.min[0] > box.max[0] || box.min[1] > box.max[1])
     throw SqlError{SQLITE_MISMATCH, format_sql("%s: the window is inverted (%s > %s)", f,

@@ -118,9 +118,10 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
                           "CREATE TABLE %s(id INTEGER PRIMARY KEY, t REAL, x REAL, y REAL, "
                           "vx REAL, vy REAL);"
                           "CREATE TABLE %s(k TEXT PRIMARY KEY, v);"
-                          "INSERT INTO %s VALUES('format', %d), ('generation', 0);",
+                          "INSERT INTO %s VALUES('format', %d), ('generation', %lld);",
                           t.shadow("report").c_str(), t.shadow("current").c_str(),
-                          t.shadow("meta").c_str(), t.shadow("meta").c_str(), kFormat));
+                          t.shadow("meta").c_str(), t.shadow("meta").c_str(), kFormat,
+                          ShadowTable::first_generation()));
     if (create || !t.find_missing_shadow()) t.prepare_statements();
     t.attach(db, argv[1], argv[2], registry_of(aux));
     *out = table.release();

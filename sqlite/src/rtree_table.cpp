@@ -175,15 +175,16 @@ int connect(sqlite3* db, void* aux, int argc, const char* const* argv, sqlite3_v
 
     if (create) {
       RTreeTable& t = *table;
-      exec(db, format_sql("CREATE TABLE %s(n INTEGER PRIMARY KEY, data BLOB);"
-                          "CREATE TABLE %s(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, "
-                          "miny REAL, maxy REAL);"
-                          "CREATE TABLE %s(id INTEGER PRIMARY KEY);"
-                          "CREATE TABLE %s(k TEXT PRIMARY KEY, v);"
-                          "INSERT INTO %s VALUES('format', %d), ('generation', 0);",
-                          t.shadow("node").c_str(), t.shadow("delta").c_str(),
-                          t.shadow("dead").c_str(), t.shadow("meta").c_str(),
-                          t.shadow("meta").c_str(), int(RTreeIndex::kFormat)));
+      exec(db,
+           format_sql("CREATE TABLE %s(n INTEGER PRIMARY KEY, data BLOB);"
+                      "CREATE TABLE %s(id INTEGER PRIMARY KEY, minx REAL, maxx REAL, "
+                      "miny REAL, maxy REAL);"
+                      "CREATE TABLE %s(id INTEGER PRIMARY KEY);"
+                      "CREATE TABLE %s(k TEXT PRIMARY KEY, v);"
+                      "INSERT INTO %s VALUES('format', %d), ('generation', %lld);",
+                      t.shadow("node").c_str(), t.shadow("delta").c_str(), t.shadow("dead").c_str(),
+                      t.shadow("meta").c_str(), t.shadow("meta").c_str(), int(RTreeIndex::kFormat),
+                      ShadowTable::first_generation()));
       if (t.aux_count) {
         std::string sql = "CREATE TABLE " + t.shadow("aux") + "(id INTEGER PRIMARY KEY";
         for (int i = 0; i < t.aux_count; ++i)

@@ -4,6 +4,7 @@
 #include <strings.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 
 namespace loci::sqlite {
@@ -75,6 +76,12 @@ std::string ShadowTable::check_meta(int format) {
   if (!has_format) return format_sql("%s_meta has no format", name.c_str());
   if (!has_generation) return format_sql("%s_meta has no generation", name.c_str());
   return "";
+}
+
+sqlite3_int64 ShadowTable::first_generation() {
+  std::uint64_t r = 0;
+  sqlite3_randomness(int(sizeof r), &r);
+  return sqlite3_int64(r >> 2);
 }
 
 void ShadowTable::bump_generation() {

@@ -78,6 +78,9 @@ struct ShadowTable : sqlite3_vtab {
   // what is wrong (loci_check).
   std::string check_meta(int format);
   void bump_generation();  // 'generation' + 1, stored and remembered
+  // The 'generation' a new table starts at: random in [0, 2^62), so that a connection holding
+  // a table another one dropped (or renamed) and created again under its name sees a change.
+  static sqlite3_int64 first_generation();
   // Whether another connection committed a change to this table since `generation` was read.
   bool changed_elsewhere();
   void forget_version() { data_version_known = false; }

@@ -64,9 +64,14 @@ int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
   const TableFunction& f = function_of(v);
   const int arguments = f.required + f.optional;
   std::vector<int> slot(std::size_t(arguments), -1);
+  bool compared = false;  // an argument's column under another operator than =
   for (int i = 0; i < info->nConstraint; ++i) {
     const auto& c = info->aConstraint[i];
-    if (c.iColumn < f.columns || c.op != SQLITE_INDEX_CONSTRAINT_EQ) continue;
+    if (c.iColumn < f.columns) continue;
+    if (c.op != SQLITE_INDEX_CONSTRAINT_EQ) {
+      compared = true;
+      continue;
+    }
     if (!c.usable) return SQLITE_CONSTRAINT;  // wait for a plan where the argument is known
     slot[std::size_t(c.iColumn - f.columns)] = i;
   }
@@ -77,7 +82,8 @@ int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
   for (int a = given; a < arguments; ++a)
     gap |= slot[std::size_t(a)] >= 0;
   if (given < f.required || gap) {
-    set_error(v, format_sql("%s takes %s", f.name, f.usage));
+    set_error(v, format_sql("%s takes %s%s", f.name, f.usage,
+                            compared ? " (an argument given as a column takes = or IN only)" : ""));
     return SQLITE_ERROR;
   }
   for (int a = 0; a < given; ++a) {

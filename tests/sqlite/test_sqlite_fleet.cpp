@@ -351,6 +351,23 @@ TEST(SqliteFleetSql, SurvivesCloseAndReopenAndSeesOtherConnections) {
   }
   EXPECT_EQ(db.value("SELECT count(*) FROM f WHERE id = 99999"), "0");
   EXPECT_EQ(db.rows("SELECT * FROM f ORDER BY id"), before);
+  // Dropped and created again by another connection, with as many writes: the new one answers.
+  const auto nearest = [&](Db& d) {
+    return d.rows("SELECT id, distance FROM loci_fleet_nearest('f', 300, 300, 5)");
+  };
+  const auto seen = nearest(db);
+  {
+    Db other(dir.file("f.db"));
+    other.exec("DROP TABLE f; CREATE VIRTUAL TABLE f USING loci_fleet(id, t, x, y, vx, vy)");
+    insert(other, "f", make_fleet(800, 3, 1.7e9, 35));
+    other.exec("DELETE FROM f WHERE id % 7 = 0");
+    other.exec("INSERT INTO f VALUES (99999, " + far + ", 5000.5, 5000.5, 0, 0)");
+    other.exec("DELETE FROM f WHERE id = 99999");
+  }
+  Db fresh(dir.file("f.db"));
+  ASSERT_NE(nearest(fresh), seen);
+  EXPECT_EQ(nearest(db), nearest(fresh));
+  EXPECT_EQ(db.value("SELECT loci_check('f')"), "ok");
 }
 
 // A writer killed with SIGKILL in the middle of its transactions leaves the fleet consistent.
@@ -439,6 +456,8 @@ TEST(SqliteFleetSql, BadInputIsAnSqlErrorWithAClearMessage) {
   EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_fleet_nearest('f', 0, 0, 1.5)"), "k must be"));
   EXPECT_TRUE(
       has(db.error_of("SELECT * FROM loci_fleet_nearest('f', 2e150, 0, 1)"), "x is beyond 1e150"));
+  EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_fleet_window('f', -1e151, 0, 1, 1, 0)"),
+                  "xmin is beyond 1e150"));
   // Positions far beyond 1e150 at the time asked: refused, never an infinite distance or
   // two of them ranked as a tie; after the latest report (the tree) and before it (history).
   db.exec("INSERT INTO f VALUES (2, 10, 0, 0, 1e150, 0), (3, 10, 0, 0, 5e149, 0)");

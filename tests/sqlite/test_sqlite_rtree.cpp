@@ -575,6 +575,36 @@ TEST(SqliteRtreeSql, SurvivesCloseAndReopen) {
   EXPECT_EQ(db.value("SELECT id FROM loci_nearest('t', 500.5, 500.5, 1)"), "123456");
 }
 
+// A table another connection dropped, or renamed, and created again under its name: the
+// functions answer from the new one, whose writes started from the same count.
+TEST(SqliteRtreeSql, FunctionsFollowATableReplacedByAnotherConnection) {
+  TempDir dir;
+  Db db(dir.file("r.db"));
+  db.exec(
+      "CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy);"
+      "INSERT INTO t VALUES (1, 0, 0, 0, 0)");
+  EXPECT_EQ(db.value("SELECT id FROM loci_nearest('t', 5, 5, 1)"), "1");
+  {
+    Db other(dir.file("r.db"));
+    other.exec(
+        "DROP TABLE t; CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy);"
+        "INSERT INTO t VALUES (2, 5, 5, 5, 5)");
+  }
+  EXPECT_EQ(db.rows("SELECT id, distance FROM loci_nearest('t', 5, 5, 5)"),
+            (std::vector<Row>{{"2", "0"}}));
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+  {
+    Db other(dir.file("r.db"));
+    other.exec(
+        "ALTER TABLE t RENAME TO u;"
+        "CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy);"
+        "INSERT INTO t VALUES (9, 1, 1, 1, 1)");
+  }
+  EXPECT_EQ(db.rows("SELECT id FROM loci_nearest('t', 5, 5, 5)"), (std::vector<Row>{{"9"}}));
+  EXPECT_EQ(db.rows("SELECT id FROM loci_nearest('u', 5, 5, 5)"), (std::vector<Row>{{"2"}}));
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+}
+
 // A writer killed with SIGKILL in the middle of its transactions (including the repack at
 // commit) leaves database and index consistent: SQLite's journal puts the shadow tables back.
 TEST(SqliteRtreeSql, AWriterKilledMidTransactionLeavesItConsistent) {
@@ -666,6 +696,12 @@ TEST(SqliteRtreeSql, BadInputIsAnSqlErrorWithAClearMessage) {
   EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', 0, 0, -1)").find("k must be"),
             std::string::npos);
   EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('t', 0, 0)").find("four arguments"),
+            std::string::npos);
+  EXPECT_NE(db.error_of("SELECT * FROM loci_nearest WHERE arg_table = 't' AND arg_x > 0 AND "
+                        "arg_y = 0 AND arg_k = 1")
+                .find("takes = or IN only"),
+            std::string::npos);
+  EXPECT_EQ(db.error_of("SELECT * FROM loci_nearest('t', 0, 0)").find("= or IN"),
             std::string::npos);
   EXPECT_NE(db.error_of("SELECT loci_check('nosuch')").find("no such table"), std::string::npos);
 }
