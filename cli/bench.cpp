@@ -101,7 +101,7 @@ std::string bench_layer(const BenchOptions& o) {
 
   char head[200];  // the layer's path goes around it: it may be of any length
   std::snprintf(head, sizeof head,
-                ": %zu %s boxes, %zu windows (%zu hits), %zu nearest-%zu queries\n"
+                ": %zu boxes (per %s), %zu windows (%zu hits), %zu nearest-%zu queries\n"
                 "%-28s %12s %12s %10s\n",
                 boxes.size(), o.per == Per::segment ? "segment" : "feature", o.queries, loci_hits,
                 o.queries, o.k, "", "loci ms", "Boost ms", "Boost/loci");

@@ -17,6 +17,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bench.hpp"
@@ -555,8 +556,9 @@ const std::vector<Command>& commands() {
         {"--bbox-file", nullptr, "F", "one window per line; rows start with the line number"},
         {"--nearest", "-n", "X,Y", "the k features nearest to the point, nearest first"},
         {"--nearest-file", nullptr, "F", "one X,Y per line; rows start with the line number"},
-        {"-k", nullptr, "N", "how many neighbours (default 1, must be >= 1)"},
-        {"--within", nullptr, "X,Y,D", "features at distance <= D from the point"},
+        {"-k", nullptr, "N", "how many neighbours, 1 to 1000000 (default 1)"},
+        {"--within", nullptr, "X,Y,D",
+         "features at distance <= D from the point (planar, in the layer's units)"},
         {"--segment", nullptr, "X0,Y0,X1,Y1",
          "features meeting the closed segment, with the first point of each (csv: x,y)"},
         {"--first", nullptr, nullptr,
@@ -666,7 +668,7 @@ const std::vector<Command>& commands() {
          "objects in the closed window (lon/lat for AIS input)"},
         {"--nearest", "-n", "X,Y",
          "the k objects nearest the point, nearest first (lon/lat for AIS)"},
-        {"-k", nullptr, "N", "how many neighbours (default 1)"},
+        {"-k", nullptr, "N", "how many neighbours, 1 to 1000000 (default 1)"},
         {"--at", nullptr, "T",
          "the time asked about: a number, or a UTC date 2023-01-01T00:00:07 (default: now, the "
          "latest report)"},
@@ -763,7 +765,7 @@ const std::vector<Command>& commands() {
        "loci bench LAYER [--per feature|segment] [--queries N] [-k N]",
        "the layer's boxes in loci's packed R-tree and in Boost.Geometry's rtree, side by side",
        {{"--queries", nullptr, "N", "windows and nearest-n queries to time (default 10000)"},
-        {"-k", nullptr, "N", "neighbours per nearest-n query (default 10)"},
+        {"-k", nullptr, "N", "neighbours per nearest-n query, 1 to 1000000 (default 10)"},
         {"--per", nullptr, "feature|segment", "boxes of features or of segments (default segment)"},
         kLayer,
         kQuiet},
@@ -848,6 +850,15 @@ Args parse(const Command& c, int first, int argc, char** argv) {
   return a;
 }
 
+// A message as one line: control characters (a newline in a file or layer name, an escape
+// sequence meant for the terminal) shown as '?'.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (unsigned char ch : text)
+    out += ch < 0x20 || ch == 0x7f ? '?' : char(ch);
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -893,13 +904,11 @@ int main(int argc, char** argv) {
       return status;
     } catch (const std::exception& e) {
       std::fflush(stdout);
-      std::fprintf(stderr, "loci: error: %s\n", e.what());
+      std::fprintf(stderr, "loci: error: %s\n", printable(e.what()).c_str());
       return 1;
     }
   }
-  std::string shown;
-  for (unsigned char ch : name.substr(0, 40))
-    shown += ch < 0x20 || ch == 0x7f ? '?' : char(ch);
+  const std::string shown = printable(name.substr(0, 40));
   const bool fleet = name.rfind("fleet ", 0) == 0;
   std::fprintf(stderr, "loci: error: unknown command '%s' (see loci %s--help)\n", shown.c_str(),
                fleet ? "fleet " : "");

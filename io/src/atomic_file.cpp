@@ -372,6 +372,30 @@ void refuse_replacing_layers(const std::string& out) {
               ", which writing the whole file would lose; name another file");
 }
 
+void refuse_replacing_binary_dataset(const std::string& out) {
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::status(out, ec))) return;
+  unsigned char head[16] = {};
+  std::FILE* f = std::fopen(out.c_str(), "rb");
+  if (!f) return;
+  const std::size_t n = std::fread(head, 1, sizeof head, f);
+  std::fclose(f);
+  if (n == 0) return;
+  std::string ext = fs::path(out).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  const char* kind = nullptr;
+  if (may_hold_layers(out))
+    kind = head[0] == 'S' ? "an SQLite database (a GeoPackage, say)" : "a TIFF image";
+  else if (n >= 4 && std::memcmp(head, "\0\0\x27\x0a", 4) == 0)
+    kind = "a shapefile's geometry or index (.shp, .shx)";
+  else if (ext == ".dbf")
+    kind = "a dBase table (a shapefile's attributes)";
+  if (kind)
+    throw Error("refusing to write " + out + ": it is " + kind +
+                ", which this text output would replace; name another file");
+}
+
 void refuse_overwriting(const std::string& out, const std::string& input, const char* what) {
   if (out.empty() || input.empty()) return;
   std::error_code ec;

@@ -161,11 +161,15 @@ std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& pa
 
 namespace {
 // A name in a list of names separated by spaces: as it is, or in single quotes (a quote
-// doubled) when it holds a space, a colon, a comma or a quote, or is empty.
+// doubled) when it holds a space, a colon, a comma or a quote, or is empty; control characters
+// (a newline) as '?', so that the summary keeps one line per item.
 std::string listed(const std::string& name) {
-  if (!name.empty() && name.find_first_of(" \t:,'\"") == std::string::npos) return name;
+  std::string shown;
+  for (const unsigned char c : name)
+    shown += c < 0x20 || c == 0x7f ? '?' : char(c);
+  if (!shown.empty() && shown.find_first_of(" :,'\"") == std::string::npos) return shown;
   std::string q = "'";
-  for (const char c : name)
+  for (const char c : shown)
     q += c == '\'' ? std::string("''") : std::string(1, c);
   return q + "'";
 }
@@ -175,7 +179,10 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
                            const Progress& progress) {
   const LayerSummary s = summarize_layer(layer_path, layer_name, progress);
   std::ostringstream o;
-  o << "layer:     " << s.layer_name << " (" << s.driver << ")\n";
+  std::string name = s.layer_name;
+  for (char& c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  o << "layer:     " << name << " (" << s.driver << ")\n";
   if (s.layer_names.size() > 1) {
     o << "layers:   ";
     for (const auto& n : s.layer_names)
@@ -200,7 +207,11 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   const std::string sidecar = default_sidecar_path(layer_path);
   o << "index:     ";
   if (!file_exists(sidecar)) {
-    o << "none (loci index " << layer_path << " writes " << sidecar << ")\n";
+    // Of a dataset's other layers than its first, the command names the layer.
+    const bool first = s.layer_names.empty() || s.layer_names.front() == s.layer_name;
+    o << "none (loci index " << layer_path
+      << (first ? std::string() : " --layer " + listed(s.layer_name)) << " writes " << sidecar
+      << ")\n";
     return o.str();
   }
   try {

@@ -280,6 +280,9 @@ LayerSummary summarize_layer(const std::string& path, const std::string& layer,
       ++types["(none)"];
       continue;
     }
+    // A NaN or infinite coordinate is refused, as by every command that reads the layer (the
+    // extent said inf, or left the NaN out; a point with one NaN is read as an empty point).
+    detail::flatten(g, detail::where(path, feature->GetFID()));
     const std::string type = OGRGeometryTypeToName(g->getGeometryType());
     if (g->IsEmpty()) {  // a geometry without points (POINT EMPTY): counted apart, no extent
       ++types[type + " (empty)"];

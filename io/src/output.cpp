@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <set>
 #include <string>
 #include <unordered_map>
@@ -171,6 +172,27 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
   }
 }
 
+// g as GeoJSON can hold it: triangles, TINs and polyhedral surfaces (also as members of a
+// collection) as the polygons of their faces, which GeoJSON has (GDAL's writer would leave the
+// geometry null); null when g is written as it is.
+std::unique_ptr<OGRGeometry> geojson_geometry(const OGRGeometry* g) {
+  if (!g) return nullptr;
+  if (detail::of_faces(g->getGeometryType()))
+    return std::unique_ptr<OGRGeometry>(OGRGeometryFactory::forceToMultiPolygon(g->clone()));
+  if (wkbFlatten(g->getGeometryType()) != wkbGeometryCollection) return nullptr;
+  const OGRGeometryCollection& c = *g->toGeometryCollection();
+  bool faces = false;
+  for (const OGRGeometry* m : c)
+    faces |= geojson_geometry(m) != nullptr;
+  if (!faces) return nullptr;
+  auto out = std::make_unique<OGRGeometryCollection>();
+  for (const OGRGeometry* m : c) {
+    std::unique_ptr<OGRGeometry> converted = geojson_geometry(m);
+    out->addGeometryDirectly(converted ? converted.release() : m->clone());
+  }
+  return out;
+}
+
 void write_geojson(const AnswerSource& src, std::span<const Answer> answers, bool numbered,
                    bool with_distance, bool with_point, const std::string& target) {
   auto ol = detail::open_layer(src.layer_path, src.layer_name);
@@ -218,8 +240,12 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
     if (x_field >= 0) out.SetField(x_field, a.at[0]);
     if (y_field >= 0) out.SetField(y_field, a.at[1]);
     for (const auto& [from, to] : copied)
-      if (f->IsFieldSetAndNotNull(from)) out.SetField(to, f->GetRawFieldRef(from));
-    out.SetGeometry(f->GetGeometryRef());
+      if (f->IsFieldSetAndNotNull(from))
+        out.SetField(to, f->GetRawFieldRef(from));
+      else if (f->IsFieldNull(from))
+        out.SetFieldNull(to);  // "n": null, as the layer has it (an unset field is left out)
+    const std::unique_ptr<OGRGeometry> faces = geojson_geometry(f->GetGeometryRef());
+    out.SetGeometry(faces ? faces.get() : f->GetGeometryRef());
     if (layer->CreateFeature(&out) != OGRERR_NONE)
       throw Error("cannot write feature " + std::to_string(a.fid) + " as GeoJSON");
   }
@@ -239,7 +265,9 @@ Format parse_format(const std::string& name) {
 }
 
 OutputFile::OutputFile(const std::string& path, std::FILE* fallback) : fallback_(fallback) {
-  if (!path.empty()) file_.emplace(path);
+  if (path.empty()) return;
+  file_.emplace(path);  // refuses a layer of several, naming them
+  refuse_replacing_binary_dataset(path);
 }
 
 void OutputFile::commit() {

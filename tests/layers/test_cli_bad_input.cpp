@@ -105,6 +105,12 @@ TEST_F(BadInput, NaNCoordinatesAreRefusedNamingTheFeature) {
     EXPECT_NE(r.err.find("feature 1"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(l + ".loci"));
   }
+  // info too (its extent said inf, or left a NaN out).
+  const CliRun info = run_loci("info " + shell_quote(l));
+  expect_one_line_error(info);
+  EXPECT_NE(info.err.find("feature 1 has a NaN or infinite coordinate"), std::string::npos)
+      << info.err;
+  EXPECT_TRUE(info.out.empty()) << info.out;
   const CliRun clip =
       run_loci("clip " + shell_quote(l) + " --bbox -1,-1,3,3 -o " + shell_quote(path("c.geojson")));
   expect_one_line_error(clip);
@@ -133,6 +139,7 @@ TEST_F(BadInput, NaNPointsGdalReadsAsEmptyAreRefusedToo) {
     }
     const CliRun join = run_loci("join " + shell_quote(l) + " " + shell_quote(l));
     expect_one_line_error(join);
+    expect_one_line_error(run_loci("info " + shell_quote(l)));
     // intersections reads linework only, and refuses such a point all the same
     const CliRun crossings = run_loci("intersections " + shell_quote(l));
     expect_one_line_error(crossings);
@@ -681,3 +688,19 @@ TEST_F(BadInput, UnusualLayersAnswerAndBrokenOnesFailInOneLine) {
 }
 
 }  // namespace
+
+// A newline in a file, layer or field name keeps an error to one line and a summary to one
+// line per item (they were printed raw).
+TEST_F(BadInput, NamesWithNewlinesKeepMessagesToOneLine) {
+  const CliRun missing =
+      run_loci("query " + shell_quote(path("no\nfile.geojson")) + " --bbox 0,0,1,1");
+  expect_one_line_error(missing);
+  EXPECT_NE(missing.err.find("no?file.geojson"), std::string::npos) << missing.err;
+  const std::string l = write("odd.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"a\nb":1},"geometry":{"type":"Point","coordinates":[0,0]}}]})");
+  expect_one_line_error(
+      run_loci("query " + shell_quote(l) + " --layer " + shell_quote("x\ny") + " --bbox 0,0,1,1"));
+  const CliRun info = run_loci("info " + shell_quote(l));
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("fields:    a?b:Integer\n"), std::string::npos) << info.out;
+}

@@ -686,6 +686,14 @@ TEST_F(LayersCli, InfoSummarisesTheLayerAndItsIndex) {
                          " -nln alpha && ogr2ogr -update " + two + " " + layer + " -nln beta")
                             .c_str()),
             0);
+  // Before an index: the command that writes one names the layer when it is not the first.
+  r = run_loci("info " + two + " --layer beta");
+  EXPECT_NE(r.out.find("none (loci index " + two + " --layer beta writes " + two + ".loci)"),
+            std::string::npos)
+      << r.out;
+  r = run_loci("info " + two);
+  EXPECT_NE(r.out.find("none (loci index " + two + " writes " + two + ".loci)"), std::string::npos)
+      << r.out;
   ASSERT_EQ(run_loci("index -q " + two + " --layer beta").status, 0);
   r = run_loci("info " + two + " --layer alpha");
   EXPECT_NE(r.out.find("not this layer's (it indexes layer 'beta'"), std::string::npos) << r.out;
@@ -1182,6 +1190,24 @@ TEST_F(LayersCli, OutputsRefuseToReplaceAFileHoldingOtherLayers) {
   ASSERT_EQ(got.geoms.size(), 1u);
   EXPECT_EQ(got.envelopes[0].MinX, 1.0);
   EXPECT_EQ(got.envelopes[0].MaxY, 2.0);
+  // A text output (an answer, a drawing) does not replace a binary dataset, of one layer
+  // either: the GeoPackage, a shapefile's .shp or .dbf (they became text, and the dataset
+  // would no longer open). A text dataset is replaced, as a run again replaces its answer.
+  const std::string shp = path("other.shp"), dbf = path("other.dbf");
+  ASSERT_EQ(std::system(("ogr2ogr " + shp + " " + u).c_str()), 0);
+  const auto shp_size = fs::file_size(shp), one_size = fs::file_size(one);
+  for (const std::string& target : {one, shp, dbf})
+    for (const std::string command :
+         {"query " + u + " --bbox 1,1,2,2", "query " + u + " --bbox 1,1,2,2 -f csv",
+          "draw " + u + " -q", "intersections " + u + " -q"})
+      expect_error(command + " -o " + target, "which this text output would replace");
+  EXPECT_EQ(fs::file_size(shp), shp_size);
+  EXPECT_EQ(fs::file_size(one), one_size);
+  EXPECT_EQ(read_with_ogr(shp).geoms.size(), 1u);
+  const std::string text = path("answer.geojson");
+  for (int run = 0; run < 2; ++run)
+    ASSERT_EQ(run_loci("query " + u + " --bbox 1,1,2,2 -f geojson -o " + text).status, 0);
+  EXPECT_EQ(read_with_ogr(text).geoms.size(), 1u);
 }
 
 // A sidecar written elsewhere with -o is drawn with --index (draw took the layer from the
@@ -1279,6 +1305,36 @@ TEST_F(LayersCli, TrianglesTinsAndPolyhedralSurfacesAreSurfaces) {
   for (const auto& g : got.geoms)
     area += OGR_G_Area(OGRGeometry::ToHandle(g.get()));
   EXPECT_DOUBLE_EQ(area, 12.5 + 50 + 25);
+  // A query's GeoJSON holds them as the polygons of their faces (GDAL wrote a null geometry).
+  const std::string answer = path("tin_answer.geojson");
+  const CliRun q = run_loci("query " + gpkg + " --bbox 0,0,50,10 -f geojson -o " + answer);
+  ASSERT_EQ(q.status, 0) << q.err;
+  const OgrFeatureSet found = read_with_ogr(answer);
+  ASSERT_EQ(found.geoms.size(), 3u);
+  area = 0;
+  for (const auto& g : found.geoms) {
+    ASSERT_TRUE(g) << read_text(answer);
+    EXPECT_EQ(wkbFlatten(g->getGeometryType()), wkbMultiPolygon);
+    area += OGR_G_Area(OGRGeometry::ToHandle(g.get()));
+  }
+  EXPECT_DOUBLE_EQ(area, 50 + 100 + 50);
+}
+
+// A null attribute stays null in a GeoJSON answer (it was left out, as if the layer had no
+// such value), and empty in a CSV one.
+TEST_F(LayersCli, NullAttributesStayNull) {
+  const std::string layer = path("nulls.geojson"), answer = path("nulls_answer.geojson");
+  std::ofstream(layer) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"n":null,"m":"x"},"geometry":{"type":"Point","coordinates":[1,1]}},
+{"type":"Feature","properties":{"n":2,"m":null},"geometry":{"type":"Point","coordinates":[2,2]}}]})";
+  const CliRun r = run_loci("query " + layer + " --bbox 0,0,5,5 -f geojson -o " + answer);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string text = read_text(answer);
+  EXPECT_NE(text.find(R"("n": null, "m": "x")"), std::string::npos) << text;
+  EXPECT_NE(text.find(R"("n": 2, "m": null)"), std::string::npos) << text;
+  const CliRun c = run_loci("query " + layer + " --bbox 0,0,5,5 -f csv");
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(c.out, "fid,n,m\n0,,x\n1,2,\n");
 }
 
 // A clip keeps Z (interpolated along the cut) and writes no M (GEOS does not carry measures:

@@ -76,6 +76,12 @@ class AtomicDataset {
 // constructor calls it (a command constructs its output before its work, to fail early).
 void refuse_replacing_layers(const std::string& out);
 
+// Throws loci::Error when `out` is an existing file of a binary dataset (an SQLite database or
+// GeoPackage, a TIFF, a shapefile's .shp, .shx or .dbf), which a text output (an answer, a
+// drawing) written over it would destroy; text datasets (a GeoJSON, a CSV) are replaced, as a
+// command run again replaces its answer.
+void refuse_replacing_binary_dataset(const std::string& out);
+
 // True when the two paths name one file (spelled alike, or the same file through another
 // spelling, a link or a relative path).
 bool same_file(const std::string& a, const std::string& b);

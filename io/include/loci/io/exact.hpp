@@ -12,8 +12,9 @@
 // or one of its polygons contains a point of it (crossing parity decided with the exact
 // orientation predicate; a point on a ring is caught by the edge test, not by parity). The
 // rings of a feature are taken together (the even-odd rule, as GEOS and the per-segment index
-// count them): for valid geometries that is polygon by polygon, and where polygons of one
-// invalid multi-polygon overlap, their overlap is outside.
+// count them): for a valid polygon or multi-polygon that is polygon by polygon, and where
+// polygons of one feature overlap (an invalid multi-polygon, a collection of overlapping
+// polygons, faces of a surface overlapping in plan), their overlap is outside.
 // Touching counts. Distances are computed in floating point and are 0 inside a polygon; a
 // point's distance is 0 exactly when the point lies on the geometry, and whether it is within
 // a distance is decided exactly.
