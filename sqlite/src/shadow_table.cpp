@@ -163,6 +163,36 @@ bool is_schema(sqlite3* db, std::string_view name) {
   return false;
 }
 
+// `text` as SQL identifiers quoted as SQL quotes them ("a""b", [a], `a`), one or two
+// separated by a dot: {table} or {schema, table}; empty when it is not that.
+std::vector<std::string> quoted_identifiers(std::string_view text) {
+  std::vector<std::string> out;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const char open = text[i];
+    const char close = open == '[' ? ']' : open;
+    if (open != '"' && open != '[' && open != '`') return {};
+    std::string id;
+    for (++i;; ++i) {
+      if (i >= text.size()) return {};
+      if (text[i] != close) {
+        id += text[i];
+      } else if (close != ']' && i + 1 < text.size() && text[i + 1] == close) {
+        id += close;  // a doubled quote
+        ++i;
+      } else {
+        break;
+      }
+    }
+    out.push_back(std::move(id));
+    if (++i == text.size()) break;
+    if (text[i] != '.' || out.size() == 2) return {};
+    ++i;
+    if (i == text.size()) return {};
+  }
+  return out;
+}
+
 }  // namespace
 
 bool ShadowTable::find_missing_shadow() {
@@ -204,9 +234,18 @@ ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* 
   }
   if (schema.empty()) {
     const char* found = schema_of(db, whole);
-    if (!found) throw SqlError{SQLITE_ERROR, format_sql("%s: no such table: %s", function, name)};
-    schema = found;
-    table = whole;
+    // Quoted as in SQL ('"main"."t"', '"t"'), when no table has the name as it is.
+    if (const auto ids = quoted_identifiers(whole); !found && !ids.empty()) {
+      if (ids.size() == 2 && is_schema(db, ids[0]) && holds_table(db, ids[0].c_str(), ids[1]))
+        schema = ids[0], table = ids[1];
+      else if (ids.size() == 1 && (found = schema_of(db, ids[0])))
+        schema = found, table = ids[0];
+    } else if (found) {
+      schema = found;
+      table = whole;
+    }
+    if (schema.empty())
+      throw SqlError{SQLITE_ERROR, format_sql("%s: no such table: %s", function, name)};
   }
   if (ShadowTable* t = registry.find(schema, table)) return t;
   // Not connected on this connection yet: naming it in a statement connects it (or says what

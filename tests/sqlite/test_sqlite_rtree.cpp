@@ -810,6 +810,14 @@ TEST(SqliteRtreeSql, FunctionsFindTablesAsSqlDoes) {
     EXPECT_EQ(db.value("SELECT id FROM t"), "7");
     EXPECT_EQ(nearest("t"), "7");
     EXPECT_EQ(nearest("main.t"), "1");
+    // Quoted as in SQL (they were "no such table").
+    EXPECT_EQ(nearest("\"main\".\"t\""), "1");
+    EXPECT_EQ(nearest("[aux].`t`"), "2");
+    EXPECT_EQ(nearest("\"t\""), "7");
+    EXPECT_EQ(window("\"aux\".\"f\""), "2");
+    EXPECT_NE(
+        db.error_of("SELECT * FROM loci_nearest('\"main\".\"t', 0, 0, 1)").find("no such table"),
+        std::string::npos);
     EXPECT_NE(db.error_of("SELECT * FROM loci_nearest('nosuch.t', 0, 0, 1)")
                   .find("loci_nearest: no such table: nosuch.t"),
               std::string::npos);
