@@ -143,6 +143,11 @@ inline void check_coordinate(double x, const char* what = "query value") {
 template <class F, class... Args>
 concept Visitor = std::predicate<F&, Args...>;
 
+// visitor(a, b) for each reported pair (of ids, or of indices into the inputs of a join);
+// false stops.
+template <class F>
+concept PairVisitor = Visitor<F, Id, Id>;
+
 template <class F, int D>
 concept WindowVisitor = Visitor < F,
         Id, const Box<D>

@@ -34,9 +34,6 @@
 
 namespace loci {
 
-template <class F>
-concept PairVisitor = Visitor<F, Id, Id>;
-
 namespace detail {
 
 // Boxes in sweep order, structure of arrays, with their input indices.

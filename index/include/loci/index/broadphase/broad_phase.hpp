@@ -47,15 +47,12 @@
 namespace loci {
 
 // An overlapping pair of proxies, a < b.
+// Pairs reach a PairVisitor (query.hpp) as visitor(a, b) with a < b.
 struct IdPair {
   Id a;
   Id b;
   friend constexpr auto operator<=>(const IdPair&, const IdPair&) = default;
 };
-
-// visitor(a, b) for each reported pair, a < b; false stops.
-template <class F>
-concept PairVisitor = Visitor<F, Id, Id>;
 
 namespace detail {
 struct PairProbe {
