@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -32,6 +33,17 @@ TEST(Motion, BadReportsAreRefused) {
   EXPECT_NO_THROW(check_motion(Motion2{0, {1e149, 0}, {0, 0}}));
   EXPECT_THROW(check_window(MovingWindow<2>::during({{0, 0}, {1, 1}}, 2, 1)), InvalidGeometry);
   EXPECT_THROW(check_window(MovingWindow<2>::at({{1, 0}, {0, 1}}, 0)), InvalidGeometry);
+  // Moving windows doubles cannot follow: the bounds' speed overflows (it was infinite, and
+  // the window met everything beyond it), the interval overflows (the speed came out 0, a
+  // window standing still), or two boxes at one time (the second was ignored).
+  const Box2 a{{0, 0}, {1, 1}}, b{{1, 0}, {2, 1}}, far{{100, 0}, {101, 1}};
+  EXPECT_THROW(check_window(MovingWindow<2>(a, b, 0, std::numeric_limits<double>::denorm_min())),
+               InvalidGeometry);
+  EXPECT_THROW(check_window(MovingWindow<2>(a, far, -1e308, 1e308)), InvalidGeometry);
+  EXPECT_THROW(check_window(MovingWindow<2>(a, b, 5, 5)), InvalidGeometry);
+  EXPECT_NO_THROW(check_window(MovingWindow<2>(a, b, 0, 1e-300)));
+  EXPECT_NO_THROW(check_window(MovingWindow<2>::during(a, -1e308, 1e308)));
+  EXPECT_NO_THROW(check_window(MovingWindow<2>(a, far, -1e307, 1e307)));
 }
 
 // The message of check_motion's refusal (empty when it accepts).

@@ -151,7 +151,9 @@ struct MovingWindow {
   Point<D> vmin_, vmax_;
 };
 
-// Throws InvalidGeometry for NaN or infinite bounds or times, an inverted box or t1 > t2.
+// Throws InvalidGeometry for NaN or infinite bounds or times, an inverted box or t1 > t2, and
+// for a window that moves but cannot be followed in doubles: two boxes at one time
+// (t1 == t2), an interval t2 - t1 that overflows, or bounds whose speed does.
 template <int D>
 void check_window(const MovingWindow<D>& w) {
   if (!std::isfinite(w.t1) || !std::isfinite(w.t2))
@@ -159,6 +161,13 @@ void check_window(const MovingWindow<D>& w) {
   if (w.t1 > w.t2) throw InvalidGeometry("window's time interval is inverted (t1 > t2)");
   if (!is_valid(w.from) || !is_valid(w.to))
     throw InvalidGeometry("window has a NaN, infinite or inverted bound");
+  if (w.from == w.to) return;
+  if (w.t1 == w.t2)
+    throw InvalidGeometry("window at one time (t1 == t2) has two boxes (from != to)");
+  if (!std::isfinite(w.t2 - w.t1))
+    throw InvalidGeometry("moving window's interval t2 - t1 overflows a double");
+  if (!is_finite(w.vmin()) || !is_finite(w.vmax()))
+    throw InvalidGeometry("moving window's bounds move faster than a double holds");
 }
 
 // The times in [w.t1, w.t2] at which the box [lo + vlo (s - t), hi + vhi (s - t)] meets the
