@@ -180,7 +180,11 @@ constexpr double squared_minmax_distance(const Point<D>& p, const Box<D>& b) {
 
 template <int D>
 std::string to_string(const Box<D>& b) {
-  return "[" + to_string(b.min) + " .. " + to_string(b.max) + "]";
+  std::string s = "[";
+  s += to_string(b.min);
+  s += " .. ";
+  s += to_string(b.max);
+  return s += ']';
 }
 
 // The largest magnitude of a coordinate of b: the scale its coordinates' rounding is
