@@ -163,33 +163,44 @@ bool is_schema(sqlite3* db, std::string_view name) {
   return false;
 }
 
-// `text` as SQL identifiers quoted as SQL quotes them ("a""b", [a], `a`), one or two
-// separated by a dot: {table} or {schema, table}; empty when it is not that.
+// `text` as SQL identifiers, one or two separated by a dot, at least one quoted as SQL quotes
+// them ("a""b", [a], `a`; the other may be bare): {table} or {schema, table}; empty when it is
+// not that.
 std::vector<std::string> quoted_identifiers(std::string_view text) {
   std::vector<std::string> out;
+  bool quoted = false;
   std::size_t i = 0;
   while (i < text.size()) {
     const char open = text[i];
-    const char close = open == '[' ? ']' : open;
-    if (open != '"' && open != '[' && open != '`') return {};
     std::string id;
-    for (++i;; ++i) {
-      if (i >= text.size()) return {};
-      if (text[i] != close) {
-        id += text[i];
-      } else if (close != ']' && i + 1 < text.size() && text[i + 1] == close) {
-        id += close;  // a doubled quote
-        ++i;
-      } else {
-        break;
+    if (open == '"' || open == '[' || open == '`') {
+      const char close = open == '[' ? ']' : open;
+      for (++i;; ++i) {
+        if (i >= text.size()) return {};
+        if (text[i] != close) {
+          id += text[i];
+        } else if (close != ']' && i + 1 < text.size() && text[i + 1] == close) {
+          id += close;  // a doubled quote
+          ++i;
+        } else {
+          break;
+        }
       }
+      ++i;
+      quoted = true;
+    } else {
+      for (; i < text.size() && text[i] != '.'; ++i) {
+        if (text[i] == '"' || text[i] == '[' || text[i] == '`') return {};
+        id += text[i];
+      }
+      if (id.empty()) return {};
     }
     out.push_back(std::move(id));
-    if (++i == text.size()) break;
+    if (i == text.size()) break;
     if (text[i] != '.' || out.size() == 2) return {};
-    ++i;
-    if (i == text.size()) return {};
+    if (++i == text.size()) return {};
   }
+  if (!quoted) return {};
   return out;
 }
 

@@ -815,6 +815,8 @@ TEST(SqliteRtreeSql, FunctionsFindTablesAsSqlDoes) {
     EXPECT_EQ(nearest("[aux].`t`"), "2");
     EXPECT_EQ(nearest("\"t\""), "7");
     EXPECT_EQ(window("\"aux\".\"f\""), "2");
+    EXPECT_EQ(nearest("main.\"t\""), "1");
+    EXPECT_EQ(nearest("\"aux\".t"), "2");
     EXPECT_NE(
         db.error_of("SELECT * FROM loci_nearest('\"main\".\"t', 0, 0, 1)").find("no such table"),
         std::string::npos);
