@@ -31,6 +31,15 @@
 
 namespace {
 
+// A message as one line: control characters (a newline in a file or layer name, an escape
+// sequence meant for the terminal) shown as '?'.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (unsigned char ch : text)
+    out += ch < 0x20 || ch == 0x7f ? '?' : char(ch);
+  return out;
+}
+
 using namespace loci;
 using namespace loci::io;
 
@@ -163,13 +172,13 @@ int run_index(const Args& a) {
     if (r.without_geometry > 0)
       skipped = "; skipped " + counted(r.without_geometry, "feature") + " without a geometry";
     std::fprintf(stderr, "loci: indexed %s of layer '%s' into %s (%llu bytes, %.2f s)%s\n",
-                 what.c_str(), r.layer_name.c_str(), r.path.c_str(),
+                 what.c_str(), printable(r.layer_name).c_str(), printable(r.path).c_str(),
                  static_cast<unsigned long long>(r.bytes), r.seconds, skipped.c_str());
     if (!r.replaced_layer.empty())
       std::fprintf(stderr,
                    "loci: %s held the index of layer '%s', now replaced (one index per file: "
                    "give another with -o to keep both)\n",
-                   r.path.c_str(), r.replaced_layer.c_str());
+                   printable(r.path).c_str(), printable(r.replaced_layer).c_str());
   }
   return 0;
 }
@@ -257,7 +266,7 @@ int run_clip(const Args& a) {
   const ClipResult r = clip_layer(o);
   if (!a.has("--quiet")) {
     std::fprintf(stderr, "loci: %zu feature%s clipped into %s\n", r.written,
-                 r.written == 1 ? "" : "s", o.out_path.c_str());
+                 r.written == 1 ? "" : "s", printable(o.out_path).c_str());
     if (r.dropped > 0)
       std::fprintf(stderr,
                    "loci: %zu piece%s of lower dimension left out (points or lines where the "
@@ -290,7 +299,7 @@ int run_intersections(const Args& a) {
   const std::size_t n = write_intersections(o, stdout);
   if (!a.has("--quiet") && !o.out_path.empty())
     std::fprintf(stderr, "loci: %s written into %s\n", counted(n, "row").c_str(),
-                 o.out_path.c_str());
+                 printable(o.out_path).c_str());
   return 0;
 }
 
@@ -320,7 +329,7 @@ int run_join(const Args& a) {
   const std::size_t n = write_join(o, stdout);
   if (!a.has("--quiet") && !o.out_path.empty())
     std::fprintf(stderr, "loci: %s written into %s\n", counted(n, "pair").c_str(),
-                 o.out_path.c_str());
+                 printable(o.out_path).c_str());
   return 0;
 }
 
@@ -341,7 +350,8 @@ int run_draw(const Args& a) {
   const std::size_t n = draw_index(o);
   if (!a.has("--quiet"))
     std::fprintf(stderr, "loci: %s drawn into %s\n",
-                 counted(n, o.cell_levels >= 0 ? "cell" : "node").c_str(), o.out_path.c_str());
+                 counted(n, o.cell_levels >= 0 ? "cell" : "node").c_str(),
+                 printable(o.out_path).c_str());
   return 0;
 }
 
@@ -386,7 +396,7 @@ std::optional<double> at_flag(const Args& a) {
 // The summary line of what was read, and for AIS input what the output's units are.
 void print_fleet_run(const Args& a, const FleetRun& r) {
   if (a.has("--quiet")) return;
-  std::fprintf(stderr, "loci: %s\n", r.summary.c_str());
+  std::fprintf(stderr, "loci: %s\n", printable(r.summary).c_str());
   if (!r.units.empty()) std::fprintf(stderr, "loci: %s\n", r.units.c_str());
 }
 
@@ -459,7 +469,7 @@ int run_fleet_generate(const Args& a) {
   const std::size_t n = fleet_generate(o, stdout);
   if (!a.has("--quiet"))
     std::fprintf(stderr, "loci: %s of %s written into %s\n", counted(n, "report").c_str(),
-                 counted(o.count, "object").c_str(), o.out_path.c_str());
+                 counted(o.count, "object").c_str(), printable(o.out_path).c_str());
   return 0;
 }
 
@@ -850,15 +860,6 @@ Args parse(const Command& c, int first, int argc, char** argv) {
   return a;
 }
 
-// A message as one line: control characters (a newline in a file or layer name, an escape
-// sequence meant for the terminal) shown as '?'.
-std::string printable(std::string_view text) {
-  std::string out;
-  for (unsigned char ch : text)
-    out += ch < 0x20 || ch == 0x7f ? '?' : char(ch);
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -896,7 +897,16 @@ int main(int argc, char** argv) {
         return 0;
       }
     try {
-      const int status = c.run(parse(c, first, argc, argv));
+      const Args args = parse(c, first, argc, argv);
+      // A text or GeoJSON output that would replace a dataset is refused before the work
+      // (the refusal came after a join or conflict search had run to its end); an index and a
+      // clip judge their targets themselves.
+      const std::string command = c.name;
+      if (args.has("--output") && command != "index" && command != "clip") {
+        refuse_replacing_layers(args.get("--output"));
+        refuse_replacing_binary_dataset(args.get("--output"));
+      }
+      const int status = c.run(args);
       // Output that did not reach its destination (a full disk, a closed pipe) is a failure.
       if (std::fflush(stdout) != 0 || std::ferror(stdout))
         throw loci::Error(std::string("cannot write output (") +

@@ -381,15 +381,26 @@ void refuse_replacing_binary_dataset(const std::string& out) {
   const std::size_t n = std::fread(head, 1, sizeof head, f);
   std::fclose(f);
   if (n == 0) return;
-  std::string ext = fs::path(out).extension().string();
+  // The name of the file itself, a link followed.
+  std::string ext = fs::weakly_canonical(out, ec).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return char(std::tolower(c)); });
+  // A dBase table by its header: a version byte dBase and GDAL write, a month and a day, and a
+  // header of 32 bytes per field plus 33.
+  const auto dbase = [&] {
+    const unsigned char versions[] = {0x02, 0x03, 0x30, 0x31, 0x32, 0x43,
+                                      0x63, 0x83, 0x8b, 0xcb, 0xf5, 0xfb};
+    const unsigned header = head[8] | unsigned(head[9]) << 8;
+    return n == 16 &&
+           std::find(std::begin(versions), std::end(versions), head[0]) != std::end(versions) &&
+           head[2] <= 12 && head[3] <= 31 && header >= 33;
+  };
   const char* kind = nullptr;
   if (may_hold_layers(out))
     kind = head[0] == 'S' ? "an SQLite database (a GeoPackage, say)" : "a TIFF image";
   else if (n >= 4 && std::memcmp(head, "\0\0\x27\x0a", 4) == 0)
     kind = "a shapefile's geometry or index (.shp, .shx)";
-  else if (ext == ".dbf")
+  else if (ext == ".dbf" && dbase())
     kind = "a dBase table (a shapefile's attributes)";
   if (kind)
     throw Error("refusing to write " + out + ": it is " + kind +

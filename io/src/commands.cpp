@@ -173,16 +173,33 @@ std::string listed(const std::string& name) {
     q += c == '\'' ? std::string("''") : std::string(1, c);
   return q + "'";
 }
+// Control characters as '?': a name shown on a line of its own keeps it.
+std::string printable(std::string text) {
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return text;
+}
+
+// A word as a shell reads it back: as it is when it holds only characters the shell takes
+// literally, else in single quotes (a quote as '\'').
+std::string shell_word(const std::string& word) {
+  const std::string text = printable(word);
+  if (!text.empty() &&
+      text.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-.,/:"
+                             "+=@%") == std::string::npos)
+    return text;
+  std::string q = "'";
+  for (const char c : text)
+    q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
 }  // namespace
 
 std::string describe_layer(const std::string& layer_path, const std::string& layer_name,
                            const Progress& progress) {
   const LayerSummary s = summarize_layer(layer_path, layer_name, progress);
   std::ostringstream o;
-  std::string name = s.layer_name;
-  for (char& c : name)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  o << "layer:     " << name << " (" << s.driver << ")\n";
+  o << "layer:     " << printable(s.layer_name) << " (" << s.driver << ")\n";
   if (s.layer_names.size() > 1) {
     o << "layers:   ";
     for (const auto& n : s.layer_names)
@@ -209,9 +226,9 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   if (!file_exists(sidecar)) {
     // Of a dataset's other layers than its first, the command names the layer.
     const bool first = s.layer_names.empty() || s.layer_names.front() == s.layer_name;
-    o << "none (loci index " << layer_path
-      << (first ? std::string() : " --layer " + listed(s.layer_name)) << " writes " << sidecar
-      << ")\n";
+    o << "none (loci index " << shell_word(layer_path)
+      << (first ? std::string() : " --layer " + shell_word(s.layer_name)) << " writes "
+      << printable(sidecar) << ")\n";
     return o.str();
   }
   try {
@@ -226,12 +243,12 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
             ? "not this layer's (it indexes layer '" + i.layer_name + "'; give --index)"
         : !fresh ? "stale (" + stale_reason(i.source, now) + ")"
                  : "fresh";
-    o << sidecar << ": " << status << ", "
+    o << printable(sidecar) << ": " << printable(status) << ", "
       << (i.packing == Packing::str ? "packed-str" : "packed-hilbert") << " per "
-      << to_string(i.per) << granularity_reason(i) << ", layer " << i.layer_name << ", " << i.items
-      << " entries, " << i.file_size << " bytes\n";
+      << to_string(i.per) << granularity_reason(i) << ", layer " << printable(i.layer_name) << ", "
+      << i.items << " entries, " << i.file_size << " bytes\n";
   } catch (const Error& e) {
-    o << "unusable: " << e.what() << '\n';
+    o << "unusable: " << printable(e.what()) << '\n';
   }
   return o.str();
 }

@@ -173,22 +173,26 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
 }
 
 // g as GeoJSON can hold it: triangles, TINs and polyhedral surfaces (also as members of a
-// collection) as the polygons of their faces, which GeoJSON has (GDAL's writer would leave the
-// geometry null); null when g is written as it is.
+// collection) as the polygons of their faces, which GeoJSON has, and collections without their
+// empty members (GDAL's writer left such geometries null, or wrote "geometries": null); null
+// when g is written as it is.
 std::unique_ptr<OGRGeometry> geojson_geometry(const OGRGeometry* g) {
   if (!g) return nullptr;
   if (detail::of_faces(g->getGeometryType()))
     return std::unique_ptr<OGRGeometry>(OGRGeometryFactory::forceToMultiPolygon(g->clone()));
-  if (wkbFlatten(g->getGeometryType()) != wkbGeometryCollection) return nullptr;
+  if (!OGR_GT_IsSubClassOf(wkbFlatten(g->getGeometryType()), wkbGeometryCollection)) return nullptr;
   const OGRGeometryCollection& c = *g->toGeometryCollection();
-  bool faces = false;
+  bool changed = false;
   for (const OGRGeometry* m : c)
-    faces |= geojson_geometry(m) != nullptr;
-  if (!faces) return nullptr;
-  auto out = std::make_unique<OGRGeometryCollection>();
+    changed |= m->IsEmpty() || geojson_geometry(m) != nullptr;
+  if (!changed) return nullptr;
+  std::unique_ptr<OGRGeometry> out(OGRGeometryFactory::createGeometry(g->getGeometryType()));
+  if (!out) return nullptr;
   for (const OGRGeometry* m : c) {
-    std::unique_ptr<OGRGeometry> converted = geojson_geometry(m);
-    out->addGeometryDirectly(converted ? converted.release() : m->clone());
+    if (m->IsEmpty()) continue;
+    std::unique_ptr<OGRGeometry> member = geojson_geometry(m);
+    if (!member) member.reset(m->clone());
+    if (out->toGeometryCollection()->addGeometry(member.get()) != OGRERR_NONE) return nullptr;
   }
   return out;
 }
@@ -289,6 +293,7 @@ void write_answers(const AnswerSource& source, std::span<const Answer> answers, 
       OutputFile(std::string(), fallback).commit();  // a full or closed stdout is an error
       return;
     }
+    refuse_replacing_binary_dataset(out_path);  // a dataset's own file: GeoJSON would replace it
     OutputDataset out(out_path);
     write_geojson(source, answers, numbered, with_distance, with_point, out.staging_path());
     out.commit();

@@ -703,4 +703,19 @@ TEST_F(BadInput, NamesWithNewlinesKeepMessagesToOneLine) {
   const CliRun info = run_loci("info " + shell_quote(l));
   ASSERT_EQ(info.status, 0) << info.err;
   EXPECT_NE(info.out.find("fields:    a?b:Integer\n"), std::string::npos) << info.out;
+  // A path with a newline: info's index line, and a command's report of what it wrote.
+  fs::create_directories(path("nl\ndir"));
+  const std::string odd = path("nl\ndir/x.geojson");
+  fs::copy_file(l, odd, fs::copy_options::overwrite_existing);
+  const CliRun in_dir = run_loci("info " + shell_quote(odd));
+  ASSERT_EQ(in_dir.status, 0) << in_dir.err;
+  EXPECT_EQ(lines(in_dir.out).size(), 7u) << in_dir.out;
+  EXPECT_NE(
+      in_dir.out.find("index:     none (loci index '" + path("nl?dir/x.geojson") + "' writes "),
+      std::string::npos)
+      << in_dir.out;
+  const CliRun wrote = run_loci("intersections " + shell_quote(lines_layer()) + " -o " +
+                                shell_quote(path("a\nb.csv")));
+  ASSERT_EQ(wrote.status, 0) << wrote.err;
+  EXPECT_EQ(lines(wrote.err).size(), 1u) << wrote.err;
 }

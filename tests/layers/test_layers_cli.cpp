@@ -1199,11 +1199,16 @@ TEST_F(LayersCli, OutputsRefuseToReplaceAFileHoldingOtherLayers) {
   for (const std::string& target : {one, shp, dbf})
     for (const std::string command :
          {"query " + u + " --bbox 1,1,2,2", "query " + u + " --bbox 1,1,2,2 -f csv",
-          "draw " + u + " -q", "intersections " + u + " -q"})
+          "query " + u + " --bbox 1,1,2,2 -f geojson", "draw " + u + " -q",
+          "intersections " + u + " -q", "join " + u + " " + u + " -q"})
       expect_error(command + " -o " + target, "which this text output would replace");
   EXPECT_EQ(fs::file_size(shp), shp_size);
   EXPECT_EQ(fs::file_size(one), one_size);
   EXPECT_EQ(read_with_ogr(shp).geoms.size(), 1u);
+  // A dBase table is told by its header, not its name: an answer named .dbf is replaced.
+  const std::string named = path("answer.dbf");
+  for (int run = 0; run < 2; ++run)
+    EXPECT_EQ(run_loci("query " + u + " --bbox 1,1,2,2 -f csv -o " + named).status, 0) << run;
   const std::string text = path("answer.geojson");
   for (int run = 0; run < 2; ++run)
     ASSERT_EQ(run_loci("query " + u + " --bbox 1,1,2,2 -f geojson -o " + text).status, 0);
@@ -1256,7 +1261,8 @@ TEST_F(LayersCli, DrawOfASidecarRefusesItsLayerAsTheOutput) {
   ASSERT_EQ(std::system(("ogr2ogr -f GPKG " + layer + " " + u + " -nln drawn").c_str()), 0);
   ASSERT_EQ(run_loci("index -q " + layer).status, 0);
   const auto layer_size = fs::file_size(layer);
-  expect_error("draw " + layer + ".loci -q -o " + layer, "is the input layer");
+  // (A GeoPackage: refused as a dataset a drawing would replace, before the layer is read.)
+  expect_error("draw " + layer + ".loci -q -o " + layer, "refusing to write " + layer + ": it is");
   EXPECT_EQ(fs::file_size(layer), layer_size);
   EXPECT_EQ(read_with_ogr(layer).geoms.size(), 1u);
   const auto sidecar_size = fs::file_size(layer + ".loci");
@@ -1335,6 +1341,15 @@ TEST_F(LayersCli, NullAttributesStayNull) {
   const CliRun c = run_loci("query " + layer + " --bbox 0,0,5,5 -f csv");
   ASSERT_EQ(c.status, 0) << c.err;
   EXPECT_EQ(c.out, "fid,n,m\n0,,x\n1,2,\n");
+  // Collections with empty members are written without them (GDAL wrote a null geometry, or
+  // "geometries": null).
+  const std::string empties = path("empties.csv"), out = path("empties.geojson");
+  std::ofstream(empties) << "id,WKT\n1,\"GEOMETRYCOLLECTION (POINT EMPTY, POINT (1 1))\"\n"
+                            "2,\"MULTIPOINT (EMPTY, (2 2))\"\n";
+  const CliRun e = run_loci("query " + empties + " --bbox 0,0,5,5 -f geojson -o " + out);
+  ASSERT_EQ(e.status, 0) << e.err;
+  EXPECT_EQ(read_text(out).find("null"), std::string::npos) << read_text(out);
+  EXPECT_EQ(read_with_ogr(out).geoms.size(), 2u) << read_text(out);
 }
 
 // A clip keeps Z (interpolated along the cut) and writes no M (GEOS does not carry measures:
