@@ -340,6 +340,9 @@ int run_draw(const Args& a) {
   o.index_path = a.get("--index");
   if (!a.has("--output")) throw UsageError("loci draw needs -o OUT.svg");
   o.out_path = a.get("--output");
+  if (a.has("--levels") && a.has("--cells"))
+    throw UsageError(
+        "loci draw takes --levels (index nodes) or --cells (quadtree cells), not both");
   if (a.has("--levels")) o.max_levels = int(parse_count("--levels", a.get("--levels"), 1, 64));
   if (a.has("--width")) o.width = int(parse_count("--width", a.get("--width"), 16, 100000));
   if (a.has("--cells"))

@@ -8,6 +8,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "gdal_layer.hpp"
@@ -27,13 +28,17 @@ inline bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
+// The world's width fitted to `width` pixels, at any extent (a layer 1e-15 wide fills the
+// drawing as one 1e15 wide does; a floor of 1e-12 once drew small layers in the corner). A side
+// of no extent takes the other's; a scale beyond a double's range is held at its largest.
 inline Frame frame_of(const Box2& world, int width) {
   Frame f;
   f.world = world;
-  const double w = std::max(world.extent(0), 1e-12), h = std::max(world.extent(1), 1e-12);
+  const double w0 = world.extent(0), h0 = world.extent(1);
+  const double w = w0 > 0 ? w0 : (h0 > 0 ? h0 : 1), h = h0 > 0 ? h0 : w;
   f.width = std::max(width, 16);
-  f.scale = f.width / w;
-  f.height = std::max(1, int(std::ceil(h * f.scale)));
+  f.scale = std::min(f.width / w, std::numeric_limits<double>::max());
+  f.height = int(std::clamp(std::ceil(h * f.scale), 1.0, 1e7));
   return f;
 }
 

@@ -144,4 +144,12 @@ TEST_F(LayerCells, DrawCellsWritesEveryLeafOnce) {
     EXPECT_NE(e.err.find("loci: error: --cells"), std::string::npos) << e.err;
     EXPECT_FALSE(fs::exists(bad_out));
   }
+  // --levels is the index's: refused beside --cells (it was ignored).
+  const std::string both_out = (dir_ / "both.svg").string();
+  const CliRun both = run_loci("draw " + path + " --cells 2 --levels 3 -o " + both_out);
+  EXPECT_EQ(both.status, 1);
+  EXPECT_NE(both.err.find("--levels (index nodes) or --cells (quadtree cells), not both"),
+            std::string::npos)
+      << both.err;
+  EXPECT_FALSE(fs::exists(both_out));
 }

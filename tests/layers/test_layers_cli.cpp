@@ -664,6 +664,16 @@ TEST_F(LayersCli, DrawWritesAnSvg) {
       << read_text(dots);
   EXPECT_NE(read_text(dots).find("<path d=\"M54.5 109.1L1145.5 109.1\"/>"), std::string::npos)
       << read_text(dots);
+  // A layer of any size fills the drawing alike (below 1e-12 it was drawn in the corner).
+  for (const char* size : {"1e-12", "1e-15", "1e-200"}) {
+    std::ofstream(points) << R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[)"
+                          << size << "," << size << "]]}}]}";
+    ASSERT_EQ(run_loci("draw " + points + " -q -o " + dots).status, 0);
+    EXPECT_NE(read_text(dots).find("<path d=\"M54.5 1145.5L1145.5 54.5\"/>"), std::string::npos)
+        << size << "\n"
+        << read_text(dots);
+  }
   fs::remove(points);
   fs::remove(dots);
 }
