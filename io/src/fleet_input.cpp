@@ -281,6 +281,7 @@ std::string SkipCounts::summary() const {
     if (!first) s += ", ";
     first = false;
     s += std::to_string(count[i]) + " " + to_string(SkipReason(i));
+    if (SkipReason(i) == SkipReason::duplicate && count[i] > 1) s += 's';
   }
   return s + ")";
 }
@@ -326,6 +327,13 @@ void LocalFrame::to_local(std::span<double> x, std::span<double> y) const {
 }
 
 Point2 LocalFrame::to_lonlat(const Point2& xy) const {
+  // No point of the earth lies farther from another than half a meridian (20,003.93 km): a
+  // position beyond it (a vessel extrapolated far ahead) has no longitude and latitude; the
+  // projection's inverse would wrap it onto the globe somewhere.
+  if (const double r = std::hypot(xy[0], xy[1]); r > 20003931.5)
+    throw Error("a position " + std::to_string(std::llround(std::min(r, 1e18) / 1000)) +
+                " km from the fleet's centre, beyond the far side of the earth, has no longitude "
+                "and latitude (a time too far from the reports?)");
   double x = xy[0], y = xy[1];
   if (!impl_->inverse->Transform(1, &x, &y) || !std::isfinite(x) || !std::isfinite(y))
     throw Error("cannot unproject " + std::to_string(xy[0]) + "," + std::to_string(xy[1]));
@@ -410,7 +418,17 @@ bool digits(std::string_view s, std::size_t at, std::size_t n, int& v) {
 
 std::optional<double> parse_utc(std::string_view s) {
   s = trimmed(s);
-  if (!s.empty() && (s.back() == 'Z' || s.back() == 'z')) s.remove_suffix(1);
+  // A UTC date, marked Z or not, or a local one with its offset from UTC (+01:00, -05:00).
+  int offset = 0;
+  if (!s.empty() && (s.back() == 'Z' || s.back() == 'z')) {
+    s.remove_suffix(1);
+  } else if (int oh, om; s.size() >= 25 && (s[s.size() - 6] == '+' || s[s.size() - 6] == '-') &&
+                         digits(s, s.size() - 5, 2, oh) && s[s.size() - 3] == ':' &&
+                         digits(s, s.size() - 2, 2, om)) {
+    if (oh > 23 || om > 59) return std::nullopt;
+    offset = (s[s.size() - 6] == '+' ? 1 : -1) * (oh * 3600 + om * 60);
+    s.remove_suffix(6);
+  }
   int y, mo, d, h, mi, se;
   if (s.size() < 19 || !digits(s, 0, 4, y) || s[4] != '-' || !digits(s, 5, 2, mo) || s[7] != '-' ||
       !digits(s, 8, 2, d) || (s[10] != 'T' && s[10] != ' ') || !digits(s, 11, 2, h) ||
@@ -428,7 +446,8 @@ std::optional<double> parse_utc(std::string_view s) {
     if (!f) return std::nullopt;
     frac = *f;
   }
-  return double(days_from_civil(y, unsigned(mo), unsigned(d)) * 86400 + h * 3600 + mi * 60 + se) +
+  return double(days_from_civil(y, unsigned(mo), unsigned(d)) * 86400 + h * 3600 + mi * 60 + se -
+                offset) +
          frac;
 }
 

@@ -81,7 +81,7 @@ TEST(FleetCsv, DuplicateReportsAreSkippedAndCountedTheLastKept) {
   EXPECT_EQ(d.reports[0].m.p, (Point2{8, 8}));
   EXPECT_EQ(d.skipped[SkipReason::duplicate], 2u);
   EXPECT_EQ(d.rows, 3u);
-  EXPECT_EQ(d.summary(), "read 1 report of 1 object; skipped 2 (2 duplicate)");
+  EXPECT_EQ(d.summary(), "read 1 report of 1 object; skipped 2 (2 duplicates)");
 }
 
 TEST(FleetCsv, MalformedInputIsOneLineErrorNamingFileAndLine) {
@@ -254,6 +254,11 @@ TEST(FleetAis, FrameRoundTripTrueDistancesAndCourses) {
     }
   const Point2 n = f.north(13.0, 58.0);
   EXPECT_LT(n[0], -0.01);  // east of the centre, north leans west in the frame
+  // Beyond half a meridian from the centre a position has no lon/lat (it was wrapped onto the
+  // globe: a vessel 80,000 km from a point was shown at that point).
+  EXPECT_THROW(f.to_lonlat({80040379, 0}), Error);
+  EXPECT_THROW(f.to_lonlat({0, -2.1e7}), Error);
+  EXPECT_NO_THROW(f.to_lonlat({0, 1.9e7}));
 }
 
 TEST(FleetTime, UtcDatesReadAndWritten) {
@@ -261,6 +266,11 @@ TEST(FleetTime, UtcDatesReadAndWritten) {
   EXPECT_EQ(parse_utc("2023-01-01 00:00:07Z"), 1672531207.0);
   EXPECT_EQ(parse_utc("2024-02-29T12:00:00.5"), 1709208000.5);
   EXPECT_EQ(parse_utc("1970-01-01T00:00:00"), 0.0);
+  // A local time with its offset from UTC (such dates were skipped as bad).
+  EXPECT_EQ(parse_utc("2023-01-01T01:00:07+01:00"), 1672531207.0);
+  EXPECT_EQ(parse_utc("2022-12-31T19:00:07.25-05:00"), 1672531207.25);
+  EXPECT_FALSE(parse_utc("2023-01-01T00:00:00+24:00"));
+  EXPECT_FALSE(parse_utc("2023-01-01T00:00:00+01:00Z"));
   for (const char* bad : {"2023-02-29T00:00:00", "2023-13-01T00:00:00", "2023-01-01T24:00:00",
                           "2023-01-01", "2023-01-01T00:00:0x", "2023-01-01T00:00:00.", ""})
     EXPECT_FALSE(parse_utc(bad)) << bad;
