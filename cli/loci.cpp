@@ -31,15 +31,6 @@
 
 namespace {
 
-// A message as one line: control characters (a newline in a file or layer name, an escape
-// sequence meant for the terminal) shown as '?'.
-std::string printable(std::string_view text) {
-  std::string out;
-  for (unsigned char ch : text)
-    out += ch < 0x20 || ch == 0x7f ? '?' : char(ch);
-  return out;
-}
-
 using namespace loci;
 using namespace loci::io;
 

@@ -24,15 +24,19 @@
 #include "loci/io/sidecar.hpp"
 
 namespace loci::io {
+
+std::string printable(std::string_view text) {
+  std::string out(text);
+  for (char& c : out)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return out;
+}
+
 namespace {
 
-// The text as a message may quote it: at most 60 characters, control characters (a NUL, an
-// escape sequence meant for the terminal) shown as '?'.
+// The text as a message may quote it: at most 60 characters, printable.
 std::string quoted(const std::string& text) {
-  std::string out;
-  for (unsigned char c : text.substr(0, 60))
-    out += c < 0x20 || c == 0x7f ? '?' : char(c);
-  return "'" + out + (text.size() > 60 ? "...'" : "'");
+  return "'" + printable(text.substr(0, 60)) + (text.size() > 60 ? "...'" : "'");
 }
 
 // "A,B,..." as n finite numbers; spaces around each are allowed. std::from_chars reads the
@@ -164,22 +168,13 @@ namespace {
 // doubled) when it holds a space, a colon, a comma or a quote, or is empty; control characters
 // (a newline) as '?', so that the summary keeps one line per item.
 std::string listed(const std::string& name) {
-  std::string shown;
-  for (const unsigned char c : name)
-    shown += c < 0x20 || c == 0x7f ? '?' : char(c);
+  const std::string shown = printable(name);
   if (!shown.empty() && shown.find_first_of(" :,'\"") == std::string::npos) return shown;
   std::string q = "'";
   for (const char c : shown)
     q += c == '\'' ? std::string("''") : std::string(1, c);
   return q + "'";
 }
-// Control characters as '?': a name shown on a line of its own keeps it.
-std::string printable(std::string text) {
-  for (char& c : text)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  return text;
-}
-
 // A word as a shell reads it back: as it is when it holds only characters the shell takes
 // literally, else in single quotes (a quote as '\'').
 std::string shell_word(const std::string& word) {

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "loci/geom/error.hpp"
+#include "loci/io/commands.hpp"
 #include "loci/io/fleet.hpp"
 
 namespace loci::io {
@@ -22,12 +23,9 @@ namespace {
 
 constexpr double kKnot = 1852.0 / 3600.0;  // metres per second
 
-// The text as a message may quote it: at most 40 characters, control characters as '?'.
+// The text as a message may quote it: at most 40 characters, printable.
 std::string quoted(std::string_view text) {
-  std::string out;
-  for (unsigned char c : text.substr(0, 40))
-    out += c < 0x20 || c == 0x7f ? '?' : char(c);
-  return "'" + out + (text.size() > 40 ? "...'" : "'");
+  return "'" + printable(text.substr(0, 40)) + (text.size() > 40 ? "...'" : "'");
 }
 
 // RFC 4180 records, one at a time. A record's fields are views into the text, or into

@@ -181,18 +181,22 @@ std::unique_ptr<OGRGeometry> geojson_geometry(const OGRGeometry* g) {
   if (detail::of_faces(g->getGeometryType()))
     return std::unique_ptr<OGRGeometry>(OGRGeometryFactory::forceToMultiPolygon(g->clone()));
   if (!OGR_GT_IsSubClassOf(wkbFlatten(g->getGeometryType()), wkbGeometryCollection)) return nullptr;
+  // Each member converted once; the collection rebuilt only when one was, or is empty.
   const OGRGeometryCollection& c = *g->toGeometryCollection();
+  std::vector<std::unique_ptr<OGRGeometry>> members;
   bool changed = false;
-  for (const OGRGeometry* m : c)
-    changed |= m->IsEmpty() || geojson_geometry(m) != nullptr;
+  for (const OGRGeometry* m : c) {
+    members.push_back(m->IsEmpty() ? nullptr : geojson_geometry(m));
+    changed |= m->IsEmpty() || members.back();
+  }
   if (!changed) return nullptr;
   std::unique_ptr<OGRGeometry> out(OGRGeometryFactory::createGeometry(g->getGeometryType()));
   if (!out) return nullptr;
-  for (const OGRGeometry* m : c) {
+  for (int i = 0; i < c.getNumGeometries(); ++i) {
+    const OGRGeometry* m = c.getGeometryRef(i);
     if (m->IsEmpty()) continue;
-    std::unique_ptr<OGRGeometry> member = geojson_geometry(m);
-    if (!member) member.reset(m->clone());
-    if (out->toGeometryCollection()->addGeometry(member.get()) != OGRERR_NONE) return nullptr;
+    const OGRGeometry* member = members[std::size_t(i)] ? members[std::size_t(i)].get() : m;
+    if (out->toGeometryCollection()->addGeometry(member) != OGRERR_NONE) return nullptr;
   }
   return out;
 }

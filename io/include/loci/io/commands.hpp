@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "loci/io/layer_query.hpp"
@@ -41,6 +42,10 @@ Query parse_within(const std::string& text);
 // Throws Error naming the file and line of a bad line.
 std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& path,
                                                            Query::Kind kind, std::size_t k);
+
+// Text as a message or a summary line shows it: control characters (a newline in a file or
+// layer name, an escape sequence meant for the terminal) as '?', so that it keeps to one line.
+std::string printable(std::string_view text);
 
 std::string describe_layer(const std::string& layer_path, const std::string& layer_name,
                            const Progress& progress = {});
