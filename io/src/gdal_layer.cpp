@@ -10,8 +10,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <memory>
+#include <span>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -328,6 +330,7 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
   if (linear) g = linear.get();
   add_points(g, out, what);
   std::uint32_t polygons = 0;
+  std::uint32_t last_polygon = std::numeric_limits<std::uint32_t>::max();
   walk(g, polygons, [&](const OGRSimpleCurve& c, bool ring, std::uint32_t polygon) {
     const int n = c.getNumPoints();
     if (n == 0) return;
@@ -339,9 +342,59 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
     }
     out.parts.push_back(
         {at, std::uint32_t(out.points.size()), ring ? PartKind::ring : PartKind::line, polygon});
+    if (ring) {
+      // A polygon's first ring is its outer ring, the others its holes.
+      out.parts.back().winding =
+          std::int8_t(ring_winding(std::span(out.points).subspan(at), polygon != last_polygon));
+      last_polygon = polygon;
+    }
   });
   out.polygons = polygons;
   return out;
+}
+
+void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& path,
+                  LayerItems& out) {
+  std::int32_t part = 0;
+  std::uint32_t last_polygon = std::numeric_limits<std::uint32_t>::max();
+  std::vector<Point2> points;
+  for_each_curve(g, [&](const OGRSimpleCurve& c, bool ring, std::uint32_t polygon) {
+    const int n = c.getNumPoints();
+    points.resize(std::size_t(n));
+    for (int i = 0; i < n; ++i) {
+      points[std::size_t(i)] = {c.getX(i), c.getY(i)};
+      if (!within_coordinate_range(points[std::size_t(i)]))
+        check_layer_point(points[std::size_t(i)], where(path, fid));
+    }
+    // A ring's segments keep the direction its role winds it in (exact.hpp); a polygon's
+    // first ring is its outer ring, the others its holes.
+    int winding = 1;
+    if (ring && n > 0) {
+      winding = ring_winding(points, polygon != last_polygon);
+      last_polygon = polygon;
+    }
+    // A curve of one point is that point: a segment of length zero, so that a per-segment
+    // index answers for it as the feature's own geometry does.
+    for (int i = 0; i + 1 < n || (i == 0 && n == 1); ++i) {
+      const Point2& a = points[std::size_t(i)];
+      const Point2& b = points[std::size_t(std::min(i + 1, n - 1))];
+      // The box keeps the segment when we also know which diagonal of it the segment is.
+      out.boxes.push_back(Segment2{a, b}.box());
+      out.records.push_back({fid, part, segment_flags(a, b, ring, winding)});
+    }
+    ++part;
+  });
+  // Isolated points have no linework; they are kept as zero-length segments so that a
+  // per-segment index still answers for them.
+  const auto t = wkbFlatten(g->getGeometryType());
+  if (t == wkbPoint || t == wkbMultiPoint || t == wkbGeometryCollection) {
+    const FlatGeometry flat = flatten(g, where(path, fid));
+    for (const Part& p : flat.parts) {
+      if (p.kind != PartKind::point) continue;
+      out.boxes.push_back(Box2::of_point(flat.points[p.begin]));
+      out.records.push_back({fid, part++, 0u});
+    }
+  }
 }
 
 GDALDriver* driver_for(const std::string& path) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "loci/io/exact.hpp"
+#include "loci/io/layer_reader.hpp"
 
 namespace loci::io::detail {
 
@@ -93,6 +94,12 @@ void for_each_curve(const OGRGeometry* g,
 
 // Throws InvalidGeometry (naming `what`) on a NaN or infinite coordinate.
 FlatGeometry flatten(const OGRGeometry* g, const std::string& what);
+
+// The segments of g for a per-segment index, appended to `out` (what read_items gives per
+// segment): each line or ring's consecutive points, parts numbered in order, a ring's
+// segments wound as its role gives it (exact.hpp); a curve of one point and each isolated
+// point as a segment of length zero. Refuses a coordinate out of range.
+void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& path, LayerItems& out);
 
 // A triangle, TIN or polyhedral surface: a surface made of polygon faces, read as those faces.
 inline bool of_faces(OGRwkbGeometryType type) {

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <limits>
 #include <map>
 #include <memory>
+#include <vector>
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
@@ -94,39 +96,6 @@ void check_curves(const OGRGeometry* g, const std::string& path, std::int64_t fi
   });
 }
 
-void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& path,
-                  LayerItems& out) {
-  std::int32_t part = 0;
-  detail::for_each_curve(g, [&](const OGRSimpleCurve& c, bool ring, std::uint32_t) {
-    const int n = c.getNumPoints();
-    // A curve of one point is that point: a segment of length zero, so that a per-segment
-    // index answers for it as the feature's own geometry does.
-    for (int i = 0; i + 1 < n || (i == 0 && n == 1); ++i) {
-      const int j = std::min(i + 1, n - 1);
-      const Point2 a{c.getX(i), c.getY(i)}, b{c.getX(j), c.getY(j)};
-      if (!within_coordinate_range(a) || !within_coordinate_range(b)) {
-        detail::check_layer_point(a, where(path, fid));
-        detail::check_layer_point(b, where(path, fid));
-      }
-      // The box keeps the segment when we also know which diagonal of it the segment is.
-      out.boxes.push_back(Segment2{a, b}.box());
-      out.records.push_back({fid, part, segment_flags(a, b, ring)});
-    }
-    ++part;
-  });
-  // Isolated points have no linework; they are kept as zero-length segments so that a
-  // per-segment index still answers for them.
-  const auto t = wkbFlatten(g->getGeometryType());
-  if (t == wkbPoint || t == wkbMultiPoint || t == wkbGeometryCollection) {
-    const FlatGeometry flat = detail::flatten(g, where(path, fid));
-    for (const Part& p : flat.parts) {
-      if (p.kind != PartKind::point) continue;
-      out.boxes.push_back(Box2::of_point(flat.points[p.begin]));
-      out.records.push_back({fid, part++, 0u});
-    }
-  }
-}
-
 }  // namespace
 
 namespace {
@@ -173,7 +142,7 @@ void read_layer_items(const std::string& path, const std::string& layer, const P
       by_feature->boxes.push_back(box);
       by_feature->records.push_back({fid, 0, 0u});
     }
-    if (by_segment) add_segments(g, fid, path, *by_segment);
+    if (by_segment) detail::add_segments(g, fid, path, *by_segment);
   }
   read_check.finish();
 }

@@ -18,6 +18,7 @@
 #include <cstring>
 #include <map>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 #include <cpl_conv.h>
@@ -423,7 +424,12 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
       continue;
     }
     ++items.features;
-    add(r, fid, record + 8, file_type);
+    // An `add` that answers false gives the layer to GDAL.
+    if constexpr (std::is_same_v<decltype(add(r, fid, record + 8, file_type)), bool>) {
+      if (!add(r, fid, record + 8, file_type)) return false;
+    } else {
+      add(r, fid, record + 8, file_type);
+    }
   }
   items.layer_name = ol.layer->GetName();
   items.has_polygons = is_polygon_type(file_type) && items.features > 0;
@@ -457,11 +463,15 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
   return true;
 }
 
+bool ring_roles(const unsigned char* c, std::vector<std::uint8_t>& outer);
+
 // A record's segments, as a per-segment read through GDAL gives them: each line or ring's
 // consecutive points (parts numbered in file order), each point of a point or multipoint
-// shape, and a part of one point, as a zero-length segment. The record was read and checked by
-// read_record.
-void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::int64_t fid,
+// shape, and a part of one point, as a zero-length segment; a ring's segments wound as its
+// role gives it. The record was read and checked by read_record. False, with nothing added,
+// for a polygon record whose rings only GDAL sorts (ring_roles).
+
+bool add_record_segments(const unsigned char* c, std::uint32_t file_type, std::int64_t fid,
                          LayerItems& out) {
   const auto point = [](const unsigned char* xy) {
     return Point2{le_double(xy), le_double(xy + 8)};
@@ -481,20 +491,29 @@ void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
     case Kind::polyline_or_polygon: {
       const std::uint32_t parts = le32(c + 36), n = le32(c + 40);
       const bool ring = is_polygon_type(file_type);
+      // Each ring's role as the driver sorts the rings (one ring is its polygon's outer
+      // ring), for the way it is wound (exact.hpp).
+      static thread_local std::vector<std::uint8_t> outer;
+      static thread_local std::vector<Point2> points;
+      outer.assign(parts, 1);
+      if (ring && parts > 1 && !ring_roles(c, outer)) return false;
       const unsigned char* xy = c + 44 + 4 * std::uint64_t(parts);
       for (std::uint32_t k = 0; k < parts; ++k) {
         const std::uint32_t begin = le32(c + 44 + 4 * std::uint64_t(k)),
                             end = k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n;
-        Point2 a = point(xy + 16 * std::uint64_t(begin));
-        if (end - begin == 1) {  // a part of one point is that point
-          out.boxes.push_back(Box2::of_point(a));
-          out.records.push_back({fid, std::int32_t(k), segment_flags(a, a, ring)});
+        points.clear();
+        for (std::uint32_t i = begin; i < end; ++i)
+          points.push_back(point(xy + 16 * std::uint64_t(i)));
+        const int winding = ring ? ring_winding(points, outer[k] != 0) : 1;
+        if (points.size() == 1) {  // a part of one point is that point
+          out.boxes.push_back(Box2::of_point(points[0]));
+          out.records.push_back({fid, std::int32_t(k), segment_flags(points[0], points[0], ring)});
         }
-        for (std::uint32_t i = begin + 1; i < end; ++i) {
-          const Point2 b = point(xy + 16 * std::uint64_t(i));
+        for (std::size_t i = 1; i < points.size(); ++i) {
+          const Point2& a = points[i - 1];
+          const Point2& b = points[i];
           out.boxes.push_back(Segment2{a, b}.box());
-          out.records.push_back({fid, std::int32_t(k), segment_flags(a, b, ring)});
-          a = b;
+          out.records.push_back({fid, std::int32_t(k), segment_flags(a, b, ring, winding)});
         }
       }
       break;
@@ -502,6 +521,7 @@ void add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
     case Kind::other:
       break;
   }
+  return true;
 }
 
 // The rings of a polygon record (read and checked by read_record): ring k runs over points
@@ -619,8 +639,21 @@ const char* polygon_type(const unsigned char* c) {
   return "Polygon";
 }
 
-// The geometry GDAL's shapefile driver makes of a 2D polygon record of several rings (read
-// and checked by read_record), built without its all-against-all sorting of rings. The
+// Ring k of r as an OGR ring, made the first time it is asked for.
+OGRLinearRing& ogr_ring(const PolygonRings& r, std::vector<std::unique_ptr<OGRLinearRing>>& rings,
+                        std::uint32_t k) {
+  if (!rings[k]) {
+    const auto [begin, end] = r.range(k);
+    rings[k] = std::make_unique<OGRLinearRing>();
+    rings[k]->setNumPoints(int(end - begin), FALSE);
+    for (std::uint32_t i = begin; i < end; ++i)
+      rings[k]->setPoint(int(i - begin), r.x(i), r.y(i));
+  }
+  return *rings[k];
+}
+
+// The polygons GDAL's shapefile driver makes of a 2D polygon record of several rings (read
+// and checked by read_record), sorted without its all-against-all tests of rings. The
 // driver sorts with organizePolygons' ONLY_CCW method: clockwise rings are outer rings, each
 // counter-clockwise ring (a hole) goes to the smallest (by GDAL's area) clockwise ring of
 // larger area whose envelope holds the hole's and which holds the hole's first point (when
@@ -628,35 +661,33 @@ const char* polygon_type(const unsigned char* c) {
 // polygons keep the order of their outer rings, the holes their order in the record. Here
 // the candidates come from a packed R-tree of the outer rings' envelopes and are tested as
 // GDAL tests them, so a record of thousands of islands and lakes no longer costs holes times
-// rings. nullptr, for GDAL to build it, whenever the record is
+// rings. Nothing, for GDAL to sort them, whenever the record is
 // not plain: a ring orientation cannot place, no outer ring, a tie in area, a hole not
 // starting strictly inside the one outer ring (GDAL versions differ there; GDAL needs no
 // sorting then). As in GDAL, the largest ring of all, when clockwise, holds every hole inside
 // its envelope that no smaller outer ring holds, and a counter-clockwise ring no outer ring
 // holds is a polygon of its own.
-std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
-  const PolygonRings r(c);
+struct Organized {
+  std::vector<std::uint32_t> owner;  // per ring: a hole's outer ring, kNone for others
+  std::vector<std::uint32_t> top;    // the rings that start a polygon, in any order
+  std::vector<std::unique_ptr<OGRLinearRing>> rings;  // as OGR rings: those made to test
+};
+
+std::optional<Organized> organize(const PolygonRings& r) {
   std::vector<std::uint32_t> outers;
   std::vector<std::uint8_t> cw(r.parts);
   for (std::uint32_t k = 0; k < r.parts; ++k) {
     const int o = r.clockwise(k);
-    if (o < 0) return nullptr;
+    if (o < 0) return std::nullopt;
     cw[k] = std::uint8_t(o);
     if (o) outers.push_back(k);
   }
-  if (outers.empty() || r.parts < 2) return nullptr;
+  if (outers.empty() || r.parts < 2) return std::nullopt;
   // The rings as OGR rings, made once: tested below, then handed to the polygons.
-  std::vector<std::unique_ptr<OGRLinearRing>> rings(r.parts);
-  const auto ring = [&](std::uint32_t k) -> OGRLinearRing& {
-    if (!rings[k]) {
-      const auto [begin, end] = r.range(k);
-      rings[k] = std::make_unique<OGRLinearRing>();
-      rings[k]->setNumPoints(int(end - begin), FALSE);
-      for (std::uint32_t i = begin; i < end; ++i)
-        rings[k]->setPoint(int(i - begin), r.x(i), r.y(i));
-    }
-    return *rings[k];
-  };
+  Organized out;
+  std::vector<std::unique_ptr<OGRLinearRing>>& rings = out.rings;
+  rings.resize(r.parts);
+  const auto ring = [&](std::uint32_t k) -> OGRLinearRing& { return ogr_ring(r, rings, k); };
   // Where p lies in an outer ring, decided by GDAL's own predicates on the ring (its boundary
   // test, then its crossing test), so that a point on or within rounding of an edge goes where
   // GDAL puts it; each costs a pass over the ring, as in GDAL, but only the candidates GDAL
@@ -691,14 +722,16 @@ std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
     }
     return Location::outside;
   };
-  std::vector<std::uint32_t> owner(r.parts, kNone);  // the outer ring of each hole
-  std::vector<std::uint32_t> top = outers;           // the rings that start a polygon
+  std::vector<std::uint32_t>& owner = out.owner;  // the outer ring of each hole
+  std::vector<std::uint32_t>& top = out.top;      // the rings that start a polygon
+  owner.assign(r.parts, kNone);
+  top = outers;
   if (outers.size() == 1) {
     // GDAL makes every other ring a hole of the one outer ring (later versions test them):
     // taken here when each starts inside it, where all versions agree.
     for (std::uint32_t k = 0; k < r.parts; ++k) {
       if (k == outers[0]) continue;
-      if (at(outers[0], r.point(r.range(k).first)) != Location::inside) return nullptr;
+      if (at(outers[0], r.point(r.range(k).first)) != Location::inside) return std::nullopt;
       owner[k] = outers[0];
     }
   } else {
@@ -711,7 +744,7 @@ std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
       if (area[k] > area[largest]) largest = k;
     }
     for (std::uint32_t k = 0; k < r.parts; ++k)
-      if (k != largest && area[k] == area[largest]) return nullptr;  // GDAL's order unknown
+      if (k != largest && area[k] == area[largest]) return std::nullopt;  // GDAL's order unknown
     std::vector<Box2> outer_boxes;
     outer_boxes.reserve(outers.size());
     for (const std::uint32_t k : outers)
@@ -731,12 +764,12 @@ std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
             return true;
           },
           Relation::contains);
-      if (tie) return nullptr;
+      if (tie) return std::nullopt;
       std::sort(candidates.begin(), candidates.end(),
                 [&](std::uint32_t a, std::uint32_t b) { return area[a] < area[b]; });
       for (std::size_t j = 0; j < candidates.size() && owner[k] == kNone; ++j) {
         const std::uint32_t o = candidates[j];
-        if (j + 1 < candidates.size() && area[candidates[j + 1]] == area[o]) return nullptr;
+        if (j + 1 < candidates.size() && area[candidates[j + 1]] == area[o]) return std::nullopt;
         // GDAL takes the largest ring of all on its envelope alone.
         if (o == largest || locate(o, k) == Location::inside) owner[k] = o;
       }
@@ -744,6 +777,42 @@ std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
       if (owner[k] == kNone) top.push_back(k);
     }
   }
+  return out;
+}
+
+// The role of each ring of a polygon record of several rings as the driver sorts them: its
+// clockwise rings are outer rings (1), its counterclockwise ones holes (0) of the outer ring
+// holding them, or outer rings of polygons of their own where none does. False, for GDAL to
+// read the record, when organize() leaves the sorting to GDAL, unless every ring runs
+// clockwise.
+bool ring_roles(const unsigned char* c, std::vector<std::uint8_t>& outer) {
+  const PolygonRings r(c);
+  outer.assign(r.parts, 1);
+  bool holes = false;
+  for (std::uint32_t k = 0; k < r.parts && !holes; ++k)
+    holes = r.clockwise(k) != 1;
+  if (!holes) return true;
+  if (const char* type = polygon_type(c); type && std::strcmp(type, "Polygon") == 0) {
+    for (std::uint32_t k = 0; k < r.parts; ++k)  // one outer ring holding all the others
+      outer[k] = r.clockwise(k) == 1;
+    return true;
+  }
+  const auto organized = organize(r);
+  if (!organized) return false;
+  for (std::uint32_t k = 0; k < r.parts; ++k)
+    outer[k] = organized->owner[k] == kNone;
+  return true;
+}
+
+// The geometry of organize()'s polygons.
+std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
+  const PolygonRings r(c);
+  auto organized = organize(r);
+  if (!organized) return nullptr;
+  const std::vector<std::uint32_t>& owner = organized->owner;
+  std::vector<std::uint32_t>& top = organized->top;
+  std::vector<std::unique_ptr<OGRLinearRing>>& rings = organized->rings;
+  const auto ring = [&](std::uint32_t k) { ogr_ring(r, rings, k); };
   // Each outer ring's holes, in the record's order: a list threaded through `next`.
   std::vector<std::uint32_t> head(r.parts, kNone), tail(r.parts, kNone), next(r.parts, kNone);
   for (std::uint32_t k = 0; k < r.parts; ++k) {
@@ -843,8 +912,11 @@ std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
 
 std::optional<LayerItems> read_shapefile_segments(const std::string& path, const std::string& layer,
                                                   const Progress& progress) {
+  // A user's OGR_ORGANIZE_POLYGONS changes how GDAL sorts rings: then GDAL answers.
+  if (CPLGetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr)) return std::nullopt;
   LayerItems items;
   items.per = Per::segment;
+  std::optional<detail::OpenLayer> gdal;
   const bool read = scan_shapefile(
       path, layer, progress, items,
       [&](std::uint32_t file_type, std::uint64_t, std::uint64_t shp_bytes) {
@@ -856,7 +928,13 @@ std::optional<LayerItems> read_shapefile_segments(const std::string& path, const
         items.records.reserve(bound);
       },
       [&](const RecordRead&, std::int64_t fid, const unsigned char* c, std::uint32_t file_type) {
-        add_record_segments(c, file_type, fid, items);
+        if (add_record_segments(c, file_type, fid, items)) return true;
+        // Rings only GDAL sorts: that record's segments from GDAL's geometry.
+        if (!gdal) gdal = detail::open_layer(path, layer);
+        const OGRFeatureUniquePtr f(gdal->layer->GetFeature(fid));
+        if (!f || !f->GetGeometryRef()) return false;
+        detail::add_segments(f->GetGeometryRef(), fid, path, items);
+        return true;
       });
   if (!read) return std::nullopt;
   return items;

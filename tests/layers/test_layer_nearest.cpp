@@ -400,11 +400,17 @@ TEST(LayerNearest, OneQueryReadsAFewChunksOfTheStoredHierarchies) {
 }
 
 // Polygons per segment: features of one to three rings (star-shaped, vertices on an integer
-// grid so that rays from grid points run through vertices and along edges; a ring inside
-// another of the same feature is a hole by the even-odd rule), overlapping each other.
+// grid so that rays from grid points run through vertices and along edges; the second ring a
+// hole in the first, the third another polygon, which may overlap the first), overlapping each
+// other; rings run either way, their records carrying the way their role winds them.
 struct Polygons {
   LayerItems items;
-  std::vector<std::pair<std::int64_t, Segment2>> rings;  // (fid, segment)
+  struct Edge {
+    std::int64_t fid;
+    int polygon;  // of the feature
+    Segment2 s;
+  };
+  std::vector<Edge> rings;
 };
 
 Polygons star_polygons(int features, std::uint64_t seed) {
@@ -430,12 +436,14 @@ Polygons star_polygons(int features, std::uint64_t seed) {
         ring.push_back({double(ox + int(std::lround(len * std::cos(a)))),
                         double(oy + int(std::lround(len * std::sin(a))))});
       }
+      if ((f + r) % 2) std::reverse(ring.begin(), ring.end());
+      const int winding = ring_winding(ring, r != 1);
       for (int i = 0; i < n; ++i) {
         const Point2 a = ring[i], b = ring[(i + 1) % n];
         const Segment2 s{a, b};
         l.items.boxes.push_back(s.box());
-        l.items.records.push_back({fid, 0, segment_flags(a, b, true)});
-        l.rings.emplace_back(fid, s);
+        l.items.records.push_back({fid, 0, segment_flags(a, b, true, winding)});
+        l.rings.push_back({fid, r == 2 ? 1 : 0, s});
       }
     }
   }
@@ -470,12 +478,12 @@ void check_polygons(const LayerIndex& index, const Polygons& l) {
     const Point2 p = i % 3 == 2 ? Point2{any(rng), any(rng)}
                                 : Point2{grid(rng) / 2.0, grid(rng) / 2.0 + (i % 3) * 0.25};
     std::map<std::int64_t, double> best;
-    std::map<std::int64_t, bool> odd;
-    for (const auto& [fid, s] : l.rings) {
+    std::map<std::pair<std::int64_t, int>, bool> odd;  // per polygon of each feature
+    for (const auto& [fid, polygon, s] : l.rings) {
       const double d = std::sqrt(squared_distance(p, s));
       const auto [it, fresh] = best.try_emplace(fid, d);
       if (!fresh) it->second = std::min(it->second, d);
-      odd[fid] ^= ray_crosses(s.a, s.b, p);
+      odd[{fid, polygon}] ^= ray_crosses(s.a, s.b, p);
     }
     bool on_a_ring = false;
     for (const auto& [fid, d] : best)
@@ -483,7 +491,7 @@ void check_polygons(const LayerIndex& index, const Polygons& l) {
     if (on_a_ring) continue;  // on a ring a point may or may not count: distance 0 either way
     std::vector<std::int64_t> expected;
     for (auto& [fid, d] : best)
-      if (odd[fid]) {
+      if (odd[{fid, 0}] || odd[{fid, 1}]) {
         expected.push_back(fid);
         d = 0;
       }
@@ -566,15 +574,15 @@ TEST(LayerNearest, CandidatesRankFeaturesByTheirBoxes) {
     for (int i = 0; i < 400; ++i) {
       const Point2 p{any(rng), any(rng)};
       std::map<std::int64_t, double> best;
-      std::map<std::int64_t, bool> odd;
-      for (const auto& [fid, seg] : l.rings) {
+      std::map<std::pair<std::int64_t, int>, bool> odd;  // per polygon of each feature
+      for (const auto& [fid, polygon, seg] : l.rings) {
         const double d = std::sqrt(squared_distance(p, seg.box()));
         const auto [it, fresh] = best.try_emplace(fid, d);
         if (!fresh) it->second = std::min(it->second, d);
-        odd[fid] ^= ray_crosses(seg.a, seg.b, p);
+        odd[{fid, polygon}] ^= ray_crosses(seg.a, seg.b, p);
       }
       for (auto& [fid, d] : best)
-        if (odd[fid]) d = 0, ++inside;
+        if (odd[{fid, 0}] || odd[{fid, 1}]) d = 0, ++inside;
       std::vector<double> distances;
       for (const auto& [fid, d] : best)
         distances.push_back(d);
@@ -638,7 +646,7 @@ TEST(LayerNearest, CandidatesPerSegmentHoldTheExactAnswer) {
             : q.kind == Query::Kind::point ? Box2::of_point(p)
                                            : q.box;
         bool met = false;
-        for (const auto& [fid, seg] : l.rings)
+        for (const auto& [fid, polygon, seg] : l.rings)
           met |= fid == a.fid && intersects(seg.box(), reach);
         without_boxes += !met;
       }

@@ -1336,6 +1336,73 @@ TEST_F(LayersCli, TrianglesTinsAndPolyhedralSurfacesAreSurfaces) {
   EXPECT_DOUBLE_EQ(area, 50 + 100 + 50);
 }
 
+// Polygons of one feature that overlap hold their overlap, whichever way their rings run
+// (it counted as outside, by the even-odd rule over all of a feature's rings): a collection
+// of two squares, an invalid multi-polygon of a square over a square with a hole, a 3D box's
+// floor and roof, a TIN's overlapping faces; and a hole running the same way as its outer
+// ring is still a hole. Per feature and per segment, in a GeoPackage and, for the
+// multi-polygons, a shapefile (rings read from the file as they run).
+TEST_F(LayersCli, OverlappingPolygonsOfOneFeatureHoldTheirOverlap) {
+  const std::string csv = path("overlaps.csv"), gpkg = path("overlaps.gpkg");
+  std::ofstream(csv)
+      << "id,WKT\n"
+         "1,\"GEOMETRYCOLLECTION (POLYGON ((0 0, 10 0, 10 10, 0 10, 0 0)), "
+         "POLYGON ((5 5, 5 15, 15 15, 15 5, 5 5)))\"\n"
+         "2,\"MULTIPOLYGON (((20 0, 30 0, 30 10, 20 10, 20 0)), ((22 2, 22 12, 32 12, 32 2, 22 2), "
+         "(24 4, 24 6, 26 6, 26 4, 24 4)))\"\n"
+         "3,\"POLYGON ((40 0, 50 0, 50 10, 40 10, 40 0), (42 2, 48 2, 48 8, 42 8, 42 2))\"\n"
+         "4,\"POLYHEDRALSURFACE Z (((60 0 0, 60 10 0, 70 10 0, 70 0 0, 60 0 0)), "
+         "((60 0 5, 70 0 5, 70 10 5, 60 10 5, 60 0 5)), ((60 0 0, 70 0 0, 70 0 5, 60 0 5, 60 0 "
+         "0)))\"\n"
+         "5,\"TIN (((80 0, 90 0, 80 10, 80 0)), ((80 0, 90 10, 80 10, 80 0)))\"\n";
+  fs::remove(gpkg);
+  ASSERT_EQ(std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + csv +
+                         " -nln overlaps -oo GEOM_POSSIBLE_NAMES=WKT -oo KEEP_GEOM_COLUMNS=NO "
+                         "-nlt GEOMETRYZ 2> /dev/null")
+                            .c_str()),
+            0);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--point 7,7", "1\n"},  // in both squares
+      {"--point 2,2", "1\n"},  // in the first only
+      {"--point 12,12", "1\n"},
+      {"--bbox 6,6,9,9", "1\n"},
+      {"--point 25,5", "2\n"},  // in both, in the second's hole
+      {"--point 27,7", "2\n"},
+      {"--point 31,11", "2\n"},
+      {"--bbox 26.5,7,29,9", "2\n"},
+      {"--point 45,5", ""},  // in the hole running as its outer ring does
+      {"--point 41,1", "3\n"},
+      {"--point 65,5", "4\n"},  // under the roof, over the floor
+      {"--point 82,5", "5\n"},  // in both faces
+      {"--point 88,9", "5\n"},  // in the second face only
+      {"--point 95,5", ""}};
+  for (const char* per : {"feature", "segment"})
+    for (const auto& [query, want] : cases) {
+      const CliRun r = run_loci("query " + gpkg + " " + query + " --per " + per + " -f ids");
+      EXPECT_EQ(r.status, 0) << query << r.err;
+      EXPECT_EQ(r.out, want) << per << " " << query;
+    }
+  // The multi-polygons in a shapefile: the driver makes polygons of clockwise rings.
+  const std::string shp = path("overlaps_shp.shp");
+  for (const char* ext : {".shp", ".shx", ".dbf", ".prj", ".cpg"})
+    fs::remove(path(std::string("overlaps_shp") + ext));
+  ASSERT_EQ(std::system(("ogr2ogr -q -f 'ESRI Shapefile' " + shp + " " + gpkg +
+                         " -where 'id IN (2, 3)' -nlt MULTIPOLYGON -dim XY 2> /dev/null")
+                            .c_str()),
+            0);
+  for (const char* per : {"feature", "segment"})
+    for (const auto& [query, want] : cases) {
+      if (want != "2\n" && want != "3\n" && query != "--point 45,5") continue;
+      const CliRun r = run_loci("query " + shp + " " + query + " --per " + per + " -f ids");
+      EXPECT_EQ(r.status, 0) << query << r.err;
+      // The shapefile numbers its records from 0.
+      EXPECT_EQ(r.out, want.empty()    ? ""
+                       : want == "2\n" ? "0\n"
+                                       : "1\n")
+          << "shapefile " << per << " " << query;
+    }
+}
+
 // A null attribute stays null in a GeoJSON answer (it was left out, as if the layer had no
 // such value), and empty in a CSV one.
 TEST_F(LayersCli, NullAttributesStayNull) {
@@ -1722,13 +1789,14 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
   put(good + "extra");
   expect_error(query, "damaged index");
   // Sidecars of earlier formats: 2 (nearest-n built the hierarchies at every run), 3 (their
-  // level-0 nodes did not say which of the leaf's slots are the feature's).
-  for (const int version : {2, 3}) {
+  // level-0 nodes did not say which of the leaf's slots are the feature's), 4 (ring segments
+  // without the direction their ring is wound in).
+  for (const int version : {2, 3, 4}) {
     std::string older = good;
     older[8] = char(version);
     put(older);
     expect_error(query, "index format version " + std::to_string(version) +
-                            ", this loci reads 4; run 'loci index' to rebuild it");
+                            ", this loci reads 5; run 'loci index' to rebuild it");
   }
   put(good);
   EXPECT_EQ(run_loci(query).status, 0);

@@ -1,5 +1,6 @@
-// PreparedGeometry::locate (the grid of cells with per-cell parity values) against brute force
-// (every edge through the exact predicates) on random polygons with holes, multi-polygons,
+// PreparedGeometry::locate (the grid of cells with per-cell winding values) against brute force
+// (every edge through the exact predicates, each polygon by its own crossing parity) on random
+// polygons with holes (their rings running either way), multi-polygons,
 // overlapping polygons, lines and isolated points, with integer coordinates so that points fall
 // on vertices, on edges and on the grid's cell borders; long diagonal edges that force a
 // coarser grid; flat envelopes. Also the pair tests on prepared geometries against their
@@ -7,8 +8,10 @@
 #include <gmpxx.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -19,9 +22,10 @@
 namespace loci::io {
 namespace {
 
-// Brute force: on an edge or isolated point, else the parity of all ring crossings.
+// Brute force: on an edge or isolated point, else inside when the crossing parity of some
+// polygon's own rings is odd (each polygon by itself: where polygons overlap, inside).
 Location brute(const FlatGeometry& g, const Point2& p) {
-  bool odd = false;
+  std::vector<bool> odd(g.polygons);
   for (const Part& part : g.parts) {
     if (part.kind == PartKind::point || part.end - part.begin == 1) {
       for (std::uint32_t i = part.begin; i < part.end; ++i)
@@ -35,17 +39,29 @@ Location brute(const FlatGeometry& g, const Point2& p) {
           p[0] <= std::max(a[0], b[0]) && std::min(a[1], b[1]) <= p[1] &&
           p[1] <= std::max(a[1], b[1]))
         return Location::boundary;
-      if (part.kind == PartKind::ring) odd ^= ray_crosses(a, b, p);
+      if (part.kind == PartKind::ring && ray_crosses(a, b, p))
+        odd[part.polygon] = !odd[part.polygon];
     }
   }
-  return odd ? Location::inside : Location::outside;
+  for (const bool o : odd)
+    if (o) return Location::inside;
+  return Location::outside;
 }
 
-void add_ring(FlatGeometry& g, const std::vector<Point2>& ring, std::uint32_t polygon) {
+// Adds a ring to polygon `polygon` (its outer ring when it is the polygon's first), its points
+// in the order given or reversed: the winding is taken from the role, not the order.
+void add_ring(FlatGeometry& g, std::vector<Point2> ring, std::uint32_t polygon,
+              bool reversed = false) {
+  if (reversed) std::reverse(ring.begin(), ring.end());
   const auto begin = std::uint32_t(g.points.size());
   g.points.insert(g.points.end(), ring.begin(), ring.end());
   g.points.push_back(ring.front());
+  bool outer = true;
+  for (const Part& part : g.parts)
+    if (part.kind == PartKind::ring && part.polygon == polygon) outer = false;
   g.parts.push_back({begin, std::uint32_t(g.points.size()), PartKind::ring, polygon});
+  g.parts.back().winding =
+      std::int8_t(ring_winding(std::span<const Point2>(g.points).subspan(begin), outer));
 }
 
 // A star-shaped ring around c with `n` integer vertices within radius r.
@@ -104,8 +120,9 @@ TEST(PreparedGeometry, PolygonsWithHolesAndMultiPolygons) {
     const int polygons = 1 + trial % 4;
     for (int k = 0; k < polygons; ++k) {
       const Point2 c{double(20 + 25 * k), double(20 + 10 * (k % 2))};
-      add_ring(g, star(rng, c, 18, 12 + 40 * (trial % 3)), std::uint32_t(k));
-      if (trial % 2) add_ring(g, star(rng, c, 5, 7), std::uint32_t(k));  // a hole
+      // Rings in either order: a hole running the same way as its outer ring is still one.
+      add_ring(g, star(rng, c, 18, 12 + 40 * (trial % 3)), std::uint32_t(k), (trial + k) % 3 == 0);
+      if (trial % 2) add_ring(g, star(rng, c, 5, 7), std::uint32_t(k), k % 2);  // a hole
     }
     g.polygons = std::uint32_t(polygons);
     expect_same(g, rng, -2, 110, "stars");
@@ -116,8 +133,15 @@ TEST(PreparedGeometry, OverlappingPolygonsLinesAndPoints) {
   std::mt19937_64 rng(32);
   FlatGeometry g;
   add_ring(g, {{0, 0}, {40, 0}, {40, 40}, {0, 40}}, 0);
-  add_ring(g, {{20, 20}, {60, 20}, {60, 60}, {20, 60}}, 1);  // overlaps the first: even-odd
-  g.polygons = 2;
+  add_ring(g, {{20, 20}, {60, 20}, {60, 60}, {20, 60}}, 1, true);  // overlaps the first
+  // A third square over both, with a hole over their overlap (inside: the two squares there),
+  // and a fourth over the third's hole where the first two do not reach.
+  add_ring(g, {{30, 30}, {50, 30}, {50, 50}, {30, 50}}, 2);
+  add_ring(g, {{32, 32}, {38, 32}, {38, 38}, {32, 38}}, 2);
+  add_ring(g, {{0, 62}, {10, 62}, {10, 68}, {0, 68}}, 3, true);
+  add_ring(g, {{4, 61}, {6, 61}, {6, 69}, {4, 69}}, 4);
+  add_ring(g, {{4.5, 64}, {5.5, 64}, {5.5, 66}, {4.5, 66}}, 4, true);
+  g.polygons = 5;
   const auto begin = std::uint32_t(g.points.size());
   for (int k = 0; k <= 30; ++k)
     g.points.push_back({double(70 + (k % 2) * 5), double(k * 2)});
@@ -127,8 +151,17 @@ TEST(PreparedGeometry, OverlappingPolygonsLinesAndPoints) {
       {std::uint32_t(g.points.size() - 1), std::uint32_t(g.points.size()), PartKind::point, 0});
   expect_same(g, rng, -1, 95, "overlap, line, point");
   const PreparedGeometry prepared(g);
-  EXPECT_EQ(prepared.locate({30, 30}), Location::outside);  // in both squares
+  EXPECT_EQ(prepared.locate({25, 25}), Location::inside);  // in both squares
+  EXPECT_EQ(prepared.locate({35, 35}), Location::inside);  // in both, in the third's hole
+  EXPECT_EQ(prepared.locate({45, 45}), Location::inside);  // in all three
   EXPECT_EQ(prepared.locate({10, 10}), Location::inside);
+  EXPECT_EQ(prepared.locate({5, 65}), Location::inside);    // in 3, in 4's hole
+  EXPECT_EQ(prepared.locate({5, 61.5}), Location::inside);  // in 4 only
+  EXPECT_EQ(prepared.locate({5, 68.5}), Location::inside);  // in 4 only
+  EXPECT_EQ(prepared.locate({5, 69.5}), Location::outside);
+  EXPECT_EQ(prepared.locate({41, 41}), Location::inside);  // in 2 and 3
+  for (const Point2& p : {Point2{25, 25}, Point2{35, 35}, Point2{5, 65}})
+    EXPECT_EQ(prepared.locate_at({{p[0] - 0.5, p[1]}, {p[0] + 0.5, p[1]}}, 0.5), Location::inside);
 }
 
 TEST(PreparedGeometry, LongDiagonalEdgesAndManySmallRings) {

@@ -85,7 +85,8 @@ std::vector<std::vector<loci::Point2>> rings_of(const OGRGeometry& g) {
 }
 
 // Brute force over those rings: on an edge, or an odd number of crossings of the ray towards
-// +x (the even-odd rule of loci and GEOS).
+// +x (the even-odd rule of GEOS; on the valid polygons of these layers, loci's winding rule
+// answers the same).
 bool brute_meets(const std::vector<std::vector<loci::Point2>>& rings, const loci::Point2& p) {
   bool odd = false;
   for (const auto& ring : rings)

@@ -9,12 +9,14 @@
 //
 // Predicates are exact: a geometry meets a box, a segment or a point when one of its points
 // lies in it, one of its edges meets it (loci's exact box/segment and segment/segment tests),
-// or one of its polygons contains a point of it (crossing parity decided with the exact
-// orientation predicate; a point on a ring is caught by the edge test, not by parity). The
-// rings of a feature are taken together (the even-odd rule, as GEOS and the per-segment index
-// count them): for a valid polygon or multi-polygon that is polygon by polygon, and where
-// polygons of one feature overlap (an invalid multi-polygon, a collection of overlapping
-// polygons, faces of a surface overlapping in plan), their overlap is outside.
+// or one of its polygons contains a point of it (a winding number decided with the exact
+// orientation predicate; a point on a ring is caught by the edge test, not by the count).
+// Each ring is wound as its polygon's role gives it, whatever order its points come in: an
+// outer ring counterclockwise, a hole clockwise (Part::winding). A point is inside when the
+// winding number of all the feature's rings about it is not zero: inside any polygon of the
+// feature, also where polygons of one feature overlap (a collection of overlapping polygons,
+// faces of a surface overlapping in plan, an invalid multi-polygon), as long as each hole lies
+// in its outer ring.
 // Touching counts. Distances are computed in floating point and are 0 inside a polygon; a
 // point's distance is 0 exactly when the point lies on the geometry, and whether it is within
 // a distance is decided exactly.
@@ -23,6 +25,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -37,6 +40,9 @@ struct Part {
   std::uint32_t end;    // one past the last
   PartKind kind;
   std::uint32_t polygon;  // rings only: which polygon of the feature the ring bounds
+  // Rings only: +1 when the points run as the ring's role winds it (an outer ring
+  // counterclockwise, a hole clockwise), -1 when they run the other way (ring_winding()).
+  std::int8_t winding = 1;
 };
 
 struct FlatGeometry {
@@ -102,9 +108,9 @@ enum class Location : std::uint8_t { outside, boundary, inside };
 
 // A geometry prepared for many point tests: a grid of cells over its envelope, each listing
 // the edges whose boxes overlap it, and for each cell what the edges entirely to its right
-// contribute to the crossing parity of a ray from any point of the cell (a few y values; see
-// exact.cpp). A test reads one cell: its edges decide exactly (boundary, crossings within the
-// cell) and a binary search in its values gives the rest of the parity, so that the cost is
+// contribute to the winding number about any point of the cell (a few y values, each with
+// its share; see exact.cpp). A test reads one cell: its edges decide exactly (boundary,
+// crossings within the cell) and a binary search in its values gives the rest, so that the cost is
 // the edges near the point, not those along its whole row (what GEOS's prepared polygons scan,
 // through an interval tree on y). The pair tests below take prepared geometries so that a
 // feature met by many others (a joined layer) is prepared once and each pair costs the edges
@@ -128,13 +134,15 @@ class PreparedGeometry {
 
  private:
   struct Edge {
-    std::uint32_t first;  // the edge runs from points[first] to points[first + 1]
-    std::uint32_t kind;   // kRing, kLine, or kPoint (an isolated point: first only)
+    std::uint32_t first;   // the edge runs from points[first] to points[first + 1]
+    std::uint16_t kind;    // kRing, kLine, or kPoint (an isolated point: first only)
+    std::int16_t winding;  // rings: the ring's Part::winding
   };
-  static constexpr std::uint32_t kRing = 0, kLine = 1, kPoint = 2;
+  static constexpr std::uint16_t kRing = 0, kLine = 1, kPoint = 2;
   std::uint32_t col(double x) const;
   std::uint32_t row(double y) const;
   void build(std::size_t cells);
+  std::int32_t sum_before(std::size_t cell, std::size_t k) const;
 
   const FlatGeometry* g_;
   Box2 envelope_;
@@ -144,7 +152,8 @@ class PreparedGeometry {
   std::vector<std::uint32_t> cell_start_, cell_edges_;  // CSR: the edges meeting each cell
   std::vector<std::uint32_t> value_start_;              // CSR into values_, per cell
   std::vector<double> values_;
-  std::vector<std::uint8_t> base_;  // per cell: the parity the values do not carry
+  std::vector<std::int32_t> sums_;  // per value: the shares of the cell's values up to it
+  std::vector<std::int32_t> base_;  // per cell: the winding number the values do not carry
 };
 
 // The pair tests above on prepared geometries (the same answers).
@@ -161,5 +170,14 @@ double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bou
 // Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
 // exactly; half-open in y so that a ray through a vertex counts once.
 bool ray_crosses(const Point2& a, const Point2& b, const Point2& p);
+// The edge a-b's share of the winding number about p: +1 when it crosses the ray from p
+// towards +x going up (a below b), -1 going down, 0 when it does not cross (as ray_crosses).
+int ray_crossing(const Point2& a, const Point2& b, const Point2& p);
+// Part::winding for a ring of the given role (outer: the first ring of its polygon): +1 when
+// its points run counterclockwise for an outer ring or clockwise for a hole, else -1. The
+// orientation is decided exactly at the ring's lowest-leftmost vertex (the signed area decides
+// when the ring doubles back there; a ring of no area counts as counterclockwise). `ring` may
+// or may not repeat its first point at the end.
+int ring_winding(std::span<const Point2> ring, bool outer);
 
 }  // namespace loci::io
