@@ -13,6 +13,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/index/moving/conflicts.hpp"
 #include "loci/index/moving/moving_scan.hpp"
+#include "loci/io/commands.hpp"
 #include "loci/io/exact.hpp"
 #include "svg.hpp"
 
@@ -57,6 +58,11 @@ struct Loaded {
 
 Loaded load(const std::string& path, std::optional<double> at) {
   Loaded l{read_fleet_file(path), 0};
+  // Rows, none of them usable: nothing could be answered, and an empty answer would hide it.
+  // (A header alone is a fleet of no objects.)
+  if (l.data.reports.empty() && l.data.skipped.total() > 0)
+    throw Error(printable(path) + ": no usable " + (l.ais() ? "AIS report" : "report") + ", " +
+                l.data.skipped.summary());
   if (at)
     l.now = *at;
   else

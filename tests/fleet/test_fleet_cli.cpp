@@ -726,7 +726,21 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   const std::string q = " --bbox 0,0,1,1";
   expect_one_line_error(run_loci("fleet query " + shell_quote(nan) + q), "line 3: x is NaN");
   expect_one_line_error(run_loci("fleet query " + shell_quote(empty) + q), "empty file");
-  for (const char* tick : {"0", "-1"})  // -1 was told ">= 0", and 0 then refused
+  // Rows of which none is usable: an error, not an empty answer (a header alone is a fleet).
+  const std::string unusable = write("unusable.csv",
+                                     "MMSI,BaseDateTime,LAT,LON,SOG,COG\n"
+                                     "219000001,2024-13-45T00:00:00,55,10,1,90\n"
+                                     "219000002,2024-01-01T00:00:00,91,181,1,90\n");
+  for (const char* cmd : {"fleet query", "fleet conflicts"}) {
+    const std::string flags =
+        std::string(cmd) == "fleet query" ? " --bbox 9,54,11,56" : " --within 100 --horizon 60";
+    expect_one_line_error(run_loci(std::string(cmd) + " " + shell_quote(unusable) + flags),
+                          "unusable.csv: no usable AIS report, skipped 2 (");
+  }
+  const std::string repeated = write("repeated.csv", "id,t,x,y\n1,0,0,0\n1,0,0,0\n");
+  const CliRun once = run_loci("fleet query " + shell_quote(repeated) + q + " -q");
+  EXPECT_EQ(once.status, 0) << once.err;  // a duplicate row leaves the first
+  for (const char* tick : {"0", "-1"})    // -1 was told ">= 0", and 0 then refused
     expect_one_line_error(run_loci("fleet simulate " + shell_quote(good) +
                                    " --within 1 --horizon 5 --ticks 2 --tick " + tick),
                           std::string("bad --tick '") + tick + "': expected a finite number > 0");
