@@ -64,7 +64,8 @@ inline void write_rect(std::FILE* o, const Frame& f, const Box2& r) {
                f.y(r.max[1]), r.extent(0) * f.scale, r.extent(1) * f.scale);
 }
 
-// With `lonlat`, a layer in a projected system is refused (check_lonlat_system).
+// With `lonlat`, a layer in a projected system is refused (check_lonlat_system), and so is
+// one without a system whose points are no longitudes and latitudes.
 inline void write_linework(std::FILE* o, const Frame& f, const std::string& layer_path,
                            const std::string& layer_name, bool lonlat = false) {
   auto src = open_layer(layer_path, layer_name);
@@ -73,14 +74,25 @@ inline void write_linework(std::FILE* o, const Frame& f, const std::string& laye
   // Tenths of a pixel, clamped far outside any canvas (a vertex beyond the frame's range
   // would overflow a long: a layer much larger than a fleet drawn at one point).
   const auto tenths = [](double v) { return std::lround(std::clamp(v * 10, -1e15, 1e15)); };
+  // With `lonlat`, a layer without a system is refused where a point is no lon/lat.
+  const auto check_point = [&](const Point2& p, std::int64_t fid) {
+    if (!within_coordinate_range(p)) check_layer_point(p, where(layer_path, fid));
+    if (lonlat && !(std::abs(p[0]) <= 180 && std::abs(p[1]) <= 90)) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    " has coordinate (%.6g, %.6g), no longitude and latitude, and AIS positions "
+                    "are; reproject the layer first (ogr2ogr -t_srs EPSG:4326)",
+                    p[0], p[1]);
+      throw Error(where(layer_path, fid) + buf);
+    }
+  };
   for (auto& feature : *src.layer) {
     const std::int64_t fid = feature->GetFID();
     detail::for_each_curve(
         feature->GetGeometryRef(), [&](const OGRSimpleCurve& c, bool, std::uint32_t) {
           const int n = c.getNumPoints();
           for (int i = 0; i < n; ++i)
-            if (const Point2 p{c.getX(i), c.getY(i)}; !within_coordinate_range(p))
-              check_layer_point(p, where(layer_path, fid));
+            check_point({c.getX(i), c.getY(i)}, fid);
           if (n < 2) return;
           std::fprintf(o, "<path d=\"");
           long lx = LONG_MIN, ly = LONG_MIN;
@@ -95,6 +107,7 @@ inline void write_linework(std::FILE* o, const Frame& f, const std::string& laye
         });
     // Isolated points (a point layer, the points of a collection) as dots.
     detail::for_each_point(feature->GetGeometryRef(), where(layer_path, fid), [&](const Point2& p) {
+      check_point(p, fid);
       std::fprintf(o, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"1.5\" fill=\"#555\"/>\n",
                    tenths(f.x(p[0])) / 10.0, tenths(f.y(p[1])) / 10.0);
     });

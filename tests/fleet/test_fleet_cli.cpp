@@ -980,6 +980,19 @@ TEST_F(FleetCli, DrawShowsEveryObjectInForceAndEveryConflict) {
     }
     fs::remove(none);
   }
+  // Without a system, a layer whose coordinates cannot be lon/lat is refused too (it was drawn,
+  // metres read as degrees).
+  const std::string metres =
+      write("metres.geojson", R"({"type":"FeatureCollection","features":[{"type":"Feature",
+"properties":{},"geometry":{"type":"LineString","coordinates":[[10,55],[500000,6100000]]}}]})");
+  const CliRun rm = run_loci("fleet draw " + shell_quote(kSample) + " --over " +
+                             shell_quote(metres) + " -q -o " + shell_quote(none));
+  EXPECT_EQ(rm.status, 1);
+  EXPECT_EQ(lines(rm.err).size(), 1u) << rm.err;
+  EXPECT_NE(rm.err.find("feature 0 has coordinate (500000, 6.1e+06), no longitude and latitude"),
+            std::string::npos)
+      << rm.err;
+  EXPECT_FALSE(fs::exists(none));
   // A layer beyond +-1e150 is refused under the fleet as loci draw refuses it.
   const std::string big =
       write("big.geojson", R"({"type":"FeatureCollection","features":[{"type":"Feature",
