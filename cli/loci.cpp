@@ -797,7 +797,8 @@ void print_help() {
   for (const auto& c : commands())
     std::printf("  %-16s %s\n", c.name, c.summary);
   std::printf(
-      "\nloci COMMAND --help (loci fleet SUB --help) documents every option of COMMAND.\n"
+      "\nloci COMMAND --help (loci fleet SUB --help) documents every option of COMMAND; an\n"
+      "option's value follows it (-k 3, --bbox 0,0,1,1) or is joined to it (-k3, --bbox=...).\n"
       "Exit status 0 on success, 1 on failure with one line 'loci: error: ...' on stderr.\n\n"
       "example:\n  loci index countries.shp && loci query countries.shp --bbox 5,45,15,55\n");
 }
@@ -815,15 +816,31 @@ void print_fleet_help() {
 Args parse(const Command& c, int first, int argc, char** argv) {
   Args a;
   std::set<std::string> given;  // options with a value seen so far, by long name
+  const auto find = [&](std::string_view name) -> const Flag* {
+    for (const Flag& f : c.flags)
+      if (name == f.name || (f.alias && name == f.alias)) return &f;
+    return nullptr;
+  };
   for (int i = first; i < argc; ++i) {
-    const std::string arg = argv[i];
+    std::string arg = argv[i];
     if (arg.size() < 2 || arg[0] != '-') {
       a.positional.push_back(arg);
       continue;
     }
-    const Flag* flag = nullptr;
-    for (const Flag& f : c.flags)
-      if (arg == f.name || (f.alias && arg == f.alias)) flag = &f;
+    const Flag* flag = find(arg);
+    // A value joined to its option: --name=VALUE, or -kVALUE for a one-letter option.
+    std::optional<std::string> joined;
+    if (!flag) {
+      const std::size_t eq = arg.find('=');
+      const std::size_t at = arg.rfind("--", 0) == 0 ? eq : arg[1] != '-' ? 2 : std::string::npos;
+      if (at != std::string::npos && at < arg.size()) {
+        if (const Flag* f = find(std::string_view(arg).substr(0, at)); f && f->value) {
+          flag = f;
+          joined = arg.substr(at + (at == eq ? 1 : 0));
+          arg.resize(at);
+        }
+      }
+    }
     if (!flag)
       throw UsageError("unknown option " + arg + " for loci " + c.name + " (see loci " + c.name +
                        " --help)");
@@ -831,17 +848,18 @@ Args parse(const Command& c, int first, int argc, char** argv) {
       a.values[flag->name] = "";
       continue;
     }
-    if (i + 1 >= argc) throw UsageError(arg + " needs a value: " + flag->value);
+    if (!joined && i + 1 >= argc) throw UsageError(arg + " needs a value: " + flag->value);
+    const std::string value = joined ? *joined : argv[i + 1];
+    if (!joined) ++i;
     // An option's value is taken once: a second one would silently replace the first (two
     // --bbox are not two windows).
     if (!given.insert(flag->name).second)
       throw UsageError(arg + " is given twice; loci " + c.name + " takes one " + flag->name);
-    if (argv[i + 1][0] == '\0')  // `-o ""` would otherwise mean stdout or a default
+    if (value.empty())  // `-o ""` would otherwise mean stdout or a default
       throw UsageError(arg + " needs a value: " + flag->value + ", not an empty one");
     // `-o -` is stdout, as usual, where the output is text that may go there; a command that
     // writes a file says so (a file named "-" is ./-).
-    if (!std::strcmp(flag->name, "--output") && !std::strcmp(argv[i + 1], "-")) {
-      ++i;
+    if (!std::strcmp(flag->name, "--output") && value == "-") {
       if (flag->stdout_allowed) {
         a.values.erase(flag->name);
         continue;
@@ -849,7 +867,7 @@ Args parse(const Command& c, int first, int argc, char** argv) {
       throw UsageError(arg + " -: loci " + c.name +
                        " writes a file, not stdout; name it (./- for a file named -)");
     }
-    a.values[flag->name] = argv[++i];
+    a.values[flag->name] = value;
   }
   return a;
 }

@@ -1123,6 +1123,17 @@ TEST_F(LayersCli, ReportsBadInput) {
   expect_error("query " + polys + " --nearest 1,1 -k 2 -k 3", "-k is given twice");
   expect_error("query " + polys + " --bbox 0,0,1,1 -k 3", "-k counts the neighbours of --nearest");
   expect_error("query " + polys + " --bbox 0,0,1,1 --format ids -f csv", "-f is given twice");
+  // A value joined to its option (-k3, --bbox=...) is that option's value, and counts once.
+  for (const std::string& joined : {"--nearest=1,1 -k3", "-n1,1 -k 3", "-n 1,1 -k3"}) {
+    const CliRun r = run_loci("query " + polys + " " + joined + " -fids");
+    EXPECT_EQ(r.status, 0) << joined << r.err;
+    EXPECT_EQ(r.out, run_loci("query " + polys + " --nearest 1,1 -k 3 -f ids").out) << joined;
+  }
+  expect_error("query " + polys + " --nearest 1,1 -k3 -k 2", "-k is given twice");
+  expect_error("query " + polys + " --bbox=0,0,1,1 -b 0,0,1,1", "-b is given twice");
+  expect_error("query " + polys + " --bbox 0,0,1,1 --quiet=yes", "unknown option --quiet=yes");
+  expect_error("query " + polys + " --bbox= ", "--bbox needs a value");
+  expect_error("query " + polys + " --bbox 0,0,1,1 -xk3", "unknown option -xk3");
   expect_error("index " + polys + " -o " + path("a.loci") + " --output -",
                "--output is given twice");
   expect_error("index " + polys + " --structure rstar", "built in memory only");
