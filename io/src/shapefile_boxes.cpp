@@ -620,13 +620,19 @@ struct PreparedRing {
 // nullptr, for GDAL to answer, whenever a record is unusual: a ring orientation cannot place
 // (PolygonRings::clockwise), no clockwise ring, or a hole not plainly inside the outer ring
 // (GDAL versions differ there).
-const char* polygon_type(const unsigned char* c) {
-  const PolygonRings r(c);
+// Each ring's PolygonRings::clockwise().
+std::vector<std::int8_t> orientations(const PolygonRings& r) {
+  std::vector<std::int8_t> cw(r.parts);
+  for (std::uint32_t k = 0; k < r.parts; ++k)
+    cw[k] = std::int8_t(r.clockwise(k));
+  return cw;
+}
+
+const char* polygon_type(const PolygonRings& r, const std::vector<std::int8_t>& cw) {
   std::uint32_t outer = 0, outers = 0;
   for (std::uint32_t k = 0; k < r.parts; ++k) {
-    const int cw = r.clockwise(k);
-    if (cw < 0) return nullptr;
-    if (cw) outer = k, ++outers;
+    if (cw[k] < 0) return nullptr;
+    if (cw[k]) outer = k, ++outers;
   }
   if (outers == 0) return nullptr;
   if (outers > 1) return "Multi Polygon";
@@ -637,6 +643,11 @@ const char* polygon_type(const unsigned char* c) {
     if (k != outer && prepared.prepared.locate(r.point(r.range(k).first)) != Location::inside)
       return nullptr;
   return "Polygon";
+}
+
+const char* polygon_type(const unsigned char* c) {
+  const PolygonRings r(c);
+  return polygon_type(r, orientations(r));
 }
 
 // Ring k of r as an OGR ring, made the first time it is asked for.
@@ -673,14 +684,12 @@ struct Organized {
   std::vector<std::unique_ptr<OGRLinearRing>> rings;  // as OGR rings: those made to test
 };
 
-std::optional<Organized> organize(const PolygonRings& r) {
+// `cw`: the rings' orientations().
+std::optional<Organized> organize(const PolygonRings& r, const std::vector<std::int8_t>& cw) {
   std::vector<std::uint32_t> outers;
-  std::vector<std::uint8_t> cw(r.parts);
   for (std::uint32_t k = 0; k < r.parts; ++k) {
-    const int o = r.clockwise(k);
-    if (o < 0) return std::nullopt;
-    cw[k] = std::uint8_t(o);
-    if (o) outers.push_back(k);
+    if (cw[k] < 0) return std::nullopt;
+    if (cw[k]) outers.push_back(k);
   }
   if (outers.empty() || r.parts < 2) return std::nullopt;
   // The rings as OGR rings, made once: tested below, then handed to the polygons.
@@ -787,17 +796,15 @@ std::optional<Organized> organize(const PolygonRings& r) {
 // clockwise.
 bool ring_roles(const unsigned char* c, std::vector<std::uint8_t>& outer) {
   const PolygonRings r(c);
+  const std::vector<std::int8_t> cw = orientations(r);
   outer.assign(r.parts, 1);
-  bool holes = false;
-  for (std::uint32_t k = 0; k < r.parts && !holes; ++k)
-    holes = r.clockwise(k) != 1;
-  if (!holes) return true;
-  if (const char* type = polygon_type(c); type && std::strcmp(type, "Polygon") == 0) {
+  if (std::all_of(cw.begin(), cw.end(), [](std::int8_t o) { return o == 1; })) return true;
+  if (const char* type = polygon_type(r, cw); type && std::strcmp(type, "Polygon") == 0) {
     for (std::uint32_t k = 0; k < r.parts; ++k)  // one outer ring holding all the others
-      outer[k] = r.clockwise(k) == 1;
+      outer[k] = cw[k] == 1;
     return true;
   }
-  const auto organized = organize(r);
+  const auto organized = organize(r, cw);
   if (!organized) return false;
   for (std::uint32_t k = 0; k < r.parts; ++k)
     outer[k] = organized->owner[k] == kNone;
@@ -807,7 +814,7 @@ bool ring_roles(const unsigned char* c, std::vector<std::uint8_t>& outer) {
 // The geometry of organize()'s polygons.
 std::unique_ptr<OGRGeometry> build_polygons(const unsigned char* c) {
   const PolygonRings r(c);
-  auto organized = organize(r);
+  auto organized = organize(r, orientations(r));
   if (!organized) return nullptr;
   const std::vector<std::uint32_t>& owner = organized->owner;
   std::vector<std::uint32_t>& top = organized->top;
