@@ -33,6 +33,44 @@ bool polygonal(const OGRGeometry& g) {
   return t == wkbPolygon || t == wkbMultiPolygon;
 }
 
+// Adds the polygons of g (a polygon, or a multi-polygon or collection of polygons, at any
+// depth) to `out`, each made valid by itself; false when g holds anything else or a polygon
+// cannot be repaired. What a repair collapses to lines or points is left out.
+bool add_valid_polygons(const OGRGeometry& g, OGRMultiPolygon& out) {
+  const auto t = wkbFlatten(g.getGeometryType());
+  if (t == wkbPolygon) {
+    const std::unique_ptr<OGRGeometry> v(g.IsValid() ? g.clone() : g.MakeValid());
+    if (!v) return false;
+    const auto vt = wkbFlatten(v->getGeometryType());
+    if (vt == wkbPolygon) {
+      out.addGeometry(v.get());
+    } else if (vt == wkbMultiPolygon || vt == wkbGeometryCollection) {
+      for (const OGRGeometry* part : *v->toGeometryCollection())
+        if (wkbFlatten(part->getGeometryType()) == wkbPolygon)
+          out.addGeometry(part);
+        else if (wkbFlatten(part->getGeometryType()) == wkbMultiPolygon)
+          for (const OGRPolygon* q : *part->toMultiPolygon())
+            out.addGeometry(q);
+    }
+    return true;
+  }
+  if (t != wkbMultiPolygon && t != wkbGeometryCollection) return false;
+  for (const OGRGeometry* part : *g.toGeometryCollection())
+    if (!add_valid_polygons(*part, out)) return false;
+  return true;
+}
+
+// An invalid polygonal geometry made valid as loci's queries read it, a point inside any of
+// its polygons being inside: each polygon repaired by itself, then all united (MakeValid of
+// the whole takes the overlap of two polygons by crossing parity, as outside). Null when g
+// holds anything but polygons, or cannot be repaired.
+std::unique_ptr<OGRGeometry> united_polygons(const OGRGeometry& g) {
+  OGRMultiPolygon all;
+  if (!add_valid_polygons(g, all)) return nullptr;
+  if (all.IsEmpty()) return std::unique_ptr<OGRGeometry>(all.clone());
+  return std::unique_ptr<OGRGeometry>(all.UnionCascaded());
+}
+
 // The window as one valid polygonal geometry: the rectangle, the WKT, or the union of the
 // window layer's polygons; a rectangle of no width or height is a line or a point.
 std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o, std::string& system) {
@@ -45,8 +83,8 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o, std::string& system
     if (!polygonal(*w))
       throw InvalidGeometry("--wkt: the window must be a POLYGON or MULTIPOLYGON");
     // A window the user wrote is taken as written or refused: repairing it would choose an
-    // answer (the overlap of two polygons of a MULTIPOLYGON repaired by crossing parity is
-    // outside, while --window-layer unites them).
+    // answer (a hole reaching out of its shell, polygons that overlap: --window-layer unites
+    // them).
     if (!w->IsEmpty() && !w->IsValid())
       throw InvalidGeometry(
           "--wkt: the window is not a valid polygon (rings that cross, a hole not inside its "
@@ -64,13 +102,9 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o, std::string& system
       if (!polygonal(*g))
         throw InvalidGeometry(detail::where(o.window_layer, f->GetFID()) +
                               " is not a polygon; a window layer holds polygons");
-      std::unique_ptr<OGRGeometry> valid(g->IsValid() ? g->clone() : g->MakeValid());
-      if (!valid) throw InvalidGeometry(detail::where(o.window_layer, f->GetFID()) + " is invalid");
-      if (wkbFlatten(valid->getGeometryType()) == wkbPolygon)
-        all.addGeometry(valid.get());
-      else if (wkbFlatten(valid->getGeometryType()) == wkbMultiPolygon)
-        for (const OGRPolygon* p : *valid->toMultiPolygon())
-          all.addGeometry(p);
+      // Each polygon repaired by itself: the union below then holds where two overlap.
+      if (!add_valid_polygons(*g, all))
+        throw InvalidGeometry(detail::where(o.window_layer, f->GetFID()) + " is invalid");
     }
     check.finish();
     if (all.IsEmpty()) throw InvalidGeometry(o.window_layer + ": no polygon to clip with");
@@ -273,9 +307,16 @@ ClipResult clip_layer(const ClipOptions& options) {
       }
       const std::unique_ptr<OGRGeometry> near = near_window(*g, window_envelope);
       if (near) g = near.get();
+      // Polygons of one feature that overlap keep their overlap, as queries count it: an
+      // invalid multi-polygon, and a collection of polygons (valid however they overlap, and
+      // cut by GEOS as if the overlap were outside), are cut as the union of their polygons.
       std::unique_ptr<OGRGeometry> valid;
-      if (!g->IsValid()) {
-        valid.reset(g->MakeValid());
+      if (wkbFlatten(g->getGeometryType()) == wkbGeometryCollection) valid = united_polygons(*g);
+      if (valid) {
+        g = valid.get();
+      } else if (!g->IsValid()) {
+        valid = united_polygons(*g);
+        if (!valid) valid.reset(g->MakeValid());
         if (!valid)
           throw Error(options.load.layer_path + ": feature " + std::to_string(a.fid) +
                       " is an invalid geometry that cannot be repaired");
