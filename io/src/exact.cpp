@@ -77,8 +77,14 @@ int ring_winding(std::span<const Point2> ring, bool outer) {
   do
     next = next + 1 == n ? 0 : next + 1;
   while (next != v && ring[next] == ring[v]);
+  // A ring through that vertex twice (touching itself there) turns there once per visit, not
+  // necessarily the way it runs as a whole: the area decides.
+  std::size_t visits = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    visits += ring[i] == ring[v] && (i == 0 ? ring[n - 1] != ring[v] : ring[i - 1] != ring[v]);
   bool ccw = true;
-  const Orientation o = orientation(ring[prev], ring[v], ring[next]);
+  const Orientation o =
+      visits > 1 ? Orientation::collinear : orientation(ring[prev], ring[v], ring[next]);
   if (o != Orientation::collinear) {
     ccw = o == Orientation::counterclockwise;
   } else {

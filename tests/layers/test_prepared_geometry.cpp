@@ -164,6 +164,26 @@ TEST(PreparedGeometry, OverlappingPolygonsLinesAndPoints) {
     EXPECT_EQ(prepared.locate_at({{p[0] - 0.5, p[1]}, {p[0] + 0.5, p[1]}}, 0.5), Location::inside);
 }
 
+// A ring through its lowest-leftmost vertex twice (two lobes touching there) runs as its area
+// says, not as it turns at its first visit there: its hole stays a hole.
+TEST(PreparedGeometry, ARingTouchingItselfAtItsLowestVertexWindsByItsArea) {
+  const std::vector<Point2> lobes = {{4, 1}, {4, 3}, {0, 0}, {-4, 3}, {-4, 1}, {0, 0}, {4, 1}};
+  EXPECT_EQ(ring_winding(lobes, true), 1);
+  EXPECT_EQ(ring_winding(lobes, false), -1);
+  std::vector<Point2> reversed(lobes.rbegin(), lobes.rend());
+  EXPECT_EQ(ring_winding(reversed, true), -1);
+  for (const bool flip : {false, true}) {
+    FlatGeometry g;
+    add_ring(g, {lobes.begin(), lobes.end() - 1}, 0, flip);
+    add_ring(g, {{3.5, 1.5}, {3.5, 2}, {3.9, 2}, {3.9, 1.5}}, 0, !flip);
+    g.polygons = 1;
+    const PreparedGeometry prepared(g);
+    EXPECT_EQ(prepared.locate({3.7, 1.7}), Location::outside) << flip;  // in the hole
+    EXPECT_EQ(prepared.locate({3, 1.3}), Location::inside) << flip;
+    EXPECT_EQ(prepared.locate({-3, 1.3}), Location::inside) << flip;
+  }
+}
+
 TEST(PreparedGeometry, LongDiagonalEdgesAndManySmallRings) {
   // A huge thin triangle across many small squares: listing its edges in every cell of their
   // boxes would be quadratic, so the grid is made coarser; answers must not change.

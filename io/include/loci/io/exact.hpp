@@ -176,8 +176,8 @@ int ray_crossing(const Point2& a, const Point2& b, const Point2& p);
 // Part::winding for a ring of the given role (outer: the first ring of its polygon): +1 when
 // its points run counterclockwise for an outer ring or clockwise for a hole, else -1. The
 // orientation is decided exactly at the ring's lowest-leftmost vertex (the signed area decides
-// when the ring doubles back there; a ring of no area counts as counterclockwise). `ring` may
-// or may not repeat its first point at the end.
+// when the ring doubles back there or passes through it twice; a ring of no area counts as
+// counterclockwise). `ring` may or may not repeat its first point at the end.
 int ring_winding(std::span<const Point2> ring, bool outer);
 
 }  // namespace loci::io
