@@ -275,6 +275,27 @@ std::optional<Point2> interior_point(const FlatGeometry& g, std::span<const std:
   return std::nullopt;
 }
 
+// True when q lies strictly inside a polygon of g (by the crossing parity of that polygon's own
+// rings, exactly) none of whose rings passes through q: then g's area holds q and all around
+// it, whatever boundary of g's other polygons runs through q. Only a feature of several
+// polygons can have such boundary inside itself (polygons that overlap).
+bool inside_another_polygon(const FlatGeometry& g, const Point2& q) {
+  if (g.polygons < 2) return false;
+  std::vector<std::uint8_t> state(g.polygons, 0);  // 1: odd crossings; 2: q on a ring
+  for (const Part& part : g.parts) {
+    if (part.kind != PartKind::ring || part.polygon >= g.polygons) continue;
+    std::uint8_t& st = state[part.polygon];
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i) {
+      const Segment2 e{g.points[i], g.points[i + 1]};
+      if (intersects(e, Segment2{q, q}))
+        st |= 2;
+      else if (ray_crosses(e.a, e.b, q))
+        st ^= 1;
+    }
+  }
+  return std::find(state.begin(), state.end(), std::uint8_t(1)) != state.end();
+}
+
 Box2 common(const Box2& a, const Box2& b) {
   return {{std::max(a.min[0], b.min[0]), std::max(a.min[1], b.min[1])},
           {std::min(a.max[0], b.max[0]), std::min(a.max[1], b.max[1])}};
@@ -387,10 +408,12 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
   if (!areas) return true;
   // No point of a's polygons' boundary lies strictly inside b's polygons: a vertex there, or a
   // piece of a ring edge between its cuts with b's edges (a hole or notch of a inside b; the
-  // boundary of a has a's outside beside it).
+  // boundary of a has a's outside beside it), unless another polygon of a holds it (the edge
+  // of one of two polygons that overlap, inside the other).
   const Box2& env = pb.envelope();
   for (const Point2& v : a.points)
-    if (intersects(env, v) && pb.locate(v) == Location::inside) return false;
+    if (intersects(env, v) && pb.locate(v) == Location::inside && !inside_another_polygon(a, v))
+      return false;
   k = 0;
   for (std::uint32_t j = 0; j < ea.segs.size(); ++j) {
     const Segment2& e = ea.segs[j];
@@ -399,7 +422,10 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
         ++k;
       continue;
     }
-    if (!each_piece(on_a, k, j, [&](double t) { return pb.locate_at(e, t) != Location::inside; }))
+    if (!each_piece(on_a, k, j, [&](double t) {
+          return pb.locate_at(e, t) != Location::inside ||
+                 inside_another_polygon(a, point_at(e, t));
+        }))
       return false;
   }
   // So the inside of each polygon of b lies wholly inside a or wholly outside it (say, a's hole

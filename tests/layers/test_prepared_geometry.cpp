@@ -428,6 +428,60 @@ TEST(PreparedGeometry, DistanceWithinIsExactNearD) {
   EXPECT_GT(out, 200);
 }
 
+TEST(PreparedGeometry, CoversOfOverlappingPolygonsAgainstLatticeEvidence) {
+  // a: two or three rectangles as polygons of one feature, overlapping or apart (corners at
+  // integers, then at quarters and halves, so that no two share an edge), rings either way, the
+  // second sometimes with a hole; b: an integer rectangle. Eighth-lattice points decide. An
+  // edge of one polygon inside another was taken for a's boundary inside b: not covered.
+  std::mt19937_64 rng(38);
+  std::uniform_int_distribution<int> c(0, 12), s(1, 9), coin(0, 1);
+  int covered = 0, across = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    FlatGeometry a, b;
+    const int n = 2 + trial % 2;
+    for (int k = 0; k < n; ++k) {
+      const double off = k * 0.25, x = c(rng) + off, y = c(rng) + off;
+      const double w = s(rng), h = s(rng);
+      add_ring(a, {{x, y}, {x + w, y}, {x + w, y + h}, {x, y + h}}, std::uint32_t(k), coin(rng));
+      if (k == 1 && w >= 3 && h >= 3 && coin(rng))
+        add_ring(a,
+                 {{x + 1.25, y + 1.25},
+                  {x + w - 1.25, y + 1.25},
+                  {x + w - 1.25, y + h - 1.25},
+                  {x + 1.25, y + h - 1.25}},
+                 1, coin(rng));
+    }
+    a.polygons = std::uint32_t(n);
+    std::uniform_int_distribution<int> small(1, 5);
+    const double x = c(rng), y = c(rng), w = small(rng), h = small(rng);
+    add_ring(b, {{x, y}, {x + w, y}, {x + w, y + h}, {x, y + h}}, 0);
+    b.polygons = 1;
+    bool b_in_a = true, in_two = false;
+    for (double px = x; px <= x + w && b_in_a; px += 0.125)
+      for (double py = y; py <= y + h; py += 0.125) {
+        if (brute(a, {px, py}) == Location::outside) {
+          b_in_a = false;
+          break;
+        }
+        int holding = 0;
+        for (std::uint32_t k = 0; k < a.polygons; ++k) {
+          FlatGeometry one;
+          for (const Part& part : a.parts)
+            if (part.polygon == k)
+              add_ring(one, {a.points.begin() + part.begin, a.points.begin() + part.end - 1}, 0);
+          one.polygons = 1;
+          holding += brute(one, {px, py}) != Location::outside;
+        }
+        in_two |= holding > 1;
+      }
+    covered += b_in_a;
+    across += b_in_a && in_two;
+    EXPECT_EQ(covers(PreparedGeometry(a), PreparedGeometry(b)), b_in_a) << trial;
+  }
+  EXPECT_GT(covered, 150);
+  EXPECT_GT(across, 50);  // covered only by two polygons together, or by their overlap
+}
+
 TEST(PreparedGeometry, CoversWithHolesAgainstLatticeEvidence) {
   // Rectangles with integer corners, each with a rectangular hole or none (a hole filled
   // exactly by the other, a hole sharing edges with it, a hole inside it): half-lattice
