@@ -4,7 +4,7 @@
 // A layer's features arrive from GDAL in many shapes (points, lines, polygons with holes,
 // multi-geometries, collections). For refinement only three kinds of part matter: isolated
 // points, line strings, and polygon rings, the latter grouped by the polygon they bound so
-// that holes are handled by crossing parity. Keeping them as one vector of points plus part
+// that holes are handled by their winding. Keeping them as one vector of points plus part
 // ranges costs one allocation per feature and keeps the tests simple loops.
 //
 // Predicates are exact: a geometry meets a box, a segment or a point when one of its points
