@@ -24,20 +24,18 @@ bool any_edge(const FlatGeometry& g, F&& f) {
   return false;
 }
 
-// True when p is strictly inside g's polygons: the winding number of its rings, each wound
-// as its role gives it, is not zero about p. Points on a ring may answer either way; callers
-// test the boundary separately.
+// True when p is strictly inside one of g's polygons: an odd number of that polygon's rings
+// cross the ray from p towards +x. Points on a ring may answer either way; callers test the
+// boundary separately.
 bool inside_polygon(const FlatGeometry& g, const Point2& p) {
   if (g.polygons == 0) return false;
-  long winding = 0;
+  OddPolygons odd;
   for (const Part& part : g.parts) {
     if (part.kind != PartKind::ring) continue;
-    long w = 0;
     for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-      w += ray_crossing(g.points[i], g.points[i + 1], p);
-    winding += part.winding * w;
+      if (ray_crosses(g.points[i], g.points[i + 1], p)) odd.toggle(part.polygon);
   }
-  return winding != 0;
+  return odd.any();
 }
 
 }  // namespace
@@ -57,45 +55,18 @@ bool ray_crosses(const Point2& a, const Point2& b, const Point2& p) {
   return o == Orientation::counterclockwise;
 }
 
-int ray_crossing(const Point2& a, const Point2& b, const Point2& p) {
-  if (!ray_crosses(a, b, p)) return 0;
-  return a[1] < b[1] ? 1 : -1;
-}
-
-int ring_winding(std::span<const Point2> ring, bool outer) {
-  std::size_t n = ring.size();
-  if (n > 1 && ring[0] == ring[n - 1]) --n;
-  if (n < 3) return 1;
-  // The lowest-leftmost vertex: the ring turns at it the way it runs, unless it doubles back.
-  std::size_t v = 0;
-  for (std::size_t i = 1; i < n; ++i)
-    if (ring[i][1] < ring[v][1] || (ring[i][1] == ring[v][1] && ring[i][0] < ring[v][0])) v = i;
-  std::size_t prev = v, next = v;
-  do
-    prev = prev == 0 ? n - 1 : prev - 1;
-  while (prev != v && ring[prev] == ring[v]);
-  do
-    next = next + 1 == n ? 0 : next + 1;
-  while (next != v && ring[next] == ring[v]);
-  // A ring through that vertex twice (touching itself there) turns there once per visit, not
-  // necessarily the way it runs as a whole: the area decides.
-  std::size_t visits = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    visits += ring[i] == ring[v] && (i == 0 ? ring[n - 1] != ring[v] : ring[i - 1] != ring[v]);
-  bool ccw = true;
-  const Orientation o =
-      visits > 1 ? Orientation::collinear : orientation(ring[prev], ring[v], ring[next]);
-  if (o != Orientation::collinear) {
-    ccw = o == Orientation::counterclockwise;
-  } else {
-    // Twice the signed area (shoelace), relative to the first point for precision.
-    double area = 0;
-    for (std::size_t i = 1; i + 1 < n; ++i)
-      area += (ring[i][0] - ring[0][0]) * (ring[i + 1][1] - ring[0][1]) -
-              (ring[i + 1][0] - ring[0][0]) * (ring[i][1] - ring[0][1]);
-    ccw = !(area < 0);
-  }
-  return ccw == outer ? 1 : -1;
+void OddPolygons::toggle(std::uint32_t polygon) {
+  for (std::size_t i = 0; i < n_; ++i)
+    if (at(i) == polygon) {
+      at(i) = at(n_ - 1);
+      if (--n_ >= small_.size()) more_.pop_back();
+      return;
+    }
+  if (n_ < small_.size())
+    small_[n_] = polygon;
+  else
+    more_.push_back(polygon);
+  ++n_;
 }
 
 bool meets(const FlatGeometry& g, const Box2& box) {
@@ -522,27 +493,25 @@ double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bou
 // The grid. A ray from p towards +x crosses the ring edges of p's cell (tested exactly) and
 // ring edges lying entirely right of the cell: those whose leftmost cell column is greater
 // than p's. For such an edge e the crossing only depends on y: it happens exactly when
-// ylo(e) <= p.y < yhi(e), that is [ylo(e) <= p.y] - [yhi(e) <= p.y], and adds the edge's
-// direction as its ring is wound (+1 up, -1 down) to the winding number. Over the set S of
-// those edges in p's row, the sum is that of the shares of the end values (ylo with the
-// direction, yhi with its opposite, for every edge of S) at most p.y. A value below the row
-// counts for every p of the row (it goes into the cell's base), a value above it never, and
-// shares at one value are summed: a vertex between two edges of S going on the same way
-// cancels. What is left per cell is a handful of values (where the boundary passes from the
-// cell's side of the row to its right), sorted for a binary search, with the running sum of
-// their shares. Rows and columns are compared through the same monotone functions row() and
-// col() that list the edges, so "below the row" and "right of the cell" are exact statements
-// about the coordinates.
+// ylo(e) <= p.y < yhi(e), whose parity is [ylo(e) <= p.y] xor [yhi(e) <= p.y]. Over the set S
+// of those edges of one polygon in p's row, that polygon's parity is that of the number of end
+// values (ylo and yhi of every edge of S) at most p.y. A value below the row counts for every
+// p of the row (the polygons odd by those go into the cell's base), a value above it never,
+// and two equal values of one polygon cancel: a vertex between two edges of S appears twice.
+// What is left per cell is a handful of values, each with its polygon (where the boundary
+// passes from the cell's side of the row to its right), sorted. Rows and columns are compared
+// through the same monotone functions row() and col() that list the edges, so "below the row"
+// and "right of the cell" are exact statements about the coordinates.
 PreparedGeometry::PreparedGeometry(const FlatGeometry& g) : g_(&g), envelope_(g.envelope()) {
   for (const Part& part : g.parts) {
     if (part.end - part.begin == 1 || part.kind == PartKind::point) {
       for (std::uint32_t i = part.begin; i < part.end; ++i)
-        edges_.push_back({i, kPoint, 0});
+        edges_.push_back({i, 0, kPoint});
       continue;
     }
-    const std::uint16_t kind = part.kind == PartKind::ring ? kRing : kLine;
+    const std::uint32_t kind = part.kind == PartKind::ring ? kRing : kLine;
     for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-      edges_.push_back({i, kind, part.winding});
+      edges_.push_back({i, part.polygon, kind});
   }
   build(std::clamp<std::size_t>(edges_.size() / 2, 1, std::size_t(1) << 22));
 }
@@ -569,9 +538,9 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
   const double hair = point_at_rounding(s);
   if (t == 0 || t == 1 || !near_boundary(m, hair)) return locate(m);
   // The real point p lies within `hair` of m in x and y, and g passes that near: p is located
-  // by the winding number of the ring edges its rightward ray crosses, each decided exactly. An
-  // edge on p or crossing that ray meets p's row at or right of p, so it is listed in a cell of the
-  // rows m's y +- hair falls in, from m's x - hair rightwards.
+  // by the parity, polygon by polygon, of the ring edges its rightward ray crosses, each
+  // decided exactly. An edge on p or crossing that ray meets p's row at or right of p, so it
+  // is listed in a cell of the rows m's y +- hair falls in, from m's x - hair rightwards.
   const std::vector<Point2>& pts = g_->points;
   // The sign of v minus p's coordinate on `axis`, exactly; the rounded point decides when v
   // lies farther from it than the rounding.
@@ -580,8 +549,8 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
     if (v < m[axis] - hair) return -1;
     return -compare_coordinate_at(s, t, axis, v);
   };
-  long winding = 0;
-  // Whether p lies on edge k (then true), else its share of the winding number.
+  OddPolygons odd;
+  // Whether p lies on edge k (then true), else its effect on the parity.
   auto on_edge = [&](std::uint32_t k) {
     const Edge& e = edges_[k];
     const Point2& a = pts[e.first];
@@ -595,11 +564,9 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
     if (o == Orientation::collinear && x0 <= 0) return true;
     // Half-open in y, as ray_crosses: the crossing is right of p when p is left of the edge
     // directed upwards.
-    if (e.kind == kRing && (ya > 0) != (yb > 0)) {
-      const bool up = a[1] < b[1];
-      if (o == (up ? Orientation::counterclockwise : Orientation::clockwise))
-        winding += up ? e.winding : -e.winding;
-    }
+    if (e.kind == kRing && (ya > 0) != (yb > 0) &&
+        o == (a[1] < b[1] ? Orientation::counterclockwise : Orientation::clockwise))
+      odd.toggle(e.polygon);
     return false;
   };
   const std::uint32_t r0 = row(m[1] - hair), r1 = row(m[1] + hair);
@@ -610,13 +577,14 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
     const std::size_t cell = std::size_t(r0) * nx_ + c0;
     const double* v0 = values_.data() + value_start_[cell];
     const double* v1 = values_.data() + value_start_[cell + 1];
-    const double* v = std::lower_bound(v0, v1, m[1] - hair);
-    winding = base_[cell] + sum_before(cell, v - v0);
-    for (; v != v1 && *v <= m[1] + hair; ++v)
-      if (above(1, *v) <= 0) winding += sum_before(cell, v - v0 + 1) - sum_before(cell, v - v0);
+    for (std::uint32_t i = base_start_[cell]; i < base_start_[cell + 1]; ++i)
+      odd.toggle(base_[i]);
+    for (const double* v = v0; v != v1 && *v <= m[1] + hair; ++v)
+      if (*v < m[1] - hair || above(1, *v) <= 0)
+        odd.toggle(value_polygons_[value_start_[cell] + std::size_t(v - v0)]);
     for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i)
       if (on_edge(cell_edges_[i])) return Location::boundary;
-    return winding != 0 ? Location::inside : Location::outside;
+    return odd.any() ? Location::inside : Location::outside;
   }
   // Else every edge listed in those rows from c0 rightwards.
   for (std::uint32_t r = r0; r <= r1; ++r)
@@ -633,7 +601,7 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
         if (on_edge(cell_edges_[i])) return Location::boundary;
       }
     }
-  return winding != 0 ? Location::inside : Location::outside;
+  return odd.any() ? Location::inside : Location::outside;
 }
 
 std::uint32_t PreparedGeometry::col(double x) const {
@@ -707,24 +675,33 @@ void PreparedGeometry::build(std::size_t cells) {
     break;
   }
   // Per row, right to left: the ring edges whose leftmost column is right of the cell, as
-  // their end values, each with its share of the winding number about a point at or above it:
-  // an edge going up (as its ring is wound) crosses the ray from p when its lower end is at
-  // most p's y and its upper end is not, so its lower end counts +1 and its upper end -1 (the
-  // other way round going down). Shares of ends below the row go to the cell's base; ends in
-  // the row are kept as values, those at one y summed and dropped when they cancel.
+  // their end values with their polygons, those of one polygon at one y cancelling in pairs;
+  // an end below the row toggles its polygon in the cell's base.
   const std::size_t n = std::size_t(nx_) * ny_;
-  base_.assign(n, 0);
-  std::vector<std::vector<std::pair<double, std::int32_t>>> per_cell(nx_);
+  base_start_.assign(n + 1, 0);
+  base_.clear();
+  std::vector<std::vector<std::pair<double, std::uint32_t>>> per_cell(nx_);
+  std::vector<std::vector<std::uint32_t>> base_per_cell(nx_);
   value_start_.assign(n + 1, 0);
   values_.clear();
-  sums_.clear();
-  std::vector<std::pair<double, std::int32_t>> open;  // the values and their shares, not 0
+  value_polygons_.clear();
+  std::vector<std::pair<double, std::uint32_t>> open;  // each present an odd number of times
+  std::vector<std::uint32_t> odd;                      // the polygons odd by ends below the row
+  const auto toggle = [](auto& set, const auto& x) {
+    const auto it = std::find(set.begin(), set.end(), x);
+    if (it == set.end()) {
+      set.push_back(x);
+    } else {
+      *it = set.back();
+      set.pop_back();
+    }
+  };
   for (std::uint32_t r = 0; r < ny_; ++r) {
     open.clear();
-    std::int32_t base = 0;
+    odd.clear();
     for (std::uint32_t c = nx_; c-- > 0;) {
       const std::size_t cell = std::size_t(r) * nx_ + c;
-      base_[cell] = base;
+      base_per_cell[c] = odd;
       per_cell[c] = open;
       std::sort(per_cell[c].begin(), per_cell[c].end());
       // Then the edges starting in this cell join the set for the cells to its left.
@@ -733,49 +710,38 @@ void PreparedGeometry::build(std::size_t cells) {
         if (e.kind != kRing) continue;
         const Box2 b = box_of(e);
         if (col(b.min[0]) != c) continue;  // listed here, but starts in a cell to the left
-        const bool up = pts[e.first][1] < pts[e.first + 1][1];
-        const std::int32_t share = up ? e.winding : -e.winding;
-        for (const auto& [v, w] : {std::pair{b.min[1], share}, std::pair{b.max[1], -share}}) {
+        for (const double v : {b.min[1], b.max[1]}) {
           const std::uint32_t vr = row(v);
-          if (vr < r) {
-            base += w;
-          } else if (vr == r) {
-            const auto it = std::find_if(open.begin(), open.end(),
-                                         [v = v](const auto& o) { return o.first == v; });
-            if (it == open.end()) {
-              open.emplace_back(v, w);
-            } else if ((it->second += w) == 0) {
-              *it = open.back();
-              open.pop_back();
-            }
-          }
+          if (vr < r)
+            toggle(odd, e.polygon);
+          else if (vr == r)
+            toggle(open, std::pair{v, e.polygon});
         }
       }
     }
     for (std::uint32_t c = 0; c < nx_; ++c) {
-      std::int32_t sum = 0;
-      for (const auto& [v, w] : per_cell[c]) {
+      const std::size_t cell = std::size_t(r) * nx_ + c;
+      for (const auto& [v, polygon] : per_cell[c]) {
         values_.push_back(v);
-        sums_.push_back(sum += w);
+        value_polygons_.push_back(polygon);
       }
-      value_start_[std::size_t(r) * nx_ + c + 1] = std::uint32_t(values_.size());
+      value_start_[cell + 1] = std::uint32_t(values_.size());
+      base_.insert(base_.end(), base_per_cell[c].begin(), base_per_cell[c].end());
+      base_start_[cell + 1] = std::uint32_t(base_.size());
     }
   }
-}
-
-// The shares of the cell's values up to the k-th (0: none).
-std::int32_t PreparedGeometry::sum_before(std::size_t cell, std::size_t k) const {
-  return k == 0 ? 0 : sums_[value_start_[cell] + k - 1];
 }
 
 Location PreparedGeometry::locate(const Point2& p) const {
   if (!intersects(envelope_, p)) return Location::outside;
   const std::vector<Point2>& pts = g_->points;
   const std::size_t cell = std::size_t(row(p[1])) * nx_ + col(p[0]);
-  // The edges right of the cell: values at most p.y, plus the base.
-  const double* v0 = values_.data() + value_start_[cell];
-  const double* v1 = values_.data() + value_start_[cell + 1];
-  long winding = base_[cell] + sum_before(cell, std::upper_bound(v0, v1, p[1]) - v0);
+  // The edges right of the cell: the base, and the values at most p.y.
+  OddPolygons odd;
+  for (std::uint32_t i = base_start_[cell]; i < base_start_[cell + 1]; ++i)
+    odd.toggle(base_[i]);
+  for (std::uint32_t i = value_start_[cell]; i < value_start_[cell + 1] && values_[i] <= p[1]; ++i)
+    odd.toggle(value_polygons_[i]);
   for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
     const Edge& e = edges_[cell_edges_[i]];
     const Point2& a = pts[e.first];
@@ -788,9 +754,9 @@ Location PreparedGeometry::locate(const Point2& p) const {
     if (std::min(a[0], b[0]) <= p[0] && p[0] <= std::max(a[0], b[0]) &&
         orientation(a, b, p) == Orientation::collinear)
       return Location::boundary;
-    if (e.kind == kRing) winding += e.winding * ray_crossing(a, b, p);
+    if (e.kind == kRing && ray_crosses(a, b, p)) odd.toggle(e.polygon);
   }
-  return winding != 0 ? Location::inside : Location::outside;
+  return odd.any() ? Location::inside : Location::outside;
 }
 
 std::size_t PreparedGeometry::memory_bytes() const {
@@ -798,7 +764,8 @@ std::size_t PreparedGeometry::memory_bytes() const {
          (cell_start_.capacity() + cell_edges_.capacity() + value_start_.capacity()) *
              sizeof(std::uint32_t) +
          values_.capacity() * sizeof(double) +
-         (sums_.capacity() + base_.capacity()) * sizeof(std::int32_t);
+         (value_polygons_.capacity() + base_start_.capacity() + base_.capacity()) *
+             sizeof(std::uint32_t);
 }
 
 double distance(const FlatGeometry& g, const Point2& p) {

@@ -10,10 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <map>
 #include <memory>
-#include <span>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -330,7 +328,6 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
   if (linear) g = linear.get();
   add_points(g, out, what);
   std::uint32_t polygons = 0;
-  std::uint32_t last_polygon = std::numeric_limits<std::uint32_t>::max();
   walk(g, polygons, [&](const OGRSimpleCurve& c, bool ring, std::uint32_t polygon) {
     const int n = c.getNumPoints();
     if (n == 0) return;
@@ -342,12 +339,6 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
     }
     out.parts.push_back(
         {at, std::uint32_t(out.points.size()), ring ? PartKind::ring : PartKind::line, polygon});
-    if (ring) {
-      // A polygon's first ring is its outer ring, the others its holes.
-      out.parts.back().winding =
-          std::int8_t(ring_winding(std::span(out.points).subspan(at), polygon != last_polygon));
-      last_polygon = polygon;
-    }
   });
   out.polygons = polygons;
   return out;
@@ -356,31 +347,21 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what) {
 void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& path,
                   LayerItems& out) {
   std::int32_t part = 0;
-  std::uint32_t last_polygon = std::numeric_limits<std::uint32_t>::max();
-  std::vector<Point2> points;
   for_each_curve(g, [&](const OGRSimpleCurve& c, bool ring, std::uint32_t polygon) {
     const int n = c.getNumPoints();
-    points.resize(std::size_t(n));
-    for (int i = 0; i < n; ++i) {
-      points[std::size_t(i)] = {c.getX(i), c.getY(i)};
-      if (!within_coordinate_range(points[std::size_t(i)]))
-        check_layer_point(points[std::size_t(i)], where(path, fid));
-    }
-    // A ring's segments keep the direction its role winds it in (exact.hpp); a polygon's
-    // first ring is its outer ring, the others its holes.
-    int winding = 1;
-    if (ring && n > 0) {
-      winding = ring_winding(points, polygon != last_polygon);
-      last_polygon = polygon;
-    }
     // A curve of one point is that point: a segment of length zero, so that a per-segment
     // index answers for it as the feature's own geometry does.
     for (int i = 0; i + 1 < n || (i == 0 && n == 1); ++i) {
-      const Point2& a = points[std::size_t(i)];
-      const Point2& b = points[std::size_t(std::min(i + 1, n - 1))];
-      // The box keeps the segment when we also know which diagonal of it the segment is.
+      const int j = std::min(i + 1, n - 1);
+      const Point2 a{c.getX(i), c.getY(i)}, b{c.getX(j), c.getY(j)};
+      if (!within_coordinate_range(a) || !within_coordinate_range(b)) {
+        check_layer_point(a, where(path, fid));
+        check_layer_point(b, where(path, fid));
+      }
+      // The box keeps the segment when we also know which diagonal of it the segment is; a
+      // ring's segment, which polygon of the feature it bounds.
       out.boxes.push_back(Segment2{a, b}.box());
-      out.records.push_back({fid, part, segment_flags(a, b, ring, winding)});
+      out.records.push_back({fid, part, segment_flags(a, b, ring, polygon)});
     }
     ++part;
   });

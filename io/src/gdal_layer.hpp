@@ -97,7 +97,7 @@ FlatGeometry flatten(const OGRGeometry* g, const std::string& what);
 
 // The segments of g for a per-segment index, appended to `out` (what read_items gives per
 // segment): each line or ring's consecutive points, parts numbered in order, a ring's
-// segments wound as its role gives it (exact.hpp); a curve of one point and each isolated
+// segments with the number of the polygon it bounds; a curve of one point and each isolated
 // point as a segment of length zero. Refuses a coordinate out of range.
 void add_segments(const OGRGeometry* g, std::int64_t fid, const std::string& path, LayerItems& out);
 

@@ -486,21 +486,21 @@ LayerIndex::Features LayerIndex::build_features(const PackedRTree2* t, Per per,
   return f;
 }
 
-// The ring segments crossing the ray from p towards +x, their winding number per feature.
+// The ring segments crossing the ray from p towards +x, counted per polygon of each feature.
 std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p) {
   std::vector<std::int64_t> out;
   if (!index.has_polygons() || index.size() == 0 || p[0] > index.bounds().max[0]) return out;
   const Box2 ray{p, {index.bounds().max[0], p[1]}};
-  std::unordered_map<std::int64_t, long> winding;
+  std::unordered_map<std::int64_t, OddPolygons> odd;
   index.window(ray, [&](const ItemRecord& r, const Box2& b) {
     if (r.flags & item_ring) {
-      const Segment2 s = wound_segment_of(b, r.flags);
-      if (const int w = ray_crossing(s.a, s.b, p)) winding[r.fid] += w;
+      const Segment2 s = segment_of(b, r.flags);
+      if (ray_crosses(s.a, s.b, p)) odd[r.fid].toggle(polygon_of(r.flags));
     }
     return true;
   });
-  for (const auto& [fid, w] : winding)
-    if (w != 0) out.push_back(fid);
+  for (const auto& [fid, o] : odd)
+    if (o.any()) out.push_back(fid);
   return out;
 }
 
@@ -510,8 +510,7 @@ namespace {
 // feature whose box holds p can contain it. Its rings are counted along the axis direction
 // that leaves its box soonest, through its own hierarchy: no other feature's segments are
 // read. Each direction is a map that turns it into +x (reflections and swaps of coordinates
-// are exact), and ray_crossing decides on the mapped points as it does for +x (a reflection
-// negates every share, so whether the sum is zero does not change).
+// are exact), and ray_crosses decides on the mapped points as it does for +x.
 std::vector<std::uint32_t> containing_features(const LayerIndex& index, const Point2& p,
                                                const LayerIndex::Features& features) {
   std::vector<std::uint32_t> out;
@@ -544,7 +543,7 @@ std::vector<std::uint32_t> containing_features(const LayerIndex& index, const Po
                                 : Box2{{p[0], reach.min[1]}, p};
     const Point2 mp = map(p);
     const std::int64_t fid = features.fid_of(top.feature);
-    long winding = 0;  // about mp, of the mapped rings (a reflection negates it)
+    OddPolygons odd;
     stack.assign(1, root);
     while (!stack.empty()) {
       const auto [level, i] = stack.back();
@@ -564,11 +563,11 @@ std::vector<std::uint32_t> containing_features(const LayerIndex& index, const Po
         if (!intersects(b, ray)) continue;
         const ItemRecord* r = features.record(features.leaf_items(node.first)[pos - first]);
         if (!r || r->fid != fid || !(r->flags & item_ring)) continue;
-        const Segment2 s = wound_segment_of(b, r->flags);
-        winding += ray_crossing(map(s.a), map(s.b), mp);
+        const Segment2 s = segment_of(b, r->flags);
+        if (ray_crosses(map(s.a), map(s.b), mp)) odd.toggle(polygon_of(r->flags));
       }
     }
-    if (winding != 0) out.push_back(top.feature);
+    if (odd.any()) out.push_back(top.feature);
     return true;
   });
   return out;

@@ -463,13 +463,13 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
   return true;
 }
 
-bool ring_roles(const unsigned char* c, std::vector<std::uint8_t>& outer);
+bool ring_polygons(const unsigned char* c, std::vector<std::uint32_t>& polygon);
 
 // A record's segments, as a per-segment read through GDAL gives them: each line or ring's
 // consecutive points (parts numbered in file order), each point of a point or multipoint
-// shape, and a part of one point, as a zero-length segment; a ring's segments wound as its
-// role gives it. The record was read and checked by read_record. False, with nothing added,
-// for a polygon record whose rings only GDAL sorts (ring_roles).
+// shape, and a part of one point, as a zero-length segment; a ring's segments with the number
+// of the polygon it bounds. The record was read and checked by read_record. False, with
+// nothing added, for a polygon record whose rings only GDAL sorts (ring_polygons).
 
 bool add_record_segments(const unsigned char* c, std::uint32_t file_type, std::int64_t fid,
                          LayerItems& out) {
@@ -491,29 +491,24 @@ bool add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
     case Kind::polyline_or_polygon: {
       const std::uint32_t parts = le32(c + 36), n = le32(c + 40);
       const bool ring = is_polygon_type(file_type);
-      // Each ring's role as the driver sorts the rings (one ring is its polygon's outer
-      // ring), for the way it is wound (exact.hpp).
-      static thread_local std::vector<std::uint8_t> outer;
-      static thread_local std::vector<Point2> points;
-      outer.assign(parts, 1);
-      if (ring && parts > 1 && !ring_roles(c, outer)) return false;
+      // The polygon each ring bounds, as the driver sorts the rings.
+      static thread_local std::vector<std::uint32_t> polygon;
+      polygon.assign(parts, 0);
+      if (ring && parts > 1 && !ring_polygons(c, polygon)) return false;
       const unsigned char* xy = c + 44 + 4 * std::uint64_t(parts);
       for (std::uint32_t k = 0; k < parts; ++k) {
         const std::uint32_t begin = le32(c + 44 + 4 * std::uint64_t(k)),
                             end = k + 1 < parts ? le32(c + 48 + 4 * std::uint64_t(k)) : n;
-        points.clear();
-        for (std::uint32_t i = begin; i < end; ++i)
-          points.push_back(point(xy + 16 * std::uint64_t(i)));
-        const int winding = ring ? ring_winding(points, outer[k] != 0) : 1;
-        if (points.size() == 1) {  // a part of one point is that point
-          out.boxes.push_back(Box2::of_point(points[0]));
-          out.records.push_back({fid, std::int32_t(k), segment_flags(points[0], points[0], ring)});
+        Point2 a = point(xy + 16 * std::uint64_t(begin));
+        if (end - begin == 1) {  // a part of one point is that point
+          out.boxes.push_back(Box2::of_point(a));
+          out.records.push_back({fid, std::int32_t(k), segment_flags(a, a, ring, polygon[k])});
         }
-        for (std::size_t i = 1; i < points.size(); ++i) {
-          const Point2& a = points[i - 1];
-          const Point2& b = points[i];
+        for (std::uint32_t i = begin + 1; i < end; ++i) {
+          const Point2 b = point(xy + 16 * std::uint64_t(i));
           out.boxes.push_back(Segment2{a, b}.box());
-          out.records.push_back({fid, std::int32_t(k), segment_flags(a, b, ring, winding)});
+          out.records.push_back({fid, std::int32_t(k), segment_flags(a, b, ring, polygon[k])});
+          a = b;
         }
       }
       break;
@@ -789,25 +784,29 @@ std::optional<Organized> organize(const PolygonRings& r, const std::vector<std::
   return out;
 }
 
-// The role of each ring of a polygon record of several rings as the driver sorts them: its
-// clockwise rings are outer rings (1), its counterclockwise ones holes (0) of the outer ring
-// holding them, or outer rings of polygons of their own where none does. False, for GDAL to
-// read the record, when organize() leaves the sorting to GDAL, unless every ring runs
-// clockwise.
-bool ring_roles(const unsigned char* c, std::vector<std::uint8_t>& outer) {
+// The polygon each ring of a polygon record of several rings bounds, as the driver sorts the
+// rings and numbers the polygons (in the order of their outer rings): its clockwise rings are
+// outer rings, its counterclockwise ones holes of the outer ring holding them, or polygons of
+// their own where none does. False, for GDAL to read the record, when organize() leaves the
+// sorting to GDAL, unless every ring runs clockwise.
+bool ring_polygons(const unsigned char* c, std::vector<std::uint32_t>& polygon) {
   const PolygonRings r(c);
   const std::vector<std::int8_t> cw = orientations(r);
-  outer.assign(r.parts, 1);
-  if (std::all_of(cw.begin(), cw.end(), [](std::int8_t o) { return o == 1; })) return true;
-  if (const char* type = polygon_type(r, cw); type && std::strcmp(type, "Polygon") == 0) {
-    for (std::uint32_t k = 0; k < r.parts; ++k)  // one outer ring holding all the others
-      outer[k] = cw[k] == 1;
+  polygon.assign(r.parts, 0);
+  if (std::all_of(cw.begin(), cw.end(), [](std::int8_t o) { return o == 1; })) {
+    for (std::uint32_t k = 0; k < r.parts; ++k)
+      polygon[k] = k;
     return true;
   }
+  if (const char* type = polygon_type(r, cw); type && std::strcmp(type, "Polygon") == 0)
+    return true;  // one outer ring holding all the others
   const auto organized = organize(r, cw);
   if (!organized) return false;
+  std::uint32_t next = 0;
   for (std::uint32_t k = 0; k < r.parts; ++k)
-    outer[k] = organized->owner[k] == kNone;
+    if (organized->owner[k] == kNone) polygon[k] = next++;
+  for (std::uint32_t k = 0; k < r.parts; ++k)
+    if (organized->owner[k] != kNone) polygon[k] = polygon[organized->owner[k]];
   return true;
 }
 

@@ -402,7 +402,7 @@ TEST(LayerNearest, OneQueryReadsAFewChunksOfTheStoredHierarchies) {
 // Polygons per segment: features of one to three rings (star-shaped, vertices on an integer
 // grid so that rays from grid points run through vertices and along edges; the second ring a
 // hole in the first, the third another polygon, which may overlap the first), overlapping each
-// other; rings run either way, their records carrying the way their role winds them.
+// other; rings run either way, their records carrying their polygon's number.
 struct Polygons {
   LayerItems items;
   struct Edge {
@@ -437,13 +437,13 @@ Polygons star_polygons(int features, std::uint64_t seed) {
                         double(oy + int(std::lround(len * std::sin(a))))});
       }
       if ((f + r) % 2) std::reverse(ring.begin(), ring.end());
-      const int winding = ring_winding(ring, r != 1);
+      const int polygon = r == 2 ? 1 : 0;
       for (int i = 0; i < n; ++i) {
         const Point2 a = ring[i], b = ring[(i + 1) % n];
         const Segment2 s{a, b};
         l.items.boxes.push_back(s.box());
-        l.items.records.push_back({fid, 0, segment_flags(a, b, true, winding)});
-        l.rings.push_back({fid, r == 2 ? 1 : 0, s});
+        l.items.records.push_back({fid, 0, segment_flags(a, b, true, std::uint32_t(polygon))});
+        l.rings.push_back({fid, polygon, s});
       }
     }
   }

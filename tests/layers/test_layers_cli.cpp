@@ -1365,7 +1365,9 @@ TEST_F(LayersCli, OverlappingPolygonsOfOneFeatureHoldTheirOverlap) {
          "4,\"POLYHEDRALSURFACE Z (((60 0 0, 60 10 0, 70 10 0, 70 0 0, 60 0 0)), "
          "((60 0 5, 70 0 5, 70 10 5, 60 10 5, 60 0 5)), ((60 0 0, 70 0 0, 70 0 5, 60 0 5, 60 0 "
          "0)))\"\n"
-         "5,\"TIN (((80 0, 90 0, 80 10, 80 0)), ((80 0, 90 10, 80 10, 80 0)))\"\n";
+         "5,\"TIN (((80 0, 90 0, 80 10, 80 0)), ((80 0, 90 10, 80 10, 80 0)))\"\n"
+         "6,\"MULTIPOLYGON (((100 0, 110 0, 110 10, 100 10, 100 0)), ((120 0, 130 0, 130 10, "
+         "120 10, 120 0), (102 2, 102 4, 104 4, 104 2, 102 2)))\"\n";
   fs::remove(gpkg);
   ASSERT_EQ(std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + csv +
                          " -nln overlaps -oo GEOM_POSSIBLE_NAMES=WKT -oo KEEP_GEOM_COLUMNS=NO "
@@ -1383,9 +1385,10 @@ TEST_F(LayersCli, OverlappingPolygonsOfOneFeatureHoldTheirOverlap) {
       {"--bbox 26.5,7,29,9", "2\n"},
       {"--point 45,5", ""},  // in the hole running as its outer ring does
       {"--point 41,1", "3\n"},
-      {"--point 65,5", "4\n"},  // under the roof, over the floor
-      {"--point 82,5", "5\n"},  // in both faces
-      {"--point 88,9", "5\n"},  // in the second face only
+      {"--point 65,5", "4\n"},   // under the roof, over the floor
+      {"--point 82,5", "5\n"},   // in both faces
+      {"--point 88,9", "5\n"},   // in the second face only
+      {"--point 103,3", "6\n"},  // in the first polygon, under the second's stray hole
       {"--point 95,5", ""}};
   for (const char* per : {"feature", "segment"})
     for (const auto& [query, want] : cases) {
@@ -1818,7 +1821,7 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
   expect_error(query, "damaged index");
   // Sidecars of earlier formats: 2 (nearest-n built the hierarchies at every run), 3 (their
   // level-0 nodes did not say which of the leaf's slots are the feature's), 4 (ring segments
-  // without the direction their ring is wound in).
+  // without the number of the polygon their ring bounds).
   for (const int version : {2, 3, 4}) {
     std::string older = good;
     older[8] = char(version);

@@ -1,4 +1,4 @@
-// PreparedGeometry::locate (the grid of cells with per-cell winding values) against brute force
+// PreparedGeometry::locate (the grid of cells with per-cell parity values) against brute force
 // (every edge through the exact predicates, each polygon by its own crossing parity) on random
 // polygons with holes (their rings running either way), multi-polygons,
 // overlapping polygons, lines and isolated points, with integer coordinates so that points fall
@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <span>
 #include <utility>
 #include <vector>
 
@@ -48,20 +47,14 @@ Location brute(const FlatGeometry& g, const Point2& p) {
   return Location::outside;
 }
 
-// Adds a ring to polygon `polygon` (its outer ring when it is the polygon's first), its points
-// in the order given or reversed: the winding is taken from the role, not the order.
+// Adds a ring to polygon `polygon`, its points in the order given or reversed.
 void add_ring(FlatGeometry& g, std::vector<Point2> ring, std::uint32_t polygon,
               bool reversed = false) {
   if (reversed) std::reverse(ring.begin(), ring.end());
   const auto begin = std::uint32_t(g.points.size());
   g.points.insert(g.points.end(), ring.begin(), ring.end());
   g.points.push_back(ring.front());
-  bool outer = true;
-  for (const Part& part : g.parts)
-    if (part.kind == PartKind::ring && part.polygon == polygon) outer = false;
   g.parts.push_back({begin, std::uint32_t(g.points.size()), PartKind::ring, polygon});
-  g.parts.back().winding =
-      std::int8_t(ring_winding(std::span<const Point2>(g.points).subspan(begin), outer));
 }
 
 // A star-shaped ring around c with `n` integer vertices within radius r.
@@ -164,24 +157,27 @@ TEST(PreparedGeometry, OverlappingPolygonsLinesAndPoints) {
     EXPECT_EQ(prepared.locate_at({{p[0] - 0.5, p[1]}, {p[0] + 0.5, p[1]}}, 0.5), Location::inside);
 }
 
-// A ring through its lowest-leftmost vertex twice (two lobes touching there) runs as its area
-// says, not as it turns at its first visit there: its hole stays a hole.
-TEST(PreparedGeometry, ARingTouchingItselfAtItsLowestVertexWindsByItsArea) {
-  const std::vector<Point2> lobes = {{4, 1}, {4, 3}, {0, 0}, {-4, 3}, {-4, 1}, {0, 0}, {4, 1}};
-  EXPECT_EQ(ring_winding(lobes, true), 1);
-  EXPECT_EQ(ring_winding(lobes, false), -1);
-  std::vector<Point2> reversed(lobes.rbegin(), lobes.rend());
-  EXPECT_EQ(ring_winding(reversed, true), -1);
-  for (const bool flip : {false, true}) {
-    FlatGeometry g;
-    add_ring(g, {lobes.begin(), lobes.end() - 1}, 0, flip);
-    add_ring(g, {{3.5, 1.5}, {3.5, 2}, {3.9, 2}, {3.9, 1.5}}, 0, !flip);
-    g.polygons = 1;
-    const PreparedGeometry prepared(g);
-    EXPECT_EQ(prepared.locate({3.7, 1.7}), Location::outside) << flip;  // in the hole
-    EXPECT_EQ(prepared.locate({3, 1.3}), Location::inside) << flip;
-    EXPECT_EQ(prepared.locate({-3, 1.3}), Location::inside) << flip;
-  }
+// Polygons of one feature whose holes lie outside their own outer ring or overlap each other
+// (invalid): each polygon by its own parity, a point is inside when any polygon holds it.
+TEST(PreparedGeometry, InvalidPolygonsCountPolygonByPolygon) {
+  std::mt19937_64 rng(39);
+  FlatGeometry g;
+  add_ring(g, {{0, 0}, {10, 0}, {10, 10}, {0, 10}}, 0);
+  add_ring(g, {{20, 0}, {30, 0}, {30, 10}, {20, 10}}, 1);
+  add_ring(g, {{2, 2}, {2, 4}, {4, 4}, {4, 2}}, 1);  // polygon 1's hole, inside polygon 0
+  add_ring(g, {{5, 12}, {30, 12}, {30, 22}, {5, 22}}, 2);
+  add_ring(g, {{6, 14}, {9, 14}, {9, 20}, {6, 20}}, 2);  // two holes that overlap
+  add_ring(g, {{7, 15}, {9.5, 15}, {9.5, 19}, {7, 19}}, 2, true);
+  add_ring(g, {{0, 12}, {10, 12}, {10, 22}, {0, 22}}, 3);  // over polygon 2's holes
+  g.polygons = 4;
+  expect_same(g, rng, -1, 31, "invalid polygons");
+  const PreparedGeometry prepared(g);
+  EXPECT_EQ(prepared.locate({3, 3}), Location::inside);    // polygon 0 (and 1's hole)
+  EXPECT_EQ(prepared.locate({8, 17}), Location::inside);   // polygon 3 (2's two holes)
+  EXPECT_EQ(prepared.locate({25, 5}), Location::inside);   // polygon 1
+  EXPECT_EQ(prepared.locate({12, 5}), Location::outside);  // between them
+  for (const Point2& p : {Point2{3, 3}, Point2{8, 17}})
+    EXPECT_EQ(prepared.locate_at({{p[0] - 0.5, p[1]}, {p[0] + 0.5, p[1]}}, 0.5), Location::inside);
 }
 
 TEST(PreparedGeometry, LongDiagonalEdgesAndManySmallRings) {

@@ -509,8 +509,8 @@ void expect_polygons_like_gdal(const std::string& path, int* built_out) {
     if (g && ref) EXPECT_EQ(wkb(*g), wkb(*ref)) << "feature " << fid;
   }
   *built_out = built;
-  // The per-segment read winds each ring as the role GDAL's sorting gives it (or leaves the
-  // layer to GDAL).
+  // The per-segment read numbers each ring's polygon as GDAL's sorting does (or leaves the
+  // record to GDAL).
   if (const auto segments = loci::io::read_shapefile_segments(path))
     expect_segments_like_gdal(path, *segments);
 }

@@ -4,28 +4,27 @@
 // A layer's features arrive from GDAL in many shapes (points, lines, polygons with holes,
 // multi-geometries, collections). For refinement only three kinds of part matter: isolated
 // points, line strings, and polygon rings, the latter grouped by the polygon they bound so
-// that holes are handled by their winding. Keeping them as one vector of points plus part
+// that holes are handled polygon by polygon. Keeping them as one vector of points plus part
 // ranges costs one allocation per feature and keeps the tests simple loops.
 //
 // Predicates are exact: a geometry meets a box, a segment or a point when one of its points
 // lies in it, one of its edges meets it (loci's exact box/segment and segment/segment tests),
-// or one of its polygons contains a point of it (a winding number decided with the exact
-// orientation predicate; a point on a ring is caught by the edge test, not by the count).
-// Each ring is wound as its polygon's role gives it, whatever order its points come in: an
-// outer ring counterclockwise, a hole clockwise (Part::winding). A point is inside when the
-// winding number of all the feature's rings about it is not zero: inside any polygon of the
-// feature, also where polygons of one feature overlap (a collection of overlapping polygons,
-// faces of a surface overlapping in plan, an invalid multi-polygon), as long as each hole lies
-// in its outer ring.
+// or one of its polygons contains a point of it (crossing parity decided with the exact
+// orientation predicate; a point on a ring is caught by the edge test, not by parity). Parity
+// is kept polygon by polygon (a polygon's rings by the even-odd rule), and a point is inside
+// the feature when it is inside any of its polygons: also where polygons of one feature
+// overlap (a collection of overlapping polygons, faces of a surface overlapping in plan, an
+// invalid multi-polygon), whichever way the rings run and wherever an invalid polygon's holes
+// lie.
 // Touching counts. Distances are computed in floating point and are 0 inside a polygon; a
 // point's distance is 0 exactly when the point lies on the geometry, and whether it is within
 // a distance is decided exactly.
 // Thread-safety: plain values; the functions are pure.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
-#include <span>
 #include <vector>
 
 #include "loci/geom/box.hpp"
@@ -40,9 +39,6 @@ struct Part {
   std::uint32_t end;    // one past the last
   PartKind kind;
   std::uint32_t polygon;  // rings only: which polygon of the feature the ring bounds
-  // Rings only: +1 when the points run as the ring's role winds it (an outer ring
-  // counterclockwise, a hole clockwise), -1 when they run the other way (ring_winding()).
-  std::int8_t winding = 1;
 };
 
 struct FlatGeometry {
@@ -108,9 +104,10 @@ enum class Location : std::uint8_t { outside, boundary, inside };
 
 // A geometry prepared for many point tests: a grid of cells over its envelope, each listing
 // the edges whose boxes overlap it, and for each cell what the edges entirely to its right
-// contribute to the winding number about any point of the cell (a few y values, each with
-// its share; see exact.cpp). A test reads one cell: its edges decide exactly (boundary,
-// crossings within the cell) and a binary search in its values gives the rest, so that the cost is
+// contribute to the crossing parity of each polygon for a ray from any point of the cell (the
+// polygons odd along the whole row, and a few y values, each with its polygon; see exact.cpp).
+// A test reads one cell: its edges decide exactly (boundary, crossings within the cell) and
+// its values at most the point's y give the rest, so that the cost is
 // the edges near the point, not those along its whole row (what GEOS's prepared polygons scan,
 // through an interval tree on y). The pair tests below take prepared geometries so that a
 // feature met by many others (a joined layer) is prepared once and each pair costs the edges
@@ -134,15 +131,14 @@ class PreparedGeometry {
 
  private:
   struct Edge {
-    std::uint32_t first;   // the edge runs from points[first] to points[first + 1]
-    std::uint16_t kind;    // kRing, kLine, or kPoint (an isolated point: first only)
-    std::int16_t winding;  // rings: the ring's Part::winding
+    std::uint32_t first;    // the edge runs from points[first] to points[first + 1]
+    std::uint32_t polygon;  // rings: the polygon the ring bounds
+    std::uint32_t kind;     // kRing, kLine, or kPoint (an isolated point: first only)
   };
-  static constexpr std::uint16_t kRing = 0, kLine = 1, kPoint = 2;
+  static constexpr std::uint32_t kRing = 0, kLine = 1, kPoint = 2;
   std::uint32_t col(double x) const;
   std::uint32_t row(double y) const;
   void build(std::size_t cells);
-  std::int32_t sum_before(std::size_t cell, std::size_t k) const;
 
   const FlatGeometry* g_;
   Box2 envelope_;
@@ -152,8 +148,9 @@ class PreparedGeometry {
   std::vector<std::uint32_t> cell_start_, cell_edges_;  // CSR: the edges meeting each cell
   std::vector<std::uint32_t> value_start_;              // CSR into values_, per cell
   std::vector<double> values_;
-  std::vector<std::int32_t> sums_;  // per value: the shares of the cell's values up to it
-  std::vector<std::int32_t> base_;  // per cell: the winding number the values do not carry
+  std::vector<std::uint32_t> value_polygons_;     // per value: its polygon
+  std::vector<std::uint32_t> base_start_, base_;  // CSR, per cell: the polygons odd along
+                                                  // the whole row right of it
 };
 
 // The pair tests above on prepared geometries (the same answers).
@@ -170,14 +167,21 @@ double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bou
 // Crossing parity of the horizontal ray from p towards +x against the edge a-b, decided
 // exactly; half-open in y so that a ray through a vertex counts once.
 bool ray_crosses(const Point2& a, const Point2& b, const Point2& p);
-// The edge a-b's share of the winding number about p: +1 when it crosses the ray from p
-// towards +x going up (a below b), -1 going down, 0 when it does not cross (as ray_crosses).
-int ray_crossing(const Point2& a, const Point2& b, const Point2& p);
-// Part::winding for a ring of the given role (outer: the first ring of its polygon): +1 when
-// its points run counterclockwise for an outer ring or clockwise for a hole, else -1. The
-// orientation is decided exactly at the ring's lowest-leftmost vertex (the signed area decides
-// when the ring doubles back there or passes through it twice; a ring of no area counts as
-// counterclockwise). `ring` may or may not repeat its first point at the end.
-int ring_winding(std::span<const Point2> ring, bool outer);
+
+// The polygons of one feature whose rings a ray crosses an odd number of times, kept as the
+// crossings come (toggle()): the ray's start is inside the feature when any is.
+class OddPolygons {
+ public:
+  void toggle(std::uint32_t polygon);
+  bool any() const { return n_ > 0; }
+
+ private:
+  std::uint32_t& at(std::size_t i) {
+    return i < small_.size() ? small_[i] : more_[i - small_.size()];
+  }
+  std::size_t n_ = 0;
+  std::array<std::uint32_t, 8> small_{};
+  std::vector<std::uint32_t> more_;  // beyond small_
+};
 
 }  // namespace loci::io

@@ -5,7 +5,7 @@
 // A cell is classified from a per-segment index alone: it is boundary when some segment meets
 // the closed cell (an index window query, then the exact box/segment test, stopping at the
 // first hit); otherwise no linework crosses it, so the whole cell lies in one face of the
-// layer and its centre decides, by the winding number along a ray (containing_polygons). Points
+// layer and its centre decides, by crossing parity along a ray (containing_polygons). Points
 // (kept as zero-length segments) mark the cells they lie in. The answer is exact: a cell
 // touched at one corner by a segment is boundary.
 #pragma once

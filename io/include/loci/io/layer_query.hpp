@@ -16,8 +16,8 @@
 // tests of exact.hpp. Per segment, the entries are the linework itself (a segment is its box
 // plus one bit saying which diagonal it is), so the exact tests run on the index alone and
 // the layer is never opened for `-f ids`; a polygon that contains the query without its rings
-// meeting it is found by the winding number of the ring segments a horizontal ray crosses
-// (itself an index query), each wound as its ring's role gives it (exact.hpp).
+// meeting it is found by crossing parity along a horizontal ray (itself an index query),
+// polygon by polygon: each ring segment carries its polygon's number.
 //
 // Nearest-n browses entry boxes by increasing distance (the trees' browse()) and refines with
 // exact distances: a feature is final once its exact distance is no larger than the box
@@ -256,8 +256,8 @@ class LayerIndex {
   std::span<const std::uint32_t> mapped_items_;      // and its tree's item indices
 };
 
-// Features of a per-segment index whose polygons contain p (the winding number of all rings
-// of a feature is not zero, as exact.hpp counts it); empty for a per-feature index or a layer
+// Features of a per-segment index one of whose polygons contains p (the crossing parity of
+// that polygon's rings, as exact.hpp counts it); empty for a per-feature index or a layer
 // without polygons. A point on a ring
 // may or may not count: callers test the rings themselves first.
 std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Point2& p);

@@ -44,9 +44,9 @@
 // checksum over the whole payload, hashed on every open), format 2 (no hierarchies: every
 // nearest-n run read all the records to build them), format 3 (level-0 nodes without their
 // slots: nearest-n read an item index and a record for every box it measured) and format 4
-// (ring segments without item_reversed: polygons of a feature were counted by the even-odd
-// rule, so that where two overlapped the overlap was outside) are refused with the usual
-// message.
+// (ring segments without their polygon: the rings of a feature were counted together by the
+// even-odd rule, so that where two polygons overlapped the overlap was outside) are refused
+// with the usual message.
 //
 // Fingerprint. The index is valid for the exact bytes it was built from: at index time the
 // source's size, modification time (nanoseconds), inode and a 64-bit XXH3 hash of its contents
@@ -88,10 +88,9 @@ static_assert(sizeof(ItemRecord) == 16);
 enum ItemFlags : std::uint32_t {
   item_ring = 1u,          // the segment lies on a polygon ring
   item_antidiagonal = 2u,  // the segment runs from (min x, max y) to (max x, min y) of its box
-  // On a ring: the ring, wound as its role winds it (an outer ring counterclockwise, a hole
-  // clockwise: exact.hpp, Part::winding), runs from segment_of()'s second point to its first.
-  item_reversed = 4u,
 };
+// On a ring, the bits above those two number the polygon of the feature the ring bounds.
+constexpr int kItemPolygonShift = 2;
 
 // The segment an entry of a per-segment index stands for, recovered from its box and flags.
 inline Segment2 segment_of(const Box2& box, std::uint32_t flags) {
@@ -99,21 +98,17 @@ inline Segment2 segment_of(const Box2& box, std::uint32_t flags) {
   return {box.min, box.max};
 }
 
-// The same segment in the direction its ring is wound (item_reversed), for winding numbers.
-inline Segment2 wound_segment_of(const Box2& box, std::uint32_t flags) {
-  const Segment2 s = segment_of(box, flags);
-  return flags & item_reversed ? Segment2{s.b, s.a} : s;
+// The polygon of its feature that a ring segment's ring bounds.
+inline std::uint32_t polygon_of(std::uint32_t flags) {
+  return flags >> kItemPolygonShift;
 }
 
-// The flags under which segment_of() gives back the segment from a to b (as a point set) and,
-// on a ring whose points run as its role winds it (winding +1) or the other way (-1),
-// wound_segment_of() its direction (a segment of length zero has none).
-inline std::uint32_t segment_flags(const Point2& a, const Point2& b, bool ring, int winding = 1) {
+// The flags under which segment_of() gives back the segment from a to b (as a point set), on
+// a ring of the feature's polygon `polygon` (below 2^30) when `ring`.
+inline std::uint32_t segment_flags(const Point2& a, const Point2& b, bool ring,
+                                   std::uint32_t polygon = 0) {
   const bool anti = (a[0] < b[0]) != (a[1] < b[1]) && a[0] != b[0] && a[1] != b[1];
-  // a is segment_of()'s first point: (min x, max y) on the antidiagonal, else the box's min.
-  const bool forward = anti ? a[0] < b[0] : a[0] <= b[0] && a[1] <= b[1];
-  return (ring ? item_ring : 0u) | (anti ? item_antidiagonal : 0u) |
-         (ring && a != b && forward != (winding > 0) ? item_reversed : 0u);
+  return (ring ? item_ring | polygon << kItemPolygonShift : 0u) | (anti ? item_antidiagonal : 0u);
 }
 
 // Granularity of an index: one entry per feature, or one per segment of the linework.
