@@ -520,6 +520,10 @@ Sidecar Sidecar::open(const std::string& path) {
   std::memcpy(&h, m->data, sizeof h);
   if (std::memcmp(h.magic, kMagic, 8) != 0) throw Error(path + ": not a loci index file");
   if (h.byte_order != kByteOrder) throw refuse("index written on a machine of other byte order");
+  if (h.version > kVersion && h.version < 1000)
+    throw Error(path + ": index format version " + std::to_string(h.version) +
+                ", written by a newer loci (this one reads " + std::to_string(kVersion) +
+                "); use that loci, or run 'loci index' to rebuild it");
   if (h.version != kVersion)
     throw refuse("index format version " + std::to_string(h.version) + ", this loci reads " +
                  std::to_string(kVersion));

@@ -1829,6 +1829,12 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
     expect_error(query, "index format version " + std::to_string(version) +
                             ", this loci reads 5; run 'loci index' to rebuild it");
   }
+  std::string newer = good;
+  newer[8] = char(6);
+  put(newer);
+  expect_error(query,
+               "index format version 6, written by a newer loci (this one reads 5); use "
+               "that loci, or run 'loci index' to rebuild it");
   put(good);
   EXPECT_EQ(run_loci(query).status, 0);
   const CliRun ok = run_loci("check " + sidecar);
