@@ -29,13 +29,19 @@ bool any_edge(const FlatGeometry& g, F&& f) {
 // boundary separately.
 bool inside_polygon(const FlatGeometry& g, const Point2& p) {
   if (g.polygons == 0) return false;
+  bool odd_one = false;  // one polygon: a count's parity
   OddPolygons odd;
   for (const Part& part : g.parts) {
     if (part.kind != PartKind::ring) continue;
     for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-      if (ray_crosses(g.points[i], g.points[i + 1], p)) odd.toggle(part.polygon);
+      if (ray_crosses(g.points[i], g.points[i + 1], p)) {
+        if (g.polygons == 1)
+          odd_one = !odd_one;
+        else
+          odd.toggle(part.polygon);
+      }
   }
-  return odd.any();
+  return g.polygons == 1 ? odd_one : odd.any();
 }
 
 }  // namespace
@@ -55,18 +61,17 @@ bool ray_crosses(const Point2& a, const Point2& b, const Point2& p) {
   return o == Orientation::counterclockwise;
 }
 
-void OddPolygons::toggle(std::uint32_t polygon) {
-  for (std::size_t i = 0; i < n_; ++i)
-    if (at(i) == polygon) {
-      at(i) = at(n_ - 1);
-      if (--n_ >= small_.size()) more_.pop_back();
-      return;
-    }
-  if (n_ < small_.size())
-    small_[n_] = polygon;
-  else
-    more_.push_back(polygon);
-  ++n_;
+bool OddPolygons::any() {
+  if (ids_.size() < 2) return !ids_.empty();
+  std::sort(ids_.begin(), ids_.end());
+  for (std::size_t i = 0; i < ids_.size();) {
+    std::size_t j = i + 1;
+    while (j < ids_.size() && ids_[j] == ids_[i])
+      ++j;
+    if ((j - i) & 1) return true;
+    i = j;
+  }
+  return false;
 }
 
 bool meets(const FlatGeometry& g, const Box2& box) {
@@ -149,23 +154,25 @@ namespace {
 struct Edges {
   std::vector<Segment2> segs;
   std::vector<Box2> boxes;
-  std::vector<bool> ring;  // the edge bounds a polygon
+  std::vector<bool> ring;              // the edge bounds a polygon
+  std::vector<std::uint32_t> polygon;  // which (rings only)
   Edges(const FlatGeometry& g, double grow, const Box2& window) {
-    auto add = [&](const Segment2& e, bool of_ring) {
+    auto add = [&](const Segment2& e, bool of_ring, std::uint32_t of_polygon) {
       const Box2 box = grow > 0 ? outset(e.box(), grow) : e.box();
       if (!intersects(box, window)) return;
       segs.push_back(e);
       boxes.push_back(box);
       ring.push_back(of_ring);
+      polygon.push_back(of_polygon);
     };
     for (const Part& part : g.parts) {
       if (part.end - part.begin == 1 || part.kind == PartKind::point) {
         for (std::uint32_t i = part.begin; i < part.end; ++i)
-          add({g.points[i], g.points[i]}, false);
+          add({g.points[i], g.points[i]}, false, 0);
         continue;
       }
       for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
-        add({g.points[i], g.points[i + 1]}, part.kind == PartKind::ring);
+        add({g.points[i], g.points[i + 1]}, part.kind == PartKind::ring, part.polygon);
     }
   }
 };
@@ -344,6 +351,21 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
     if (areas && ea.ring[j]) record(on_a, along_a, std::uint32_t(j), e);
     return true;
   });
+  if (areas && a.polygons > 1) {
+    // a's polygons cut each other's ring edges too, so that each piece lies wholly inside or
+    // outside every other polygon and its middle speaks for it (below).
+    const std::span<const Box2> boxes(ea.boxes);
+    join(boxes, boxes, [&](Id i, Id j) {
+      if (!ea.ring[i] || !ea.ring[j] || ea.polygon[i] == ea.polygon[j]) return true;
+      const SegmentIntersection x = intersection(ea.segs[i], ea.segs[j]);
+      if (x.kind == SegmentMeet::none) return true;
+      for (int k = 0; k < (x.kind == SegmentMeet::point ? 1 : 2); ++k) {
+        const double u = parameter(ea.segs[i], k == 0 ? x.a : x.b);
+        if (u > 0 && u < 1) on_a.push_back({std::uint32_t(i), u, u});
+      }
+      return true;
+    });
+  }
   std::sort(on_b.begin(), on_b.end());
   std::sort(on_a.begin(), on_a.end());
   // Calls f(t) for the middle of every piece of edge `edge` between its cuts that does not run
@@ -736,12 +758,22 @@ Location PreparedGeometry::locate(const Point2& p) const {
   if (!intersects(envelope_, p)) return Location::outside;
   const std::vector<Point2>& pts = g_->points;
   const std::size_t cell = std::size_t(row(p[1])) * nx_ + col(p[0]);
-  // The edges right of the cell: the base, and the values at most p.y.
+  // The edges right of the cell: the base, and the values at most p.y. With one polygon, a
+  // count's parity (the values by binary search); with several, the polygons noted.
+  const bool one = g_->polygons <= 1;
+  bool odd_one = false;
   OddPolygons odd;
-  for (std::uint32_t i = base_start_[cell]; i < base_start_[cell + 1]; ++i)
-    odd.toggle(base_[i]);
-  for (std::uint32_t i = value_start_[cell]; i < value_start_[cell + 1] && values_[i] <= p[1]; ++i)
-    odd.toggle(value_polygons_[i]);
+  const double* v0 = values_.data() + value_start_[cell];
+  const double* v1 = values_.data() + value_start_[cell + 1];
+  if (one) {
+    odd_one =
+        ((base_start_[cell + 1] - base_start_[cell]) ^ (std::upper_bound(v0, v1, p[1]) - v0)) & 1;
+  } else {
+    for (std::uint32_t i = base_start_[cell]; i < base_start_[cell + 1]; ++i)
+      odd.toggle(base_[i]);
+    for (const double* v = v0; v != v1 && *v <= p[1]; ++v)
+      odd.toggle(value_polygons_[value_start_[cell] + std::size_t(v - v0)]);
+  }
   for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
     const Edge& e = edges_[cell_edges_[i]];
     const Point2& a = pts[e.first];
@@ -754,9 +786,14 @@ Location PreparedGeometry::locate(const Point2& p) const {
     if (std::min(a[0], b[0]) <= p[0] && p[0] <= std::max(a[0], b[0]) &&
         orientation(a, b, p) == Orientation::collinear)
       return Location::boundary;
-    if (e.kind == kRing && ray_crosses(a, b, p)) odd.toggle(e.polygon);
+    if (e.kind == kRing && ray_crosses(a, b, p)) {
+      if (one)
+        odd_one = !odd_one;
+      else
+        odd.toggle(e.polygon);
+    }
   }
-  return odd.any() ? Location::inside : Location::outside;
+  return (one ? odd_one : odd.any()) ? Location::inside : Location::outside;
 }
 
 std::size_t PreparedGeometry::memory_bytes() const {

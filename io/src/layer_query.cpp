@@ -499,7 +499,7 @@ std::vector<std::int64_t> containing_polygons(const LayerIndex& index, const Poi
     }
     return true;
   });
-  for (const auto& [fid, o] : odd)
+  for (auto& [fid, o] : odd)
     if (o.any()) out.push_back(fid);
   return out;
 }

@@ -28,7 +28,7 @@ namespace loci::io {
 namespace {
 
 constexpr char kMagic[8] = {'\x89', 'L', 'O', 'C', 'I', '\r', '\n', '\x1a'};
-constexpr std::uint32_t kVersion = 5;
+constexpr std::uint32_t kVersion = 6;
 constexpr std::uint32_t kByteOrder = 0x01020304;
 constexpr std::uint8_t kStructurePackedRTree = 1;
 constexpr std::uint8_t kCoordFloat64 = 1;

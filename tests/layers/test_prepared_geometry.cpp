@@ -180,6 +180,20 @@ TEST(PreparedGeometry, InvalidPolygonsCountPolygonByPolygon) {
     EXPECT_EQ(prepared.locate_at({{p[0] - 0.5, p[1]}, {p[0] + 0.5, p[1]}}, 0.5), Location::inside);
 }
 
+// Many polygons stacked on one another (floor slabs of a polyhedral surface): inside all of
+// them is inside, as in one.
+TEST(PreparedGeometry, ManyStackedPolygons) {
+  std::mt19937_64 rng(40);
+  FlatGeometry g;
+  for (std::uint32_t k = 0; k < 60; ++k)
+    add_ring(g, {{0, 0}, {10, 0}, {10, 10}, {0, 10}}, k, k % 2);
+  g.polygons = 60;
+  expect_same(g, rng, -1, 11, "stacked");
+  const PreparedGeometry prepared(g);
+  EXPECT_EQ(prepared.locate({5, 5}), Location::inside);
+  EXPECT_EQ(prepared.locate({10.5, 5}), Location::outside);
+}
+
 TEST(PreparedGeometry, LongDiagonalEdgesAndManySmallRings) {
   // A huge thin triangle across many small squares: listing its edges in every cell of their
   // boxes would be quadratic, so the grid is made coarser; answers must not change.
@@ -476,6 +490,35 @@ TEST(PreparedGeometry, CoversOfOverlappingPolygonsAgainstLatticeEvidence) {
   }
   EXPECT_GT(covered, 150);
   EXPECT_GT(across, 50);  // covered only by two polygons together, or by their overlap
+}
+
+// Four rectangles in a pinwheel over a hole of a fifth leave a hole of their own: every edge
+// of theirs inside b is partly inside another of them and partly the feature's boundary (each
+// edge is cut where the others cross it, so that the boundary part is tested).
+TEST(PreparedGeometry, CoversSeesAHoleLeftByAPinwheelOfPolygons) {
+  FlatGeometry a, b;
+  const auto rect = [](FlatGeometry& g, double x0, double x1, double y0, double y1,
+                       std::uint32_t polygon) {
+    add_ring(
+        g, {{x0 + 0.5, y0 + 0.5}, {x1 + 0.5, y0 + 0.5}, {x1 + 0.5, y1 + 0.5}, {x0 + 0.5, y1 + 0.5}},
+        polygon);
+  };
+  rect(a, -10, 10, -10, 10, 0);
+  rect(a, -0.9, 1.9, -0.9, 1.9, 0);  // its hole
+  rect(a, -1, 4, -1, 0, 1);
+  rect(a, 1, 2, -1, 4, 2);
+  rect(a, -3, 2, 1, 2, 3);
+  rect(a, -1, 0, -3, 2, 4);
+  a.polygons = 5;
+  add_ring(b, {{-5, -5}, {5, -5}, {5, 5}, {-5, 5}}, 0);
+  b.polygons = 1;
+  const PreparedGeometry pa(a), pb(b);
+  EXPECT_EQ(pa.locate({1, 1}), Location::outside);
+  EXPECT_FALSE(covers(pa, pb));
+  // Filled by a sixth (its edges apart from theirs): covered.
+  rect(a, -0.3, 1.3, -0.3, 1.3, 5);
+  a.polygons = 6;
+  EXPECT_TRUE(covers(PreparedGeometry(a), pb));
 }
 
 TEST(PreparedGeometry, CoversWithHolesAgainstLatticeEvidence) {

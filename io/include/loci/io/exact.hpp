@@ -22,7 +22,6 @@
 // Thread-safety: plain values; the functions are pure.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -168,20 +167,16 @@ double distance(const PreparedGeometry& a, const PreparedGeometry& b, double bou
 // exactly; half-open in y so that a ray through a vertex counts once.
 bool ray_crosses(const Point2& a, const Point2& b, const Point2& p);
 
-// The polygons of one feature whose rings a ray crosses an odd number of times, kept as the
-// crossings come (toggle()): the ray's start is inside the feature when any is.
+// The polygons of one feature whose rings a ray crosses an odd number of times: the crossings
+// are noted as they come (toggle()), and the ray's start is inside the feature when one
+// polygon was crossed an odd number of times (any(), which sorts what was noted).
 class OddPolygons {
  public:
-  void toggle(std::uint32_t polygon);
-  bool any() const { return n_ > 0; }
+  void toggle(std::uint32_t polygon) { ids_.push_back(polygon); }
+  bool any();
 
  private:
-  std::uint32_t& at(std::size_t i) {
-    return i < small_.size() ? small_[i] : more_[i - small_.size()];
-  }
-  std::size_t n_ = 0;
-  std::array<std::uint32_t, 8> small_{};
-  std::vector<std::uint32_t> more_;  // beyond small_
+  std::vector<std::uint32_t> ids_;
 };
 
 }  // namespace loci::io

@@ -1,7 +1,7 @@
 // The sidecar index file (`LAYER.loci`, DESIGN.md section 7): a packed R-tree over a layer's
 // features or segments, saved so that later queries map it into memory and search it in place.
 //
-// Layout (little-endian, every offset a multiple of 64 from the start of the file), format 5:
+// Layout (little-endian, every offset a multiple of 64 from the start of the file), format 6:
 //
 //   0    header, 256 bytes (SidecarHeader in sidecar.cpp): magic "\x89LOCI\r\n\x1a", format
 //        version, byte-order mark, structure kind, packing, coordinate type, granularity (per
@@ -43,10 +43,11 @@
 // forged with valid checksums cannot make a query read outside the mapping. Format 1 (one
 // checksum over the whole payload, hashed on every open), format 2 (no hierarchies: every
 // nearest-n run read all the records to build them), format 3 (level-0 nodes without their
-// slots: nearest-n read an item index and a record for every box it measured) and format 4
+// slots: nearest-n read an item index and a record for every box it measured), format 4
 // (ring segments without their polygon: the rings of a feature were counted together by the
-// even-odd rule, so that where two polygons overlapped the overlap was outside) are refused
-// with the usual message.
+// even-odd rule, so that where two polygons overlapped the overlap was outside) and format 5
+// (ring segments with a direction bit, where format 6 numbers their polygon) are refused with
+// the usual message.
 //
 // Fingerprint. The index is valid for the exact bytes it was built from: at index time the
 // source's size, modification time (nanoseconds), inode and a 64-bit XXH3 hash of its contents
