@@ -1294,6 +1294,16 @@ TEST_F(LayersCli, DrawOfASidecarRefusesItsLayerAsTheOutput) {
   EXPECT_EQ(fs::file_size(layer + ".loci"), sidecar_size);
 }
 
+// A GeoPackage of the WKT geometries of a CSV (column WKT), as ogr2ogr converts it.
+bool gpkg_of_wkt_csv(const std::string& csv, const std::string& gpkg, const std::string& layer,
+                     const std::string& type) {
+  fs::remove(gpkg);
+  return std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + csv + " -nln " + layer +
+                      " -oo GEOM_POSSIBLE_NAMES=WKT -oo KEEP_GEOM_COLUMNS=NO -nlt " + type +
+                      " 2> /dev/null")
+                         .c_str()) == 0;
+}
+
 // Triangles, TINs and polyhedral surfaces (a MultiPatch shapefile's 3D buildings are TINs to
 // GDAL) are surfaces: found by points and windows inside them and by nearest-n at 0, and cut
 // by clip. Before, the exact tests took them for empty: only a window holding the whole
@@ -1304,12 +1314,7 @@ TEST_F(LayersCli, TrianglesTinsAndPolyhedralSurfacesAreSurfaces) {
                         "1,\"TRIANGLE ((0 0, 10 0, 0 10, 0 0))\"\n"
                         "2,\"TIN (((20 0, 30 0, 20 10, 20 0)),((30 0, 30 10, 20 10, 30 0)))\"\n"
                         "3,\"POLYHEDRALSURFACE Z (((40 0 0, 50 0 0, 40 10 0, 40 0 0)))\"\n";
-  fs::remove(gpkg);
-  ASSERT_EQ(std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + csv +
-                         " -nln tin -oo GEOM_POSSIBLE_NAMES=WKT -oo KEEP_GEOM_COLUMNS=NO "
-                         "-nlt GEOMETRYZ 2> /dev/null")
-                            .c_str()),
-            0);
+  ASSERT_TRUE(gpkg_of_wkt_csv(csv, gpkg, "tin", "GEOMETRYZ"));
   for (const auto& [query, want] : std::vector<std::pair<std::string, std::string>>{
            {"--point 1,1", "1\n"},
            {"--point 29,9", "2\n"},
@@ -1368,12 +1373,7 @@ TEST_F(LayersCli, OverlappingPolygonsOfOneFeatureHoldTheirOverlap) {
          "5,\"TIN (((80 0, 90 0, 80 10, 80 0)), ((80 0, 90 10, 80 10, 80 0)))\"\n"
          "6,\"MULTIPOLYGON (((100 0, 110 0, 110 10, 100 10, 100 0)), ((120 0, 130 0, 130 10, "
          "120 10, 120 0), (102 2, 102 4, 104 4, 104 2, 102 2)))\"\n";
-  fs::remove(gpkg);
-  ASSERT_EQ(std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + csv +
-                         " -nln overlaps -oo GEOM_POSSIBLE_NAMES=WKT -oo KEEP_GEOM_COLUMNS=NO "
-                         "-nlt GEOMETRYZ 2> /dev/null")
-                            .c_str()),
-            0);
+  ASSERT_TRUE(gpkg_of_wkt_csv(csv, gpkg, "overlaps", "GEOMETRYZ"));
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"--point 7,7", "1\n"},  // in both squares
       {"--point 2,2", "1\n"},  // in the first only
@@ -1465,12 +1465,8 @@ TEST_F(LayersCli, NullAttributesStayNull) {
 TEST_F(LayersCli, ClipKeepsZAndWritesNoMadeUpMeasures) {
   const std::string csv = path("zm.csv"), gpkg = path("zm.gpkg"), cut = path("zm_cut.gpkg");
   std::ofstream(csv) << "id,WKT\n1,\"LINESTRING ZM (0 1 100 5, 10 1 200 15)\"\n";
-  fs::remove(gpkg);
   fs::remove(cut);
-  ASSERT_EQ(std::system(("ogr2ogr -q -f GPKG " + gpkg + " " + csv +
-                         " -oo GEOM_POSSIBLE_NAMES=WKT -oo KEEP_GEOM_COLUMNS=NO -nlt LINESTRINGZM")
-                            .c_str()),
-            0);
+  ASSERT_TRUE(gpkg_of_wkt_csv(csv, gpkg, "zm", "LINESTRINGZM"));
   const CliRun r = run_loci("clip " + gpkg + " --bbox 2,-1,8,2 -q -o " + cut);
   ASSERT_EQ(r.status, 0) << r.err;
   const OgrFeatureSet got = read_with_ogr(cut);
