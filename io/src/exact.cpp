@@ -62,16 +62,26 @@ bool ray_crosses(const Point2& a, const Point2& b, const Point2& p) {
 }
 
 bool OddPolygons::any() {
-  if (ids_.size() < 2) return !ids_.empty();
-  std::sort(ids_.begin(), ids_.end());
-  for (std::size_t i = 0; i < ids_.size();) {
-    std::size_t j = i + 1;
-    while (j < ids_.size() && ids_[j] == ids_[i])
-      ++j;
-    if ((j - i) & 1) return true;
-    i = j;
-  }
-  return false;
+  // An odd number of crossings in all has an odd number in some polygon.
+  if (n_ & 1) return true;
+  if (n_ == 0) return false;
+  if (n_ == 2) return small_[0] != small_[1];
+  // Whether a polygon was noted an odd number of times: sorted, a run of odd length.
+  const auto odd_run = [](std::span<std::uint32_t> ids) {
+    std::sort(ids.begin(), ids.end());
+    for (std::size_t i = 0; i < ids.size();) {
+      std::size_t j = i + 1;
+      while (j < ids.size() && ids[j] == ids[i])
+        ++j;
+      if ((j - i) & 1) return true;
+      i = j;
+    }
+    return false;
+  };
+  if (n_ <= small_.size()) return odd_run(std::span(small_.data(), n_));
+  std::vector<std::uint32_t> all(more_);
+  all.insert(all.end(), small_.begin(), small_.end());
+  return odd_run(all);
 }
 
 bool meets(const FlatGeometry& g, const Box2& box) {
@@ -758,22 +768,15 @@ Location PreparedGeometry::locate(const Point2& p) const {
   if (!intersects(envelope_, p)) return Location::outside;
   const std::vector<Point2>& pts = g_->points;
   const std::size_t cell = std::size_t(row(p[1])) * nx_ + col(p[0]);
-  // The edges right of the cell: the base, and the values at most p.y. With one polygon, a
-  // count's parity (the values by binary search); with several, the polygons noted.
-  const bool one = g_->polygons <= 1;
-  bool odd_one = false;
-  OddPolygons odd;
+  // The crossings: the cell's base, its values at most p.y (by binary search) and its own
+  // edges. An odd number in all is odd in some polygon (inside), none is outside; only an
+  // even number over several polygons needs them polygon by polygon.
   const double* v0 = values_.data() + value_start_[cell];
   const double* v1 = values_.data() + value_start_[cell + 1];
-  if (one) {
-    odd_one =
-        ((base_start_[cell + 1] - base_start_[cell]) ^ (std::upper_bound(v0, v1, p[1]) - v0)) & 1;
-  } else {
-    for (std::uint32_t i = base_start_[cell]; i < base_start_[cell + 1]; ++i)
-      odd.toggle(base_[i]);
-    for (const double* v = v0; v != v1 && *v <= p[1]; ++v)
-      odd.toggle(value_polygons_[value_start_[cell] + std::size_t(v - v0)]);
-  }
+  const std::size_t below = std::size_t(std::upper_bound(v0, v1, p[1]) - v0);
+  std::size_t crossings = base_start_[cell + 1] - base_start_[cell] + below;
+  const bool several = g_->polygons > 1;
+  OddPolygons odd;
   for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
     const Edge& e = edges_[cell_edges_[i]];
     const Point2& a = pts[e.first];
@@ -787,13 +790,17 @@ Location PreparedGeometry::locate(const Point2& p) const {
         orientation(a, b, p) == Orientation::collinear)
       return Location::boundary;
     if (e.kind == kRing && ray_crosses(a, b, p)) {
-      if (one)
-        odd_one = !odd_one;
-      else
-        odd.toggle(e.polygon);
+      ++crossings;
+      if (several) odd.toggle(e.polygon);
     }
   }
-  return (one ? odd_one : odd.any()) ? Location::inside : Location::outside;
+  if (crossings & 1) return Location::inside;
+  if (crossings == 0 || !several) return Location::outside;
+  for (std::uint32_t i = base_start_[cell]; i < base_start_[cell + 1]; ++i)
+    odd.toggle(base_[i]);
+  for (std::size_t k = 0; k < below; ++k)
+    odd.toggle(value_polygons_[value_start_[cell] + k]);
+  return odd.any() ? Location::inside : Location::outside;
 }
 
 std::size_t PreparedGeometry::memory_bytes() const {

@@ -22,6 +22,7 @@
 // Thread-safety: plain values; the functions are pure.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -172,11 +173,19 @@ bool ray_crosses(const Point2& a, const Point2& b, const Point2& p);
 // polygon was crossed an odd number of times (any(), which sorts what was noted).
 class OddPolygons {
  public:
-  void toggle(std::uint32_t polygon) { ids_.push_back(polygon); }
+  void toggle(std::uint32_t polygon) {
+    if (n_ < small_.size())
+      small_[n_] = polygon;
+    else
+      more_.push_back(polygon);
+    ++n_;
+  }
   bool any();
 
  private:
-  std::vector<std::uint32_t> ids_;
+  std::size_t n_ = 0;
+  std::array<std::uint32_t, 16> small_;  // the first crossings, without allocating
+  std::vector<std::uint32_t> more_;      // the rest
 };
 
 }  // namespace loci::io
