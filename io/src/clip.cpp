@@ -311,16 +311,14 @@ ClipResult clip_layer(const ClipOptions& options) {
       // invalid multi-polygon, and a collection of polygons (valid however they overlap, and
       // cut by GEOS as if the overlap were outside), are cut as the union of their polygons.
       std::unique_ptr<OGRGeometry> valid;
-      if (wkbFlatten(g->getGeometryType()) == wkbGeometryCollection) valid = united_polygons(*g);
-      if (valid) {
-        g = valid.get();
-      } else if (!g->IsValid()) {
-        valid = united_polygons(*g);
-        if (!valid) valid.reset(g->MakeValid());
-        if (!valid)
+      const bool invalid = !g->IsValid();
+      if (invalid || wkbFlatten(g->getGeometryType()) == wkbGeometryCollection) {
+        valid = united_polygons(*g);  // null unless g holds polygons only
+        if (!valid && invalid) valid.reset(g->MakeValid());
+        if (!valid && invalid)
           throw Error(options.load.layer_path + ": feature " + std::to_string(a.fid) +
                       " is an invalid geometry that cannot be repaired");
-        g = valid.get();
+        if (valid) g = valid.get();
       }
       std::unique_ptr<OGRGeometry> piece(g->Intersection(window.get()));
       if (!piece)

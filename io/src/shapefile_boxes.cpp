@@ -18,7 +18,6 @@
 #include <cstring>
 #include <map>
 #include <optional>
-#include <type_traits>
 #include <vector>
 
 #include <cpl_conv.h>
@@ -377,7 +376,8 @@ bool uses_measures(const unsigned char* c, std::uint64_t length, std::uint32_t t
 
 // Checks that the shapefile at `path` is one this reader takes and calls `begin(file_type,
 // records, shp_bytes)`, then reads and checks each record in file order (read_record) and
-// hands each shape to `add(read, fid, content, file_type)`, counting it in `items`; `items`
+// hands each shape to `add(read, fid, content, file_type, layer)` (the layer as GDAL opened
+// it; false from `add` gives the file to GDAL), counting it in `items`; `items`
 // gets the layer's name, whether it holds polygons and the fingerprint's hash from the bytes
 // read. False: GDAL must read the file.
 template <class Begin, class Add>
@@ -424,12 +424,7 @@ bool scan_shapefile(const std::string& path, const std::string& layer, const Pro
       continue;
     }
     ++items.features;
-    // An `add` that answers false gives the layer to GDAL.
-    if constexpr (std::is_same_v<decltype(add(r, fid, record + 8, file_type)), bool>) {
-      if (!add(r, fid, record + 8, file_type)) return false;
-    } else {
-      add(r, fid, record + 8, file_type);
-    }
+    if (!add(r, fid, record + 8, file_type, *ol.layer)) return false;  // false: GDAL reads it
   }
   items.layer_name = ol.layer->GetName();
   items.has_polygons = is_polygon_type(file_type) && items.features > 0;
@@ -855,13 +850,14 @@ std::optional<ShapefileSummary> read_shapefile_summary(const std::string& path,
   ShapefileSummary out;
   LayerItems items;
   std::map<std::string, std::int64_t> types;
-  bool placed = true, measured = false, z = false;
+  bool measured = false, z = false;
   const bool read = scan_shapefile(
       path, layer, progress, items,
       [&](std::uint32_t, std::uint64_t records, std::uint64_t) {
         out.records = std::int64_t(records);
       },
-      [&](const RecordRead& r, std::int64_t fid, const unsigned char* c, std::uint32_t file_type) {
+      [&](const RecordRead& r, std::int64_t fid, const unsigned char* c, std::uint32_t file_type,
+          OGRLayer&) {
         out.extent.expand(r.box);
         if (fid == 0) measured = uses_measures(c, r.length, file_type);
         z = has_z(file_type);
@@ -876,13 +872,13 @@ std::optional<ShapefileSummary> read_shapefile_summary(const std::string& path,
             type = "Polygon";
           } else {
             type = polygon_type(c);
-            placed &= type != nullptr;
-            if (!type) return;
+            if (!type) return false;  // a record GDAL places otherwise
           }
         }
         ++types[type];
+        return true;
       });
-  if (!read || !placed) return std::nullopt;
+  if (!read) return std::nullopt;
   // Named as GDAL names them: every geometry of a Z type is 3D, and measured when the first
   // record (not a null one) uses measures.
   const std::string prefix = std::string(z ? "3D " : "") + (measured ? "Measured " : "");
@@ -907,10 +903,11 @@ std::optional<ShapefileBoxes> read_shapefile_boxes(const std::string& path,
         items.boxes.reserve(records);
         items.records.reserve(records);
       },
-      [&](const RecordRead& r, std::int64_t fid, const unsigned char*, std::uint32_t) {
+      [&](const RecordRead& r, std::int64_t fid, const unsigned char*, std::uint32_t, OGRLayer&) {
         items.boxes.push_back(r.box);
         items.records.push_back({fid, 0, 0u});
         out.segments += r.segments;
+        return true;
       });
   if (!read) return std::nullopt;
   return out;
@@ -922,7 +919,6 @@ std::optional<LayerItems> read_shapefile_segments(const std::string& path, const
   if (CPLGetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr)) return std::nullopt;
   LayerItems items;
   items.per = Per::segment;
-  std::optional<detail::OpenLayer> gdal;
   const bool read = scan_shapefile(
       path, layer, progress, items,
       [&](std::uint32_t file_type, std::uint64_t, std::uint64_t shp_bytes) {
@@ -933,11 +929,11 @@ std::optional<LayerItems> read_shapefile_segments(const std::string& path, const
         items.boxes.reserve(bound);
         items.records.reserve(bound);
       },
-      [&](const RecordRead&, std::int64_t fid, const unsigned char* c, std::uint32_t file_type) {
+      [&](const RecordRead&, std::int64_t fid, const unsigned char* c, std::uint32_t file_type,
+          OGRLayer& gdal) {
         if (add_record_segments(c, file_type, fid, items)) return true;
         // Rings only GDAL sorts: that record's segments from GDAL's geometry.
-        if (!gdal) gdal = detail::open_layer(path, layer);
-        const OGRFeatureUniquePtr f(gdal->layer->GetFeature(fid));
+        const OGRFeatureUniquePtr f(gdal.GetFeature(fid));
         if (!f || !f->GetGeometryRef()) return false;
         detail::add_segments(f->GetGeometryRef(), fid, path, items);
         return true;
