@@ -28,6 +28,7 @@
 #include "loci/io/layer_reader.hpp"
 #include "loci/io/sidecar.hpp"
 #include "shapefile_polygons.hpp"
+#include "support/scratch.hpp"
 
 namespace {
 
@@ -37,14 +38,13 @@ using loci::io::Per;
 using Make = std::function<std::unique_ptr<OGRGeometry>(int, std::mt19937_64&)>;
 
 fs::path dir() {
-  static const fs::path d = [] {
+  static const loci::test::Scratch d = [] {
     GDALAllRegister();
-    const fs::path p = fs::temp_directory_path() / ("loci-shp-boxes-" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
-    return p;
+    loci::test::Scratch s("loci-shp-boxes");
+    fs::create_directories(s.path());
+    return s;
   }();
-  return d;
+  return d.path();
 }
 
 // Writes a shapefile of `count` features made by `make` (nullptr: no geometry).

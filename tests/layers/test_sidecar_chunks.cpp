@@ -4,7 +4,6 @@
 // finds every one, and answers from an intact file equal the in-memory tree's.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
 #include <algorithm>
 #include <cstring>
 #include <fstream>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "loci/io/sidecar.hpp"
+#include "support/scratch.hpp"
 
 namespace loci::io {
 namespace {
@@ -21,7 +21,8 @@ namespace {
 struct Fixture {
   std::vector<Box2> boxes;
   std::vector<ItemRecord> records;
-  std::string path;
+  test::Scratch file{"loci-chunks", ".loci"};  // removed with the fixture
+  std::string path = file.str();
   std::string bytes;
   std::size_t data_offset = 0;  // where the blocks start in the file
 };
@@ -40,7 +41,6 @@ Fixture make(std::size_t n, std::uint64_t seed) {
   info.layer_name = "boxes";
   info.items = n;
   info.bounds = tree.bounds();
-  f.path = "/tmp/loci-chunks-" + std::to_string(::getpid()) + ".loci";
   write_sidecar(f.path, tree, f.records, info);
   std::ifstream in(f.path, std::ios::binary);
   f.bytes.assign(std::istreambuf_iterator<char>(in), {});
@@ -89,7 +89,6 @@ TEST(SidecarChunks, OpeningReadsNoDataAndASmallQueryAFewChunks) {
   EXPECT_LE(s.check().verified(), 12u) << "of " << chunks;
   s.verify();
   EXPECT_EQ(s.check().verified(), chunks);
-  ::unlink(f.path.c_str());
 }
 
 TEST(SidecarChunks, AFlippedByteIsRefusedWhenItsChunkIsRead) {
@@ -150,7 +149,6 @@ TEST(SidecarChunks, CorruptFrontIsRefusedAtOpen) {
   }
   put(f, f.bytes);
   EXPECT_NO_THROW(Sidecar::open(f.path).verify());
-  ::unlink(f.path.c_str());
 }
 
 }  // namespace
