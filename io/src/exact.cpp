@@ -263,25 +263,14 @@ std::optional<Point2> interior_point(const FlatGeometry& g, std::span<const std:
   return std::nullopt;
 }
 
-// True when q lies strictly inside a polygon of g (by the crossing parity of that polygon's own
-// rings, exactly) none of whose rings passes through q: then g's area holds q and all around
-// it, whatever boundary of g's other polygons runs through q. Only a feature of several
-// polygons can have such boundary inside itself (polygons that overlap).
-bool inside_another_polygon(const FlatGeometry& g, const Point2& q) {
-  if (g.polygons < 2) return false;
-  std::vector<std::uint8_t> state(g.polygons, 0);  // 1: odd crossings; 2: q on a ring
+// True when q lies on a ring of g, exactly.
+bool on_ring(const FlatGeometry& g, const Point2& q) {
   for (const Part& part : g.parts) {
-    if (part.kind != PartKind::ring || part.polygon >= g.polygons) continue;
-    std::uint8_t& st = state[part.polygon];
-    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i) {
-      const Segment2 e{g.points[i], g.points[i + 1]};
-      if (intersects(e, Segment2{q, q}))
-        st |= 2;
-      else if (ray_crosses(e.a, e.b, q))
-        st ^= 1;
-    }
+    if (part.kind != PartKind::ring) continue;
+    for (std::uint32_t i = part.begin; i + 1 < part.end; ++i)
+      if (intersects(Segment2{g.points[i], g.points[i + 1]}, Segment2{q, q})) return true;
   }
-  return std::find(state.begin(), state.end(), std::uint8_t(1)) != state.end();
+  return false;
 }
 
 Box2 common(const Box2& a, const Box2& b) {
@@ -409,14 +398,16 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
       return false;
   }
   if (!areas) return true;
-  // No point of a's polygons' boundary lies strictly inside b's polygons: a vertex there, or a
-  // piece of a ring edge between its cuts with b's edges (a hole or notch of a inside b; the
-  // boundary of a has a's outside beside it), unless another polygon of a holds it (the edge
-  // of one of two polygons that overlap, inside the other).
+  // No point of the boundary of a's area lies strictly inside b's polygons: a piece of a ring
+  // edge between its cuts with b's edges (a hole or notch of a inside b; the boundary of a
+  // has a's outside beside it), unless a's polygons hold both its sides (the edge of one of
+  // two polygons that overlap, inside the other, or an edge two adjacent polygons share).
+  // Every point of that boundary inside b lies on such a piece; for a single polygon a vertex
+  // there says so sooner.
   const Box2& env = pb.envelope();
-  for (const Point2& v : a.points)
-    if (intersects(env, v) && pb.locate(v) == Location::inside && !inside_another_polygon(a, v))
-      return false;
+  if (a.polygons < 2)
+    for (const Point2& v : a.points)
+      if (intersects(env, v) && pb.locate(v) == Location::inside) return false;
   k = 0;
   for (std::uint32_t j = 0; j < ea.segs.size(); ++j) {
     const Segment2& e = ea.segs[j];
@@ -427,7 +418,7 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
     }
     if (!each_piece(on_a, k, j, [&](double t) {
           return pb.locate_at(e, t) != Location::inside ||
-                 inside_another_polygon(a, point_at(e, t));
+                 (a.polygons > 1 && pa.holds_both_sides(e, t));
         }))
       return false;
   }
@@ -442,7 +433,8 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
     if (!p) continue;
     const Location where = pa.locate(*p);
     if (where == Location::outside) return false;
-    if (where == Location::boundary && !inside_polygon(a, *p)) return false;
+    // On a ring of a: inside a's area, every piece of its boundary inside b having passed.
+    if (where == Location::boundary && !inside_polygon(a, *p) && !on_ring(a, *p)) return false;
   }
   return true;
 }
@@ -634,6 +626,74 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
       }
     }
   return odd.any() ? Location::inside : Location::outside;
+}
+
+bool PreparedGeometry::holds_both_sides(const Segment2& s, double t) const {
+  const std::vector<Point2>& pts = g_->points;
+  const Point2 m = point_at(s, t);
+  const double hair = point_at_rounding(s);
+  // The sign of v minus p's coordinate on `axis`, exactly.
+  auto above = [&](int axis, double v) {
+    if (v > m[axis] + hair) return 1;
+    if (v < m[axis] - hair) return -1;
+    return -compare_coordinate_at(s, t, axis, v);
+  };
+  // The signs of s's direction (dx, dy); the step to its left is along (-dy, dx).
+  const int dx = (s.b[0] > s.a[0]) - (s.b[0] < s.a[0]);
+  const int dy = (s.b[1] > s.a[1]) - (s.b[1] < s.a[1]);
+  // Each side is located as locate does, polygon by polygon, for p moved an infinitesimal step
+  // across s's line: the polygons holding the point stepped left, and right.
+  OddPolygons side[2];
+  // False when undecided: p on a ring edge across s's line.
+  auto crossings = [&](const Edge& e) {
+    const Point2& a = pts[e.first];
+    const Point2& b = pts[e.first + 1];
+    const int ya = above(1, a[1]), yb = above(1, b[1]);
+    if ((ya > 0 && yb > 0) || (ya < 0 && yb < 0)) return true;  // wholly above or below p
+    if (above(0, std::max(a[0], b[0])) < 0) return true;        // wholly left of p
+    const bool up = a[1] < b[1];
+    const Orientation o = orientation_at(up ? a : b, up ? b : a, s, t);
+    if (o == Orientation::collinear && (orientation(s.a, s.b, a) != Orientation::collinear ||
+                                        orientation(s.a, s.b, b) != Orientation::collinear))
+      // p lies on the line of an edge across s's: on the edge itself when within its extent,
+      // else the edge misses both stepped points' rays.
+      return !(std::min(ya, yb) <= 0 && std::max(ya, yb) >= 0 &&
+               above(0, std::min(a[0], b[0])) <= 0);
+    for (int k = 0; k < 2; ++k) {
+      // The step's y has the sign of dx to the left, of -dx to the right: an end at p's height
+      // lies above the stepped point when the step goes down.
+      const int step_y = k == 0 ? dx : -dx;
+      const bool above_a = ya > 0 || (ya == 0 && step_y < 0);
+      const bool above_b = yb > 0 || (yb == 0 && step_y < 0);
+      if (above_a == above_b) continue;
+      // The crossing lies right of the stepped point when that point is left of the edge
+      // directed upwards. On s's line that is so for the step left when s runs upwards (the
+      // step's cross product with the edge has the sign of their dot product).
+      const bool right = o != Orientation::collinear ? o == Orientation::counterclockwise
+                                                     : (k == 0 ? dy > 0 : dy < 0);
+      if (right) side[k].toggle(e.polygon);
+    }
+    return true;
+  };
+  // The edges crossing either stepped point's rightward ray are listed in the rows p's y falls
+  // in, from p's column rightwards: each is taken in the first of the cells scanned that lists
+  // it, as locate_at does.
+  const std::uint32_t r0 = row(m[1] - hair), r1 = row(m[1] + hair), c0 = col(m[0] - hair);
+  for (std::uint32_t r = r0; r <= r1; ++r)
+    for (std::uint32_t c = c0; c < nx_; ++c) {
+      const std::size_t cell = std::size_t(r) * nx_ + c;
+      for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
+        const Edge& e = edges_[cell_edges_[i]];
+        if (e.kind != kRing) continue;
+        const Point2& a = pts[e.first];
+        const Point2& b = pts[e.first + 1];
+        if (std::max(row(std::min(a[1], b[1])), r0) != r ||
+            std::max(col(std::min(a[0], b[0])), c0) != c)
+          continue;
+        if (!crossings(e)) return false;
+      }
+    }
+  return side[0].any() && side[1].any();
 }
 
 std::uint32_t PreparedGeometry::col(double x) const {

@@ -1434,6 +1434,40 @@ TEST_F(LayersCli, OverlappingPolygonsOfOneFeatureHoldTheirOverlap) {
     }
 }
 
+// An edge that two polygons of one feature share, each on its own side (a collection of
+// adjacent squares, a TIN's faces, a multi-polygon of squares side by side), lies inside the
+// feature: a polygon across it is covered (join contains and within took that edge for the
+// feature's boundary). One that sticks out is not, nor one over a notch the polygons leave.
+TEST_F(LayersCli, EdgesPolygonsOfOneFeatureShareLieInsideIt) {
+  const std::string csv = path("shared.csv"), gpkg = path("shared.gpkg");
+  std::ofstream(csv) << "id,WKT\n"
+                        "1,\"GEOMETRYCOLLECTION (POLYGON ((0 0, 5 0, 5 10, 0 10, 0 0)), "
+                        "POLYGON ((5 0, 10 0, 10 10, 5 10, 5 0)))\"\n"
+                        "2,\"TIN (((20 0, 30 0, 30 10, 20 0)), ((20 0, 30 10, 20 10, 20 0)))\"\n"
+                        "3,\"MULTIPOLYGON (((40 0, 45 0, 45 10, 40 10, 40 0)), "
+                        "((50 10, 45 10, 45 0, 50 0, 50 5, 48 5, 48 6, 50 6, 50 10)))\"\n";
+  ASSERT_TRUE(gpkg_of_wkt_csv(csv, gpkg, "shared", "GEOMETRY"));
+  const std::string squares = path("across.geojson");
+  auto square = [](double x0, double y0, double x1, double y1) {
+    std::ostringstream o;
+    o << R"({"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[)" << x0
+      << ',' << y0 << "],[" << x1 << ',' << y0 << "],[" << x1 << ',' << y1 << "],[" << x0 << ','
+      << y1 << "],[" << x0 << ',' << y0 << "]]]}}";
+    return o.str();
+  };
+  std::ofstream(squares) << R"({"type":"FeatureCollection","features":[)" << square(3, 3, 7, 7)
+                         << ',' << square(22, 2, 28, 8) << ',' << square(42, 1, 47, 4) << ','
+                         << square(8, 8, 12, 12) << ',' << square(42, 4, 49, 7) << "]}";
+  const CliRun contains =
+      run_loci("join " + gpkg + " " + shell_quote(squares) + " --predicate contains -f ids -q");
+  ASSERT_EQ(contains.status, 0) << contains.err;
+  EXPECT_EQ(contains.out, "1 0\n2 1\n3 2\n");
+  const CliRun within =
+      run_loci("join " + shell_quote(squares) + " " + gpkg + " --predicate within -f ids -q");
+  ASSERT_EQ(within.status, 0) << within.err;
+  EXPECT_EQ(within.out, "0 1\n1 2\n2 3\n");
+}
+
 // A null attribute stays null in a GeoJSON answer (it was left out, as if the layer had no
 // such value), and empty in a CSV one.
 TEST_F(LayersCli, NullAttributesStayNull) {

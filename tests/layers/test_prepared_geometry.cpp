@@ -492,6 +492,81 @@ TEST(PreparedGeometry, CoversOfOverlappingPolygonsAgainstLatticeEvidence) {
   EXPECT_GT(across, 50);  // covered only by two polygons together, or by their overlap
 }
 
+// Polygons of one feature that share edges: grid cells cut along a diagonal into two
+// triangles, each its own polygon (as the faces of a TIN), and integer rectangles that may share
+// an edge with them or each other, on the same side or across, rings either way; b an integer
+// rectangle or right triangle. One point inside each of the four triangles that a unit cell's
+// two diagonals cut it into decides (each lies wholly inside or outside every polygon): b is
+// covered when each one inside b is in a. At integers and at 1e6 in steps of 2^-30. An edge
+// two polygons share was taken for the feature's boundary: b across it was not covered.
+TEST(PreparedGeometry, CoversAcrossEdgesPolygonsShare) {
+  std::mt19937_64 rng(71);
+  int covered = 0, across = 0, trials = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const bool far = trial % 2;
+    const auto at = [far](double x, double y) {
+      return far ? Point2{1e6 + std::ldexp(x, -30), 1e6 + std::ldexp(y, -30)} : Point2{x, y};
+    };
+    const auto rng_int = [&rng](int lo, int hi) { return lo + int(rng() % unsigned(hi - lo + 1)); };
+    FlatGeometry a, b;
+    std::uint32_t polygons = 0;
+    const int x0 = rng_int(0, 3), y0 = rng_int(0, 3), nx = rng_int(1, 5), ny = rng_int(1, 5);
+    for (int i = x0; i < x0 + nx; ++i)
+      for (int j = y0; j < y0 + ny; ++j) {
+        const Point2 c00 = at(i, j), c10 = at(i + 1, j), c11 = at(i + 1, j + 1), c01 = at(i, j + 1);
+        const bool rising = rng() % 2;
+        const std::vector<std::vector<Point2>> halves =
+            rising ? std::vector<std::vector<Point2>>{{c00, c10, c11}, {c00, c11, c01}}
+                   : std::vector<std::vector<Point2>>{{c00, c10, c01}, {c10, c11, c01}};
+        for (const auto& t : halves)
+          if (rng() % 8) add_ring(a, t, polygons++, rng() % 2);
+      }
+    for (int k = rng_int(0, 2); k > 0; --k) {
+      const int x = rng_int(0, 7), y = rng_int(0, 7), w = rng_int(1, 8 - x), h = rng_int(1, 8 - y);
+      add_ring(a, {at(x, y), at(x + w, y), at(x + w, y + h), at(x, y + h)}, polygons++, rng() % 2);
+    }
+    if (polygons == 0) continue;
+    a.polygons = polygons;
+    // b within the grid's extent half of the time.
+    const bool inner = rng() % 2;
+    const int bx0 = inner ? x0 : 0, bx1 = inner ? x0 + nx : 8;
+    const int by0 = inner ? y0 : 0, by1 = inner ? y0 + ny : 8;
+    const int x = rng_int(bx0, bx1 - 1), y = rng_int(by0, by1 - 1);
+    const int w = rng_int(1, bx1 - x), h = rng_int(1, by1 - y);
+    if (rng() % 2) {
+      add_ring(b, {at(x, y), at(x + w, y), at(x + w, y + h), at(x, y + h)}, 0, rng() % 2);
+    } else {
+      const int d = std::min(w, h);
+      add_ring(b, {at(x, y), at(x + d, y), at(x, y + d)}, 0, rng() % 2);
+    }
+    b.polygons = 1;
+    bool b_in_a = true;
+    std::vector<bool> by_one(polygons, true);  // whether polygon k alone holds b
+    for (int i = x; i < x + w; ++i)
+      for (int j = y; j < y + h; ++j)
+        for (const auto& [u, v] : {std::pair{0.5, 0.2}, {0.8, 0.5}, {0.5, 0.8}, {0.2, 0.5}}) {
+          const Point2 p = at(i + u, j + v);
+          if (brute(b, p) != Location::inside) continue;
+          b_in_a &= brute(a, p) == Location::inside;
+          for (std::uint32_t k = 0; k < polygons; ++k) {
+            FlatGeometry one;
+            for (const Part& part : a.parts)
+              if (part.polygon == k)
+                add_ring(one, {a.points.begin() + part.begin, a.points.begin() + part.end - 1}, 0);
+            one.polygons = 1;
+            by_one[k] = by_one[k] && brute(one, p) == Location::inside;
+          }
+        }
+    ++trials;
+    covered += b_in_a;
+    across += b_in_a && std::find(by_one.begin(), by_one.end(), true) == by_one.end();
+    EXPECT_EQ(covers(PreparedGeometry(a), PreparedGeometry(b)), b_in_a) << trial;
+  }
+  EXPECT_GT(trials, 2900);
+  EXPECT_GT(covered, 300);
+  EXPECT_GT(across, 200);  // covered only by polygons together, across the edges they share
+}
+
 // Four rectangles in a pinwheel over a hole of a fifth leave a hole of their own: every edge
 // of theirs inside b is partly inside another of them and partly the feature's boundary (each
 // edge is cut where the others cross it, so that the boundary part is tested).

@@ -88,8 +88,10 @@ std::optional<double> distance_within(const FlatGeometry& a, const FlatGeometry&
 // True when every point of b lies in a, a's boundary included (OGC's "covers"). b's edges
 // are cut where a's linework meets them; every vertex of b and the middle of every piece must
 // lie in a (pieces running along a's edges do). When b has polygons, no point of the boundary
-// of a's polygons may lie strictly inside them (a vertex, or the middle of a piece of a ring
-// edge cut by b's edges: a hole or notch of a inside b); then the inside of each polygon of b
+// of a's area may lie strictly inside them (the middle of a piece of a ring edge cut by b's
+// edges and a's other polygons' edges: a hole or notch of a inside b; a piece whose both sides
+// a's polygons hold, inside another polygon or along an edge two polygons share from either
+// side, is not that boundary); then the inside of each polygon of b
 // lies wholly in a or wholly outside (a hole of a filled exactly by b), and one point strictly
 // inside it decides. The vertex tests are exact, and so are the middles of pieces: the real
 // point, not its rounding, where the other geometry passes within rounding of it (b's edge
@@ -127,6 +129,12 @@ class PreparedGeometry {
   // Where the real point s.a + t (s.b - s.a) lies (not its rounding by point_at), exactly:
   // the rounded point decides unless g passes within rounding of it.
   Location locate_at(const Segment2& s, double t) const;
+  // For the real point p = s.a + t (s.b - s.a), 0 < t < 1, on a ring edge s of g: whether g's
+  // polygons hold the points beside p on both sides of s's line, near enough. Then p lies
+  // inside g's area although rings run through it (an edge two adjacent polygons share, or one
+  // of two that overlap inside the other). Exact; false also where a ring edge passes through p
+  // across s's line.
+  bool holds_both_sides(const Segment2& s, double t) const;
   std::size_t memory_bytes() const;
 
  private:
