@@ -161,7 +161,8 @@ int run_index(const Args& a) {
     // Features without points are left out of every index: say how many, or they go unseen.
     std::string skipped;
     if (r.without_geometry > 0)
-      skipped = "; skipped " + counted(r.without_geometry, "feature") + " without a geometry";
+      skipped = "; skipped " + counted(r.without_geometry, "feature") +
+                " without a geometry or with an empty one";
     std::fprintf(stderr, "loci: indexed %s of layer '%s' into %s (%llu bytes, %.2f s)%s\n",
                  what.c_str(), printable(r.layer_name).c_str(), printable(r.path).c_str(),
                  static_cast<unsigned long long>(r.bytes), r.seconds, skipped.c_str());
@@ -678,7 +679,8 @@ const std::vector<Command>& commands() {
          "latest report)"},
         {"--during", nullptr, "T1,T2", "objects in the window at some time of [T1, T2]"},
         {"--format", "-f", "ids|csv|geojson",
-         "ids (default), CSV id,[distance,]t,x,y (AIS: lon,lat, metres), GeoJSON points"},
+         "ids (default), CSV id,[distance,]t,x,y (AIS: id,[distance,distance_nm,]t,time_utc,"
+         "lon,lat, distance in metres), GeoJSON points"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         kQuiet},
        "  loci fleet query fleet.csv --bbox 0,0,100,100 --at 30\n"
@@ -729,8 +731,8 @@ const std::vector<Command>& commands() {
        "coastline.geojson -o ais.csv\n",
        run_fleet_generate},
       {"fleet draw",
-       "loci fleet draw FILE [--over LAYER] [--at T] [--within D --horizon H] [--arrows T] -o "
-       "OUT.svg",
+       "loci fleet draw FILE [--over LAYER] [--at T] [--within D --horizon H] [--arrows T] [-o "
+       "OUT.svg]",
        "an SVG of the fleet at a time: positions, velocity arrows and the pairs in conflict over "
        "a layer",
        {{"--over", nullptr, "LAYER", "a layer drawn underneath (lon/lat for AIS input)"},
