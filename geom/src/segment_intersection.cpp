@@ -17,12 +17,6 @@ bool lex_less(const Point<2>& p, const Point<2>& q) {
   return p[0] < q[0] || (p[0] == q[0] && p[1] < q[1]);
 }
 
-// p lies on the line of s (known); is it within s's closed extent?
-bool on_collinear(const Segment<2>& s, const Point<2>& p) {
-  return std::min(s.a[0], s.b[0]) <= p[0] && p[0] <= std::max(s.a[0], s.b[0]) &&
-         std::min(s.a[1], s.b[1]) <= p[1] && p[1] <= std::max(s.a[1], s.b[1]);
-}
-
 SegmentIntersection at(const Point<2>& p) {
   return {SegmentMeet::point, p, p};
 }

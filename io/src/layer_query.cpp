@@ -168,8 +168,8 @@ LayerQuery::LayerQuery(const LayerIndex& index, std::string layer_path, std::str
                        std::shared_ptr<LayerGeometries> shared)
     : index_(index) {
   if (!shared) shared = std::make_shared<LayerGeometries>(layer_path, layer_name);
-  geometries_.reset(
-      new Geometries{std::move(layer_path), std::move(layer_name), std::move(shared), {}, {}});
+  geometries_.reset(new Geometries{
+      std::move(layer_path), std::move(layer_name), std::move(shared), {}, {}, {}, {}});
 }
 
 LayerQuery::~LayerQuery() = default;

@@ -391,6 +391,7 @@ TEST(NarrowPhaseOverlap, RandomAgainstReferences) {
   }
   EXPECT_GT(met, 1200);
   EXPECT_GT(missed, 1200);
+  EXPECT_EQ(agree + near_tangent, 6000);  // every other answer agreed
   EXPECT_LT(near_tangent, 5);
 }
 

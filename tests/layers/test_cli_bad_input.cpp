@@ -312,7 +312,7 @@ TEST_F(BadInput, DevicesFifosAndLinksAreWrittenThroughNeverReplaced) {
   EXPECT_EQ(dash.status, 0) << dash.err;
   EXPECT_EQ(dash.out, run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9").out);
   EXPECT_FALSE(dash.out.empty());
-  for (const std::string command :
+  for (const std::string& command :
        {"index " + shell_quote(l) + " -o -", "clip " + shell_quote(l) + " --bbox 0,0,9,9 -o -",
         std::string("fleet generate --count 3 -o -")})
     expect_one_line_error(run_loci(command));
@@ -343,8 +343,8 @@ TEST_F(BadInput, TheInputLayerIsNeverOverwritten) {
   ASSERT_EQ(
       run_loci("index -q " + shell_quote(l) + " -o " + shell_quote(path("other.loci"))).status, 0);
   const std::string sidecar = read_text(l + ".loci"), other = read_text(path("other.loci"));
-  for (const std::string command : {"query " + shell_quote(l) + " --bbox 0,0,9,9",
-                                    "clip " + shell_quote(l) + " --bbox 0,0,9,9"}) {
+  for (const std::string& command : {"query " + shell_quote(l) + " --bbox 0,0,9,9",
+                                     "clip " + shell_quote(l) + " --bbox 0,0,9,9"}) {
     const CliRun own = run_loci(command + " -o " + shell_quote(l + ".loci"));
     expect_one_line_error(own);
     EXPECT_NE(own.err.find("it is the index"), std::string::npos) << own.err;

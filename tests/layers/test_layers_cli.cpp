@@ -1124,7 +1124,7 @@ TEST_F(LayersCli, ReportsBadInput) {
   expect_error("query " + polys + " --bbox 0,0,1,1 -k 3", "-k counts the neighbours of --nearest");
   expect_error("query " + polys + " --bbox 0,0,1,1 --format ids -f csv", "-f is given twice");
   // A value joined to its option (-k3, --bbox=...) is that option's value, and counts once.
-  for (const std::string& joined : {"--nearest=1,1 -k3", "-n1,1 -k 3", "-n 1,1 -k3"}) {
+  for (const char* joined : {"--nearest=1,1 -k3", "-n1,1 -k 3", "-n 1,1 -k3"}) {
     const CliRun r = run_loci("query " + polys + " " + joined + " -fids");
     EXPECT_EQ(r.status, 0) << joined << r.err;
     EXPECT_EQ(r.out, run_loci("query " + polys + " --nearest 1,1 -k 3 -f ids").out) << joined;
@@ -1193,7 +1193,7 @@ TEST_F(LayersCli, OutputsRefuseToReplaceAFileHoldingOtherLayers) {
   EXPECT_EQ(fs::file_size(two), size);
   // So does every other command's -o (query, index, draw, join and intersections wrote text,
   // a sidecar or SVG over it).
-  for (const std::string command :
+  for (const std::string& command :
        {"query " + u + " --bbox 1,1,2,2", "index " + u + " -q", "draw " + u + " -q",
         "join " + u + " " + u + " -p intersects -q", "intersections " + u + " -q"}) {
     expect_error(command + " -o " + two,
@@ -1218,7 +1218,7 @@ TEST_F(LayersCli, OutputsRefuseToReplaceAFileHoldingOtherLayers) {
   ASSERT_EQ(std::system(("ogr2ogr " + shp + " " + u).c_str()), 0);
   const auto shp_size = fs::file_size(shp), one_size = fs::file_size(one);
   for (const std::string& target : {one, shp, dbf})
-    for (const std::string command :
+    for (const std::string& command :
          {"query " + u + " --bbox 1,1,2,2", "query " + u + " --bbox 1,1,2,2 -f csv",
           "query " + u + " --bbox 1,1,2,2 -f geojson", "draw " + u + " -q",
           "intersections " + u + " -q", "join " + u + " " + u + " -q"})
@@ -1521,7 +1521,7 @@ TEST_F(LayersCli, FeaturesSharingAFidAreRefused) {
   std::ofstream(d) << R"({"type":"FeatureCollection","features":[
 {"type":"Feature","id":1,"properties":{"n":"a"},"geometry":{"type":"Point","coordinates":[0,0]}},
 {"type":"Feature","id":1,"properties":{"n":"b"},"geometry":{"type":"Point","coordinates":[20,20]}}]})";
-  for (const std::string command :
+  for (const std::string& command :
        {"query " + d + " --bbox 19,19,21,21 -f csv", "query " + d + " --nearest 20,20 -k 1",
         "index " + d + " -q -o " + path("dup.loci"),
         "clip " + d + " --bbox 19,19,21,21 -q -o " + path("dup_clip.geojson"),
@@ -1969,7 +1969,7 @@ TEST_F(LayersCli, SeesEditsToAShapefilesAttributesAndToADirectoryOfShapefiles) {
   auto touch = [](const std::string& file) {
     fs::last_write_time(file, fs::last_write_time(file) + std::chrono::seconds(5));
   };
-  for (const std::string layer : {path("dbfedit.shp"), dir}) {
+  for (const std::string& layer : {path("dbfedit.shp"), dir}) {
     SCOPED_TRACE(layer);
     ASSERT_EQ(run_loci("index -q " + layer).status, 0);
     const std::string before = run_loci("query " + layer + " --bbox 0,0,9,9").out;

@@ -22,3 +22,12 @@ run("configure the consumer" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}" -B "${WORK_DI
 run("build the consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
 run("run the consumer" "${WORK_DIR}/build/loci_consumer" "${LAYER}")
 message(STATUS "${last_output}")
+# Clang too, where the machine has it: its warnings are not GCC's.
+find_program(CLANGXX clang++)
+if(CLANGXX)
+  run("configure the consumer with clang++" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}"
+      -B "${WORK_DIR}/build-clang" -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release
+      "-DCMAKE_CXX_COMPILER=${CLANGXX}" "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix")
+  run("build the consumer with clang++" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build-clang")
+  run("run the consumer built with clang++" "${WORK_DIR}/build-clang/loci_consumer" "${LAYER}")
+endif()

@@ -235,7 +235,9 @@ TEST(RegionQuadtree, OverlayMatchesCellWiseCombination) {
     if (x == Cover::outside || y == Cover::outside) return Cover::outside;
     return x == Cover::inside && y == Cover::inside ? Cover::inside : Cover::boundary;
   };
-  for (const auto& [a, b] : {std::pair{&img, &disc}, {&disc, &disc2}, {&disc, &disc}}) {
+  for (const auto& [first, second] : {std::pair{&img, &disc}, {&disc, &disc2}, {&disc, &disc}}) {
+    const RegionQuadtree* a = first;  // named, not bound, for the lambdas below
+    const RegionQuadtree* b = second;
     const auto u = RegionQuadtree::unite(*a, *b);
     const auto m = RegionQuadtree::intersect(*a, *b);
     u.validate();

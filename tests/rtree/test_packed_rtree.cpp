@@ -55,7 +55,9 @@ void check_tree(const std::vector<Box<D>>& boxes, Packing packing, std::uint64_t
       total_hits += expected.size();
     }
   }
-  if (boxes.size() > 100) EXPECT_GT(total_hits, 0u);
+  if (boxes.size() > 100) {
+    EXPECT_GT(total_hits, 0u);
+  }
   for (int q = 0; q < 40; ++q) {
     const Point<D> p = random_point<D>(rng, -50, 1050);
     for (std::size_t k : {std::size_t(1), std::size_t(10), std::size_t(100)})
@@ -125,7 +127,7 @@ TEST(PackedRTree, ContainedNodesAreReportedWithoutTests) {
 // DBL_MAX) or spread over less than 65535 / DBL_MAX: the packing still follows the row, so a
 // window around one point reads one path, and answers are exact.
 TEST(PackedRTree, HilbertPackingOfExtremeCentres) {
-  for (const auto [x0, step] : {std::pair{1e308, 1.6e304}, std::pair{1e-300, 5e-308}}) {
+  for (const auto& [x0, step] : {std::pair{1e308, 1.6e304}, std::pair{1e-300, 5e-308}}) {
     std::vector<Box2> boxes;
     for (int i = 0; i < 4096; ++i)
       boxes.push_back(Box2::of_point({x0 + i * step, 1}));

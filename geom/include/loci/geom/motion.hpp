@@ -81,9 +81,10 @@ template <int D>
 template <int D>
 void check_motion(const Motion<D>& m, const char* what = "report") {
   // Every value within the limits, tested without branches (a NaN fails each comparison).
-  bool ok = std::abs(m.t) <= kMaxCoordinate;
+  unsigned ok = std::abs(m.t) <= kMaxCoordinate;
   for (int i = 0; i < D; ++i)
-    ok &= (std::abs(m.p[i]) <= kMaxCoordinate) & (std::abs(m.v[i]) <= kMaxCoordinate);
+    ok &=
+        unsigned(std::abs(m.p[i]) <= kMaxCoordinate) & unsigned(std::abs(m.v[i]) <= kMaxCoordinate);
   if (!ok) [[unlikely]]
     detail::refuse_motion(m, what);
 }

@@ -225,7 +225,7 @@ template <int D>
                                                  const Kinematics<D>& q1, double reach2,
                                                  double horizon) {
   const __m128d h = _mm_set1_pd(horizon);
-  __m128d dw, ww, dd, ee;
+  __m128d dw = _mm_setzero_pd(), ww = dw, dd = dw, ee = dw;  // set at k = 0
   for (int k = 0; k < D; ++k) {
     const __m128d d = _mm_sub_pd(_mm_set_pd(q1.p[k], q0.p[k]), _mm_set1_pd(p.p[k]));
     const __m128d w = _mm_sub_pd(_mm_set_pd(q1.v[k], q0.v[k]), _mm_set1_pd(p.v[k]));
@@ -628,7 +628,7 @@ class ConflictMonitor {
     std::vector<Box<D>> boxes;
     for (std::uint32_t s : recent_)
       if (alive_[s]) {
-        recent_entry_.push_back({at_base_[s], s});
+        recent_entry_.push_back({at_base_[s], s, 0});
         boxes.push_back(detail::grown_sweep(motion_[s], base_, t1, 0.5 * keep_));
       }
     recent_tree_ = PackedRTree<D>::build(boxes);

@@ -217,10 +217,12 @@ class MovingScan {
       const double dt = s - t[i];
       const double x = px[i] + vx[i] * dt;
       const double y = py[i] + vy[i] * dt;
-      bool in = (x >= b.min[0]) & (x <= b.max[0]) & (y >= b.min[1]) & (y <= b.max[1]);
+      // Branch-free: each comparison's 0 or 1.
+      unsigned in = unsigned(x >= b.min[0]) & unsigned(x <= b.max[0]) & unsigned(y >= b.min[1]) &
+                    unsigned(y <= b.max[1]);
       if constexpr (D == 3) {
         const double z = p_[2][i] + v_[2][i] * dt;
-        in = in & (z >= b.min[2]) & (z <= b.max[2]);
+        in &= unsigned(z >= b.min[2]) & unsigned(z <= b.max[2]);
       }
       out[found] = std::uint32_t(i);
       found += in;

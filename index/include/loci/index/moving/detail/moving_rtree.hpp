@@ -503,10 +503,10 @@ class MovingRTree {
   static void boxes_meet(const Node& n, const Box<D>& grown, double r, bool* in) {
     const BoxArray& b = n.box;
     for (int e = 0; e < n.count; ++e) {
-      bool ok = true;
+      unsigned ok = 1;
       for (int i = 0; i < D; ++i)
-        ok &= (b.lo[i][e] + b.vlo[i][e] * r <= grown.max[i]) &
-              (b.hi[i][e] + b.vhi[i][e] * r >= grown.min[i]);
+        ok &= unsigned(b.lo[i][e] + b.vlo[i][e] * r <= grown.max[i]) &
+              unsigned(b.hi[i][e] + b.vhi[i][e] * r >= grown.min[i]);
       in[e] = ok;
     }
   }
@@ -515,10 +515,10 @@ class MovingRTree {
     const MotionArray& m = n.motion;
     for (int e = 0; e < n.count; ++e) {
       const double dt = s - m.t[e];
-      bool ok = true;
+      unsigned ok = 1;
       for (int i = 0; i < D; ++i) {
         const double x = m.p[i][e] + m.v[i][e] * dt;
-        ok &= (x >= w.min[i]) & (x <= w.max[i]);
+        ok &= unsigned(x >= w.min[i]) & unsigned(x <= w.max[i]);
       }
       in[e] = ok;
     }
