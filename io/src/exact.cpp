@@ -351,11 +351,12 @@ bool covers(const PreparedGeometry& pa, const PreparedGeometry& pb) {
     return true;
   });
   if (areas && a.polygons > 1) {
-    // a's polygons cut each other's ring edges too, so that each piece lies wholly inside or
-    // outside every other polygon and its middle speaks for it (below).
+    // a's ring edges cut each other too, so that each piece lies wholly inside or outside every
+    // other polygon and its middle speaks for it (below), on no edge across it: those of other
+    // polygons, and those of its own that touch it (a hole touching its outer ring).
     const std::span<const Box2> boxes(ea.boxes);
     join(boxes, boxes, [&](Id i, Id j) {
-      if (!ea.ring[i] || !ea.ring[j] || ea.polygon[i] == ea.polygon[j]) return true;
+      if (!ea.ring[i] || !ea.ring[j] || i == j) return true;
       const SegmentIntersection x = intersection(ea.segs[i], ea.segs[j]);
       if (x.kind == SegmentMeet::none) return true;
       for (int k = 0; k < (x.kind == SegmentMeet::point ? 1 : 2); ++k) {
@@ -595,19 +596,15 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
   };
   const std::uint32_t r0 = row(m[1] - hair), r1 = row(m[1] + hair);
   const std::uint32_t c0 = col(m[0] - hair), c1 = col(m[0] + hair);
-  if (r0 == r1 && c0 == c1) {
-    // p lies in m's cell: as locate, the edges right of it by their end values at most p's y
-    // (those within rounding of m's y compared exactly), the cell's own edges each exactly.
-    const std::size_t cell = std::size_t(r0) * nx_ + c0;
-    const double* v0 = values_.data() + value_start_[cell];
-    const double* v1 = values_.data() + value_start_[cell + 1];
-    for (std::uint32_t i = base_start_[cell]; i < base_start_[cell + 1]; ++i)
-      odd.toggle(base_[i]);
-    for (const double* v = v0; v != v1 && *v <= m[1] + hair; ++v)
-      if (*v < m[1] - hair || above(1, *v) <= 0)
-        odd.toggle(value_polygons_[value_start_[cell] + std::size_t(v - v0)]);
-    for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i)
-      if (on_edge(cell_edges_[i])) return Location::boundary;
+  if (r1 <= r0 + 1) {
+    // p lies in one cell, or within rounding of a cell's border: as locate, the edges starting
+    // right of the cells by their end values below p (those within rounding of m's y compared
+    // exactly), the edges of the cells each exactly.
+    right_of(
+        r0, r1, c1, m[1], hair, [&](double v) { return above(1, v) <= 0; }, odd);
+    bool on = false;
+    each_edge_in(r0, r1, c0, c1, [&](std::uint32_t k) { return !(on = on_edge(k)); });
+    if (on) return Location::boundary;
     return odd.any() ? Location::inside : Location::outside;
   }
   // Else every edge listed in those rows from c0 rightwards.
@@ -675,10 +672,33 @@ bool PreparedGeometry::holds_both_sides(const Segment2& s, double t) const {
     }
     return true;
   };
-  // The edges crossing either stepped point's rightward ray are listed in the rows p's y falls
-  // in, from p's column rightwards: each is taken in the first of the cells scanned that lists
-  // it, as locate_at does.
   const std::uint32_t r0 = row(m[1] - hair), r1 = row(m[1] + hair), c0 = col(m[0] - hair);
+  if (r1 <= r0 + 1) {
+    // p lies in one cell, or within rounding of a cell's border, and so do the stepped points:
+    // as locate_at, the edges starting right of the cells by their end values below the
+    // stepped point (an end at p's height is below the point stepped up, or sideways, and
+    // above the point stepped down), then the edges of the cells, each once.
+    const std::uint32_t c1 = col(m[0] + hair);
+    for (int k = 0; k < 2; ++k) {
+      const int step_y = k == 0 ? dx : -dx;
+      right_of(
+          r0, r1, c1, m[1], hair,
+          [&](double v) {
+            const int a = above(1, v);
+            return a < 0 || (a == 0 && step_y >= 0);
+          },
+          side[k]);
+    }
+    bool decided = true;
+    each_edge_in(r0, r1, c0, c1, [&](std::uint32_t k) {
+      const Edge& e = edges_[k];
+      return e.kind != kRing || (decided = crossings(e));
+    });
+    return decided && side[0].any() && side[1].any();
+  }
+  // Else the edges crossing either stepped point's rightward ray are listed in the rows p's y
+  // falls in, from p's column rightwards: each is taken in the first of the cells scanned that
+  // lists it, as locate_at does.
   for (std::uint32_t r = r0; r <= r1; ++r)
     for (std::uint32_t c = c0; c < nx_; ++c) {
       const std::size_t cell = std::size_t(r) * nx_ + c;
@@ -694,6 +714,52 @@ bool PreparedGeometry::holds_both_sides(const Segment2& s, double t) const {
       }
     }
   return side[0].any() && side[1].any();
+}
+
+template <class Below>
+void PreparedGeometry::right_of(std::uint32_t r0, std::uint32_t r1, std::uint32_t c, double y,
+                                double hair, Below below, OddPolygons& odd) const {
+  // Cell (r1, c)'s base holds the ends below row r1, its values those in it, sorted.
+  const std::size_t cell = std::size_t(r1) * nx_ + c;
+  for (std::uint32_t i = base_start_[cell]; i < base_start_[cell + 1]; ++i)
+    odd.toggle(base_[i]);
+  for (std::uint32_t i = value_start_[cell]; i < value_start_[cell + 1]; ++i) {
+    const double v = values_[i];
+    if (v > y + hair) break;
+    if (v < y - hair || below(v)) odd.toggle(value_polygons_[i]);
+  }
+  if (r0 == r1) return;
+  // The point may lie in row r0, below r1's border: the base took every end of row r0 for
+  // below it, and those that are not are taken back (from the top of row r0's values).
+  const std::size_t under = cell - nx_;
+  for (std::uint32_t i = value_start_[under + 1]; i-- > value_start_[under];) {
+    const double v = values_[i];
+    if (v < y - hair) break;
+    if (v > y + hair || !below(v)) odd.toggle(value_polygons_[i]);
+  }
+}
+
+template <class F>
+void PreparedGeometry::each_edge_in(std::uint32_t r0, std::uint32_t r1, std::uint32_t c0,
+                                    std::uint32_t c1, F&& f) const {
+  const std::vector<Point2>& pts = g_->points;
+  const bool one = r0 == r1 && c0 == c1;
+  for (std::uint32_t r = r0; r <= r1; ++r)
+    for (std::uint32_t c = c0; c <= c1; ++c) {
+      const std::size_t cell = std::size_t(r) * nx_ + c;
+      for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
+        if (!one) {
+          // Each edge once: in the first of the cells that lists it.
+          const Edge& e = edges_[cell_edges_[i]];
+          const Point2& a = pts[e.first];
+          const Point2& b = e.kind == kPoint ? a : pts[e.first + 1];
+          if (std::max(row(std::min(a[1], b[1])), r0) != r ||
+              std::max(col(std::min(a[0], b[0])), c0) != c)
+            continue;
+        }
+        if (!f(cell_edges_[i])) return;
+      }
+    }
 }
 
 std::uint32_t PreparedGeometry::col(double x) const {

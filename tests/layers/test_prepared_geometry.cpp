@@ -567,6 +567,66 @@ TEST(PreparedGeometry, CoversAcrossEdgesPolygonsShare) {
   EXPECT_GT(across, 200);  // covered only by polygons together, across the edges they share
 }
 
+// A long strip of a TIN's faces: the grid over it has its rows' border at half height, where
+// the shared vertical edges have their middles, and its columns' borders at the vertices.
+// Those points are decided from the cells about them (it scanned the rest of the row for each,
+// 20 s for 10,000 faces), and as before: covered, not covered where one face is missing, and
+// points on and beside those edges located as by brute force.
+TEST(PreparedGeometry, CoversAcrossTheGridsBordersAlongAStrip) {
+  for (const int missing : {-1, 1234}) {
+    FlatGeometry a;
+    std::uint32_t polygons = 0;
+    for (int i = 0; i < 1500; ++i) {
+      const double x = i;
+      if (2 * i != missing) add_ring(a, {{x, 0}, {x + 1, 0}, {x + 1, 1}}, polygons++, i % 2);
+      if (2 * i + 1 != missing) add_ring(a, {{x, 0}, {x + 1, 1}, {x, 1}}, polygons++);
+    }
+    a.polygons = polygons;
+    FlatGeometry b;
+    add_ring(b, {{0.5, 0.25}, {1499.5, 0.25}, {1499.5, 0.75}, {0.5, 0.75}}, 0);
+    b.polygons = 1;
+    const PreparedGeometry pa(a);
+    EXPECT_EQ(covers(pa, PreparedGeometry(b)), missing < 0);
+    for (int i = 1; i < 1500; i += 7)
+      for (const double y : {0.5, 0.25, 0.75}) {
+        const Segment2 s{{double(i), 0}, {double(i), 1}};
+        EXPECT_EQ(pa.locate_at(s, y), brute(a, {double(i), y})) << i << " " << y;
+        const Segment2 across{{i - 0.5, y}, {i + 0.5, y}};
+        EXPECT_EQ(pa.locate_at(across, 0.25), brute(a, point_at(across, 0.25))) << i << " " << y;
+      }
+  }
+}
+
+// A polygon's own rings meeting inside another polygon's area (a hole touching its outer ring
+// at the middle of an edge, a ring crossing itself): the edge is cut there too, so that no
+// piece's middle lies on the ring that touches it, where its sides were undecided and the
+// piece taken for boundary. b is the other polygon, or a window of it.
+TEST(PreparedGeometry, CoversWhereAPolygonsRingsTouchInsideAnother) {
+  FlatGeometry a, bowtie;
+  add_ring(a, {{0, 0}, {4, 0}, {4, 4}, {0, 4}}, 0);
+  add_ring(a, {{2, 0}, {3, 1}, {1, 1}}, 0);  // a hole touching the outer ring at (2, 0)
+  add_ring(a, {{-1, -1}, {5, -1}, {5, 5}, {-1, 5}}, 1);
+  a.polygons = 2;
+  add_ring(bowtie, {{0, 0}, {4, 4}, {4, 0}, {0, 4}}, 0);  // crossing itself at (2, 2)
+  add_ring(bowtie, {{1, 1}, {3, 1}, {3, 3}, {1, 3}}, 1);
+  bowtie.polygons = 2;
+  FlatGeometry whole, window, square;
+  add_ring(whole, {{-1, -1}, {5, -1}, {5, 5}, {-1, 5}}, 0);
+  add_ring(window, {{1, -0.5}, {3, -0.5}, {3, 0.5}, {1, 0.5}}, 0);
+  add_ring(square, {{1, 1}, {3, 1}, {3, 3}, {1, 3}}, 0);
+  whole.polygons = window.polygons = square.polygons = 1;
+  EXPECT_TRUE(covers(PreparedGeometry(a), PreparedGeometry(whole)));
+  EXPECT_TRUE(covers(PreparedGeometry(a), PreparedGeometry(window)));
+  EXPECT_TRUE(covers(PreparedGeometry(bowtie), PreparedGeometry(square)));
+  // Without the polygon around them, the hole and the bow-tie's notches are outside.
+  FlatGeometry alone;
+  add_ring(alone, {{0, 0}, {4, 0}, {4, 4}, {0, 4}}, 0);
+  add_ring(alone, {{2, 0}, {3, 1}, {1, 1}}, 0);
+  add_ring(alone, {{10, 10}, {11, 10}, {11, 11}}, 1);
+  alone.polygons = 2;
+  EXPECT_FALSE(covers(PreparedGeometry(alone), PreparedGeometry(window)));
+}
+
 // Four rectangles in a pinwheel over a hole of a fifth leave a hole of their own: every edge
 // of theirs inside b is partly inside another of them and partly the feature's boundary (each
 // edge is cut where the others cross it, so that the boundary part is tested).

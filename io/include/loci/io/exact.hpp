@@ -115,6 +115,8 @@ enum class Location : std::uint8_t { outside, boundary, inside };
 // feature met by many others (a joined layer) is prepared once and each pair costs the edges
 // near the other's envelope, not the product of the sizes. It refers to `g`, which must
 // outlive it. Thread-safety: const member functions may run concurrently.
+class OddPolygons;
+
 class PreparedGeometry {
  public:
   explicit PreparedGeometry(const FlatGeometry& g);
@@ -147,6 +149,17 @@ class PreparedGeometry {
   std::uint32_t col(double x) const;
   std::uint32_t row(double y) const;
   void build(std::size_t cells);
+  // Toggles in `odd` the polygons of the ring edges whose boxes start right of column c, by
+  // their ends below a point at height y (exactly: `below(v)`, asked only of ends within `hair`
+  // of y) of row r1, or of row r0 = r1 - 1 within rounding of r1's lower border.
+  template <class Below>
+  void right_of(std::uint32_t r0, std::uint32_t r1, std::uint32_t c, double y, double hair,
+                Below below, OddPolygons& odd) const;
+  // f(edge) for each edge listed in the cells of rows r0..r1 and columns c0..c1, once, until f
+  // returns false.
+  template <class F>
+  void each_edge_in(std::uint32_t r0, std::uint32_t r1, std::uint32_t c0, std::uint32_t c1,
+                    F&& f) const;
 
   const FlatGeometry* g_;
   Box2 envelope_;
