@@ -22,6 +22,13 @@ run("configure the consumer" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}" -B "${WORK_DI
 run("build the consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
 run("run the consumer" "${WORK_DIR}/build/loci_consumer" "${LAYER}")
 message(STATUS "${last_output}")
+# The header-only index alone, with GDAL and SQLite hidden from find_package.
+run("configure the index-only consumer" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/../index_only"
+    -B "${WORK_DIR}/build-index" -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release
+    "-DCMAKE_CXX_COMPILER=${CXX}" "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix"
+    -DCMAKE_DISABLE_FIND_PACKAGE_GDAL=ON -DCMAKE_DISABLE_FIND_PACKAGE_SQLite3=ON)
+run("build the index-only consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build-index")
+run("run the index-only consumer" "${WORK_DIR}/build-index/loci_index_only")
 # Clang too, where the machine has it: its warnings are not GCC's.
 find_program(CLANGXX clang++)
 if(CLANGXX)
