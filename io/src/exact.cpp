@@ -594,34 +594,19 @@ Location PreparedGeometry::locate_at(const Segment2& s, double t) const {
       odd.toggle(e.polygon);
     return false;
   };
-  const std::uint32_t r0 = row(m[1] - hair), r1 = row(m[1] + hair);
-  const std::uint32_t c0 = col(m[0] - hair), c1 = col(m[0] + hair);
-  if (r1 <= r0 + 1) {
-    // p lies in one cell, or within rounding of a cell's border: as locate, the edges starting
-    // right of the cells by their end values below p (those within rounding of m's y compared
-    // exactly), the edges of the cells each exactly.
+  // When p lies in one cell, or within rounding of a cell's border: as locate, the edges
+  // starting right of the cells by their end values below p (those within rounding of m's y
+  // compared exactly), the edges of the cells each exactly. Else every edge listed in those
+  // rows from c0 rightwards.
+  const std::uint32_t r0 = row(m[1] - hair), r1 = row(m[1] + hair), c0 = col(m[0] - hair);
+  const bool near = r1 <= r0 + 1;
+  const std::uint32_t c1 = near ? col(m[0] + hair) : nx_ - 1;
+  if (near)
     right_of(
         r0, r1, c1, m[1], hair, [&](double v) { return above(1, v) <= 0; }, odd);
-    bool on = false;
-    each_edge_in(r0, r1, c0, c1, [&](std::uint32_t k) { return !(on = on_edge(k)); });
-    if (on) return Location::boundary;
-    return odd.any() ? Location::inside : Location::outside;
-  }
-  // Else every edge listed in those rows from c0 rightwards.
-  for (std::uint32_t r = r0; r <= r1; ++r)
-    for (std::uint32_t c = c0; c < nx_; ++c) {
-      const std::size_t cell = std::size_t(r) * nx_ + c;
-      for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
-        const Edge& e = edges_[cell_edges_[i]];
-        const Point2& a = pts[e.first];
-        const Point2& b = e.kind == kPoint ? a : pts[e.first + 1];
-        // Each edge once: in the first of the cells scanned that lists it.
-        if (std::max(row(std::min(a[1], b[1])), r0) != r ||
-            std::max(col(std::min(a[0], b[0])), c0) != c)
-          continue;
-        if (on_edge(cell_edges_[i])) return Location::boundary;
-      }
-    }
+  bool on = false;
+  each_edge_in(r0, r1, c0, c1, [&](std::uint32_t k) { return !(on = on_edge(k)); });
+  if (on) return Location::boundary;
   return odd.any() ? Location::inside : Location::outside;
 }
 
@@ -672,48 +657,30 @@ bool PreparedGeometry::holds_both_sides(const Segment2& s, double t) const {
     }
     return true;
   };
+  // p lies in one cell, or within rounding of a cell's border, and so do the stepped points:
+  // as locate_at, the edges starting right of the cells by their end values below the stepped
+  // point (an end at p's height is below the point stepped up, or sideways, and above the
+  // point stepped down), then the edges of the cells, each once. Else the edges listed in the
+  // rows p's y falls in, from p's column rightwards.
   const std::uint32_t r0 = row(m[1] - hair), r1 = row(m[1] + hair), c0 = col(m[0] - hair);
-  if (r1 <= r0 + 1) {
-    // p lies in one cell, or within rounding of a cell's border, and so do the stepped points:
-    // as locate_at, the edges starting right of the cells by their end values below the
-    // stepped point (an end at p's height is below the point stepped up, or sideways, and
-    // above the point stepped down), then the edges of the cells, each once.
-    const std::uint32_t c1 = col(m[0] + hair);
-    for (int k = 0; k < 2; ++k) {
-      const int step_y = k == 0 ? dx : -dx;
-      right_of(
-          r0, r1, c1, m[1], hair,
-          [&](double v) {
-            const int a = above(1, v);
-            return a < 0 || (a == 0 && step_y >= 0);
-          },
-          side[k]);
-    }
-    bool decided = true;
-    each_edge_in(r0, r1, c0, c1, [&](std::uint32_t k) {
-      const Edge& e = edges_[k];
-      return e.kind != kRing || (decided = crossings(e));
-    });
-    return decided && side[0].any() && side[1].any();
+  const bool near = r1 <= r0 + 1;
+  const std::uint32_t c1 = near ? col(m[0] + hair) : nx_ - 1;
+  for (int k = 0; near && k < 2; ++k) {
+    const int step_y = k == 0 ? dx : -dx;
+    right_of(
+        r0, r1, c1, m[1], hair,
+        [&](double v) {
+          const int a = above(1, v);
+          return a < 0 || (a == 0 && step_y >= 0);
+        },
+        side[k]);
   }
-  // Else the edges crossing either stepped point's rightward ray are listed in the rows p's y
-  // falls in, from p's column rightwards: each is taken in the first of the cells scanned that
-  // lists it, as locate_at does.
-  for (std::uint32_t r = r0; r <= r1; ++r)
-    for (std::uint32_t c = c0; c < nx_; ++c) {
-      const std::size_t cell = std::size_t(r) * nx_ + c;
-      for (std::uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
-        const Edge& e = edges_[cell_edges_[i]];
-        if (e.kind != kRing) continue;
-        const Point2& a = pts[e.first];
-        const Point2& b = pts[e.first + 1];
-        if (std::max(row(std::min(a[1], b[1])), r0) != r ||
-            std::max(col(std::min(a[0], b[0])), c0) != c)
-          continue;
-        if (!crossings(e)) return false;
-      }
-    }
-  return side[0].any() && side[1].any();
+  bool decided = true;
+  each_edge_in(r0, r1, c0, c1, [&](std::uint32_t k) {
+    const Edge& e = edges_[k];
+    return e.kind != kRing || (decided = crossings(e));
+  });
+  return decided && side[0].any() && side[1].any();
 }
 
 template <class Below>
