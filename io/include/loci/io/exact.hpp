@@ -104,6 +104,8 @@ bool covers(const FlatGeometry& a, const FlatGeometry& b);
 // edge of a line or ring), or strictly inside one of its polygons.
 enum class Location : std::uint8_t { outside, boundary, inside };
 
+class OddPolygons;
+
 // A geometry prepared for many point tests: a grid of cells over its envelope, each listing
 // the edges whose boxes overlap it, and for each cell what the edges entirely to its right
 // contribute to the crossing parity of each polygon for a ray from any point of the cell (the
@@ -115,8 +117,6 @@ enum class Location : std::uint8_t { outside, boundary, inside };
 // feature met by many others (a joined layer) is prepared once and each pair costs the edges
 // near the other's envelope, not the product of the sizes. It refers to `g`, which must
 // outlive it. Thread-safety: const member functions may run concurrently.
-class OddPolygons;
-
 class PreparedGeometry {
  public:
   explicit PreparedGeometry(const FlatGeometry& g);
