@@ -1,0 +1,151 @@
+// The convex hull of a set of points in the plane, and the nearest point of a hull to a point
+// outside it.
+//
+// convex_hull() is Andrew's monotone chain (1979): the points sorted by x then y, a lower and
+// an upper chain built by dropping every point that does not turn left. The turns are decided
+// by the exact orientation predicate (predicates.hpp), so the hull holds every input point and
+// its vertices are input points, whatever the rounding of nearby coordinates: a lower bound on
+// the distance to the set taken from the hull is a true one. Cost O(n log n) for the sort;
+// hull_candidates() first drops the points strictly inside the polygon of the eight extreme
+// points (Akl and Toussaint, 1978), which for the linework of a map layer leaves few.
+//
+// nearest_vertex_certified() answers, in O(h) for a hull of h vertices, whether the point of
+// the hull nearest to p is one of its vertices, and which: then, because the vertex is one of
+// the points and every point lies in the hull, the distance from p to the whole set is the
+// distance to that vertex, found without reading the set. It says so only when the floating
+// tests leave no doubt (rounding is bounded, not assumed away); otherwise the caller measures
+// the set itself.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "loci/geom/point.hpp"
+#include "loci/geom/predicates.hpp"
+
+namespace loci {
+
+// The vertices of the convex hull of `points`, counterclockwise from the least point by
+// (x, y), with no three collinear: one vertex for a single distinct point, the two ends for
+// collinear points, none for none. Sorts `points` in place; coordinates must be finite.
+inline std::vector<Point2> convex_hull(std::span<Point2> points) {
+  auto less = [](const Point2& a, const Point2& b) {
+    return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]);
+  };
+  std::sort(points.begin(), points.end(), less);
+  const auto end = std::unique(points.begin(), points.end());
+  const std::size_t n = std::size_t(end - points.begin());
+  std::vector<Point2> hull;
+  if (n <= 2) return {points.begin(), end};
+  hull.reserve(2 * n);
+  // Lower chain left to right, then upper chain right to left; each keeps only left turns.
+  for (std::size_t i = 0; i < n; ++i) {
+    while (hull.size() >= 2 && orientation(hull[hull.size() - 2], hull.back(), points[i]) !=
+                                   Orientation::counterclockwise)
+      hull.pop_back();
+    hull.push_back(points[i]);
+  }
+  const std::size_t lower = hull.size();
+  for (std::size_t i = n - 1; i-- > 0;) {
+    while (hull.size() > lower && orientation(hull[hull.size() - 2], hull.back(), points[i]) !=
+                                      Orientation::counterclockwise)
+      hull.pop_back();
+    hull.push_back(points[i]);
+  }
+  hull.pop_back();  // the first point again
+  return hull;
+}
+
+// Appends to `out` the points of `points` that can be vertices of their convex hull: all but
+// those strictly inside the polygon of the extreme points in x, y, x + y and x - y (each
+// extreme is an input point, so that polygon lies in the hull and a point strictly inside it
+// is no vertex). The strictness is decided by the exact predicate.
+inline void hull_candidates(std::span<const Point2> points, std::vector<Point2>& out) {
+  if (points.empty()) return;
+  // Extremes in the directions at 45-degree steps, counterclockwise from -y.
+  Point2 e[8];
+  std::fill(e, e + 8, points[0]);
+  auto key = [](const Point2& p, int d) {
+    switch (d) {
+      case 0:
+        return -p[1];
+      case 1:
+        return p[0] - p[1];
+      case 2:
+        return p[0];
+      case 3:
+        return p[0] + p[1];
+      case 4:
+        return p[1];
+      case 5:
+        return p[1] - p[0];
+      case 6:
+        return -p[0];
+      default:
+        return -p[0] - p[1];
+    }
+  };
+  for (const Point2& p : points)
+    for (int d = 0; d < 8; ++d)
+      if (key(p, d) > key(e[d], d)) e[d] = p;
+  // The distinct extremes in order form a convex polygon (counterclockwise, possibly with
+  // collinear vertices); fewer than three distinct ones bound no area: keep everything.
+  Point2 ring[8];
+  int m = 0;
+  for (int d = 0; d < 8; ++d)
+    if (m == 0 || !(e[d] == ring[m - 1])) ring[m++] = e[d];
+  while (m > 1 && ring[m - 1] == ring[0])
+    --m;
+  auto inside = [&](const Point2& p) {
+    for (int i = 0; i < m; ++i) {
+      const Point2& a = ring[i];
+      const Point2& b = ring[(i + 1) % m];
+      if (orientation(a, b, p) != Orientation::counterclockwise) return false;
+    }
+    return true;
+  };
+  if (m < 3) {
+    out.insert(out.end(), points.begin(), points.end());
+    return;
+  }
+  for (const Point2& p : points)
+    if (!inside(p)) out.push_back(p);
+}
+
+// For `hull` as convex_hull() gives it (at least one vertex) and p: the index of the vertex
+// nearest to p when that vertex is certainly the point of the hull nearest to p (p - v lies
+// in the cone of outward normals at v, which the two edges at v bound), else -1. Certain
+// means the signs of both dot products are beyond their rounding error; a p on the normal
+// through an edge's end, or inside the hull, gives -1.
+inline int nearest_vertex_certified(std::span<const Point2> hull, const Point2& p) {
+  const std::size_t h = hull.size();
+  if (h == 0) return -1;
+  std::size_t best = 0;
+  double best2 = INFINITY;
+  for (std::size_t i = 0; i < h; ++i) {
+    const double dx = p[0] - hull[i][0], dy = p[1] - hull[i][1];
+    const double d2 = dx * dx + dy * dy;
+    if (d2 < best2) best2 = d2, best = i;
+  }
+  if (h == 1) return 0;
+  const Point2& v = hull[best];
+  const double px = p[0] - v[0], py = p[1] - v[1];
+  // (p - v) . (w - v) < 0 for both neighbours w, beyond the error of the floating dot: each
+  // difference is rounded once (relative error eps), each product and the sum once more, so
+  // the computed value is within 4 eps of the sum of the products' magnitudes (3e-300 for
+  // what underflow loses).
+  auto away = [&](const Point2& w) {
+    const double wx = w[0] - v[0], wy = w[1] - v[1];
+    const double a = px * wx, b = py * wy;
+    const double dot = a + b;
+    return dot < -(8.9e-16 * (std::fabs(a) + std::fabs(b)) + 3e-300);
+  };
+  const Point2& prev = hull[(best + h - 1) % h];
+  const Point2& next = hull[(best + 1) % h];
+  return away(prev) && away(next) ? int(best) : -1;
+}
+
+}  // namespace loci
