@@ -361,7 +361,8 @@ bool same_hierarchies(const LayerIndex::Features& stored, const LayerIndex::Feat
   if (!built.hierarchical || !same(stored.fid, built.fid) || !same(stored.roots, built.roots) ||
       stored.levels.size() != built.levels.size() ||
       !same(stored.root_tree.blocks(), built.root_tree.blocks()) ||
-      !same(stored.root_tree.item_indices(), built.root_tree.item_indices()))
+      !same(stored.root_tree.item_indices(), built.root_tree.item_indices()) ||
+      !same(stored.hull_first, built.hull_first) || !same(stored.hull_points, built.hull_points))
     return false;
   for (std::size_t l = 0; l < built.levels.size(); ++l)
     if (!same(stored.levels[l], built.levels[l])) return false;

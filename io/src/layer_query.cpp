@@ -12,6 +12,7 @@
 #include <unordered_set>
 
 #include "gdal_layer.hpp"
+#include "loci/geom/convex_hull.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/exact.hpp"
 #include "shapefile_polygons.hpp"
@@ -327,6 +328,8 @@ const LayerIndex::Features& LayerIndex::features() const {
     f.leaves = (t->size() + PackedRTree2::node_size - 1) / PackedRTree2::node_size;
     f.fid = {m.fids, m.features};
     f.roots = {m.roots, m.features};
+    f.hull_first = {m.hull_first, m.features + 1};
+    f.hull_points = {m.hull_points, m.hull_count};
     check_->touch(m.level_sizes, 8 * m.levels);
     std::vector<std::span<const Features::Node>> levels;  // kept only when all are sound
     std::size_t at = 0;
@@ -450,6 +453,32 @@ LayerIndex::Features LayerIndex::build_features(const PackedRTree2* t, Per per,
     level[start[part.feature]++] = {t->levels() > 1 ? t->entry_box(1, part.leaf) : only_leaf,
                                     part.feature, part.leaf, part.leaf, slots_of(part)};
   parts = {};
+  // The hull of every feature's segment ends, from its level-0 nodes (in feature order).
+  f.own_hull_first.assign(features + 1, 0);
+  {
+    std::vector<Point2> ends, kept;
+    std::size_t i = 0;
+    for (std::uint32_t g = 0; g < features; ++g) {
+      ends.clear();
+      kept.clear();
+      for (; i < level.size() && level[i].feature == g; ++i) {
+        const std::size_t first = std::size_t(level[i].first) * kFanout;
+        for (std::uint32_t mine = level[i].slots & 0xffffu; mine != 0; mine &= mine - 1) {
+          const int e = std::countr_zero(mine);
+          const bool anti = (level[i].slots >> (kFanout + e)) & 1;
+          const Segment2 s = segment_of(t->box_at(first + e), anti ? item_antidiagonal : 0u);
+          ends.push_back(s.a);
+          ends.push_back(s.b);
+        }
+      }
+      hull_candidates(ends, kept);
+      const std::vector<Point2> hull = convex_hull(kept);
+      f.own_hull_points.insert(f.own_hull_points.end(), hull.begin(), hull.end());
+      f.own_hull_first[g + 1] = std::uint32_t(f.own_hull_points.size());
+    }
+  }
+  f.hull_first = f.own_hull_first;
+  f.hull_points = f.own_hull_points;
   // Then up to 16 nodes of one feature per node, until each feature has one node, its root.
   while (!level.empty()) {
     loci::detail::LargeVector<Features::Node> up;
@@ -700,6 +729,16 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     top.emplace_back(d2, f);
     std::push_heap(top.begin(), top.end());
   };
+  // Every feature has one root; one met twice is a forged file, refused (its hull would
+  // otherwise answer for roots that are not its own).
+  if (state_.size() != features.fid.size()) {
+    state_.assign(features.fid.size(), FeatureState{});
+    generation_ = 0;
+  }
+  if (++generation_ == 0) {  // wrapped: forget every stamp
+    std::fill(state_.begin(), state_.end(), FeatureState{});
+    generation_ = 1;
+  }
   // A polygon holding p is at 0, for candidates too (its boxes need not reach p).
   std::vector<std::uint32_t> inside;
   for (const std::uint32_t f : containing_features(index_, p, features)) {
@@ -722,10 +761,16 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     if (!(lower < bound())) return false;
     const auto [level, i] = features.root(r);
     const std::uint32_t f = features.node(level, i).feature;
+    if (state_[f].stamp == generation_) features.corrupt();
+    state_[f].stamp = generation_;
     if (std::find(inside.begin(), inside.end(), f) != inside.end()) return true;
-    std::uint32_t leaf;
-    const double upper = descend.dive(level, i, leaf);
-    candidates.push_back({upper, lower, std::uint32_t(r), leaf});
+    std::uint32_t leaf = FeatureDescent::kNoLeaf;
+    // The feature's distance itself when a vertex of its hull is certainly nearest (no
+    // segment read); else an upper bound from one dive down its hierarchy, or that vertex's
+    // distance when nearer.
+    const NearestVertex v = candidates_only ? NearestVertex{} : nearest_vertex(features.hull(f), p);
+    const double upper = v.certified ? v.d2 : std::min(v.d2, descend.dive(level, i, leaf));
+    candidates.push_back({upper, lower, std::uint32_t(r), leaf, v.certified});
     if (bounds.size() == q.k) {
       if (!(upper < bounds.front())) return true;
       std::pop_heap(bounds.begin(), bounds.end());
@@ -746,9 +791,12 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     const double limit = kth();
     if (!(c.lower < limit)) continue;
     const auto [level, i] = features.root(c.root);
+    const std::uint32_t f = features.node(level, i).feature;
+    // Not descended when its hull is no nearer than the k-th distance.
+    if (!c.exact && !candidates_only && !(hull_lower_bound(features.hull(f), p) < limit)) continue;
     double best = std::min(c.upper, limit);
-    if (level > 0 || i != c.leaf) descend(level, i, best, false, c.leaf);
-    if (best < limit) keep(best, features.node(level, i).feature);
+    if (!c.exact && (level > 0 || i != c.leaf)) descend(level, i, best, false, c.leaf);
+    if (best < limit) keep(best, f);
   }
   std::sort_heap(top.begin(), top.end());
   for (const auto& [d2, f] : top)

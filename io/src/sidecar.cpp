@@ -28,7 +28,7 @@ namespace loci::io {
 namespace {
 
 constexpr char kMagic[8] = {'\x89', 'L', 'O', 'C', 'I', '\r', '\n', '\x1a'};
-constexpr std::uint32_t kVersion = 6;
+constexpr std::uint32_t kVersion = 7;
 constexpr std::uint32_t kByteOrder = 0x01020304;
 constexpr std::uint8_t kStructurePackedRTree = 1;
 constexpr std::uint8_t kCoordFloat64 = 1;
@@ -74,7 +74,7 @@ struct SidecarHeader {
   std::uint64_t hierarchy_features;  // their FIDs and roots
   std::uint64_t hierarchy_nodes;     // their nodes, all levels
   std::uint32_t hierarchy_levels;
-  std::uint32_t reserved2;
+  std::uint32_t hull_count;       // the vertices of the features' hulls
   std::uint64_t header_checksum;  // XXH3-64 of the bytes before this field
 };
 static_assert(sizeof(SidecarHeader) == 256);
@@ -86,15 +86,15 @@ std::size_t align_up(std::size_t n) {
 
 // Where the arrays of the hierarchies section lie, from its offset and counts (each array
 // from a 64-byte boundary): FIDs, level sizes, roots, nodes, the roots' tree's blocks and item
-// indices. Counts too large for the file give an end beyond it (no overflow: each count is
-// checked against the file size first).
+// indices, the hulls' starts and vertices. Counts too large for the file give an end beyond it
+// (no overflow: each count is checked against the file size first).
 struct HierarchyLayout {
-  std::uint64_t fids, sizes, roots, nodes, root_blocks, root_items, end;
+  std::uint64_t fids, sizes, roots, nodes, root_blocks, root_items, hull_first, hull_points, end;
   std::uint64_t root_block_count, root_slots;
 };
 
 HierarchyLayout hierarchy_layout(std::uint64_t offset, std::uint64_t features, std::uint64_t levels,
-                                 std::uint64_t nodes) {
+                                 std::uint64_t nodes, std::uint64_t hull_count) {
   HierarchyLayout l{};
   l.root_block_count = PackedRTree2::block_count(std::size_t(features));
   l.root_slots =
@@ -105,7 +105,9 @@ HierarchyLayout hierarchy_layout(std::uint64_t offset, std::uint64_t features, s
   l.nodes = align_up(l.roots + sizeof(HierarchyRoot) * features);
   l.root_blocks = align_up(l.nodes + sizeof(HierarchyNode) * nodes);
   l.root_items = align_up(l.root_blocks + sizeof(PackedRTree2::Block) * l.root_block_count);
-  l.end = l.root_items + 4 * l.root_slots;
+  l.hull_first = align_up(l.root_items + 4 * l.root_slots);
+  l.hull_points = align_up(l.hull_first + 4 * (features + 1));
+  l.end = l.hull_points + sizeof(Point2) * hull_count;
   return l;
 }
 
@@ -368,8 +370,12 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   const auto items = tree.item_indices();
   if (hierarchies && (!hierarchies->root_tree || info.per != Per::segment ||
                       hierarchies->roots.size() != hierarchies->fids.size() ||
-                      hierarchies->root_tree->size() != hierarchies->roots.size()))
-    throw InvalidArgument("sidecar: hierarchies of a per-segment index, one root per feature");
+                      hierarchies->root_tree->size() != hierarchies->roots.size() ||
+                      hierarchies->hull_first.size() != hierarchies->fids.size() + 1 ||
+                      hierarchies->hull_first.back() != hierarchies->hull_points.size() ||
+                      hierarchies->hull_points.size() >= (1ull << 32)))
+    throw InvalidArgument(
+        "sidecar: hierarchies of a per-segment index, one root and one hull per feature");
 
   SidecarHeader h{};
   std::memcpy(h.magic, kMagic, 8);
@@ -403,8 +409,10 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
     h.hierarchy_features = hierarchies->fids.size();
     h.hierarchy_levels = std::uint32_t(level_sizes.size());
     h.hierarchy_nodes = node_count;
+    h.hull_count = std::uint32_t(hierarchies->hull_points.size());
     // Laid out from 0 first, for its length.
-    hl = hierarchy_layout(0, h.hierarchy_features, h.hierarchy_levels, h.hierarchy_nodes);
+    hl = hierarchy_layout(0, h.hierarchy_features, h.hierarchy_levels, h.hierarchy_nodes,
+                          h.hull_count);
   }
   const std::size_t hierarchy_bytes =
       hierarchies ? align_up(records.size_bytes()) - records.size_bytes() + hl.end : 0;
@@ -419,7 +427,7 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   if (hierarchies) {
     h.hierarchy_offset = align_up(h.file_size);
     hl = hierarchy_layout(h.hierarchy_offset, h.hierarchy_features, h.hierarchy_levels,
-                          h.hierarchy_nodes);
+                          h.hierarchy_nodes, h.hull_count);
     h.file_size = hl.end;
   }
   const Box2 b = tree.bounds();
@@ -458,6 +466,10 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
       throw InvalidArgument("sidecar: the roots' tree does not match the roots");
     pieces.push_back({hl.root_blocks, root_blocks.data(), root_blocks.size_bytes()});
     pieces.push_back({hl.root_items, root_items.data(), root_items.size_bytes()});
+    pieces.push_back(
+        {hl.hull_first, hierarchies->hull_first.data(), hierarchies->hull_first.size_bytes()});
+    pieces.push_back(
+        {hl.hull_points, hierarchies->hull_points.data(), hierarchies->hull_points.size_bytes()});
   }
   // The bytes [first, first + size) of the file's data: in place when one piece holds them,
   // else gathered into `buffer`.
@@ -560,15 +572,16 @@ Sidecar Sidecar::open(const std::string& path) {
       h.records_offset + 16 * std::min<std::uint64_t>(h.item_count, m->size / 16);
   const bool hierarchies_fit =
       !hierarchical ? h.hierarchy_features == 0 && h.hierarchy_nodes == 0 &&
-                          h.hierarchy_levels == 0 && h.file_size == records_end
+                          h.hierarchy_levels == 0 && h.hull_count == 0 && h.file_size == records_end
                     : h.per == std::uint8_t(Per::segment) && h.item_count > 0 &&
                           h.hierarchy_offset == align_up(records_end) && h.hierarchy_features > 0 &&
                           h.hierarchy_features <= h.item_count &&
                           h.hierarchy_features <= m->size / 16 && h.hierarchy_levels > 0 &&
                           h.hierarchy_levels <= 64 && h.hierarchy_nodes >= h.hierarchy_features &&
                           h.hierarchy_nodes <= m->size / sizeof(HierarchyNode) &&
+                          h.hull_count <= m->size / sizeof(Point2) &&
                           hierarchy_layout(h.hierarchy_offset, h.hierarchy_features,
-                                           h.hierarchy_levels, h.hierarchy_nodes)
+                                           h.hierarchy_levels, h.hierarchy_nodes, h.hull_count)
                                   .end == h.file_size;
   if (h.item_count >= (1ull << 32) || h.block_count != expect_blocks ||
       h.slot_count != expect_slots || h.blocks_offset % kAlign != 0 ||
@@ -603,7 +616,7 @@ Sidecar Sidecar::open(const std::string& path) {
                                 {blocks, std::size_t(h.block_count)}, s.items_, check, check.get());
   if (hierarchical) {
     const HierarchyLayout l = hierarchy_layout(h.hierarchy_offset, h.hierarchy_features,
-                                               h.hierarchy_levels, h.hierarchy_nodes);
+                                               h.hierarchy_levels, h.hierarchy_nodes, h.hull_count);
     auto x = std::make_shared<MappedHierarchies>();
     x->features = std::size_t(h.hierarchy_features);
     x->levels = h.hierarchy_levels;
@@ -617,6 +630,9 @@ Sidecar Sidecar::open(const std::string& path) {
                       std::size_t(l.root_block_count)};
     x->root_items = {reinterpret_cast<const std::uint32_t*>(m->data + l.root_items),
                      std::size_t(l.root_slots)};
+    x->hull_first = reinterpret_cast<const std::uint32_t*>(m->data + l.hull_first);
+    x->hull_points = reinterpret_cast<const Point2*>(m->data + l.hull_points);
+    x->hull_count = h.hull_count;
     s.hierarchies_ = std::move(x);
   }
   s.check_ = check;

@@ -27,8 +27,11 @@
 #ifdef LOCI_HAVE_IO
 #include <unistd.h>
 
+#include <filesystem>
+
 #include "loci/io/commands.hpp"
 #include "loci/io/sidecar.hpp"
+#include "support/scratch.hpp"
 #endif
 
 namespace loci::test {
@@ -252,14 +255,20 @@ TEST(ConcurrentQueries, MappedSidecar) {
 
 // A batch of layer queries spread over threads (one LayerIndex, a LayerQuery per thread)
 // writes what one thread writes: windows, nearest-n and point location on the sample, per
-// segment (no GDAL handle is used off the main thread).
+// segment (no GDAL handle is used off the main thread). The sample is copied first, so that a
+// sidecar beside it (the quick start writes one) plays no part.
 TEST(ConcurrentQueries, LayerBatchOnThreads) {
+  const loci::test::Scratch dir("loci-concurrent-layer");
+  std::filesystem::create_directories(dir.path());
+  const std::string layer = (dir.path() / "coastline-denmark.geojson").string();
+  std::filesystem::copy_file(std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson",
+                             layer);
   std::mt19937_64 rng(23);
   std::uniform_real_distribution<double> x(7, 16), y(53.5, 58.5), w(0.01, 0.8);
   for (const auto kind :
        {io::Query::Kind::bbox, io::Query::Kind::nearest, io::Query::Kind::point}) {
     io::QueryOptions o;
-    o.load.layer_path = std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson";
+    o.load.layer_path = layer;
     o.load.per = io::Per::segment;
     o.numbered = true;
     for (std::size_t n = 1; n <= 600; ++n) {

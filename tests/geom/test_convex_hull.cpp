@@ -3,7 +3,8 @@
 // in the last place apart at 1e6, and on one or two distinct points. The hull's vertices are
 // input points, every turn is strictly left, every input point lies in or on the hull, and the
 // Akl-Toussaint filter changes nothing. A certified nearest vertex is the hull's nearest point
-// to p, exactly, and certification happens for most far points.
+// to p, exactly, and certification happens for most far points; the nearest vertex's distance
+// and hull_lower_bound() hold the exact distance to the points between them.
 #include <gmpxx.h>
 #include <gtest/gtest.h>
 
@@ -121,10 +122,35 @@ TEST(ConvexHull, CertifiedNearestVertexIsTheHullsNearestPoint) {
         const Point2 &v = hull[t % h], &w = hull[(t + 1) % h];
         p = {v[0] - (w[1] - v[1]), v[1] + (w[0] - v[0])};  // v plus the edge turned right
       }
-      const int i = nearest_vertex_certified(hull, p);
+      // the nearest vertex and hull_lower_bound() bound the distance to the points (exact in
+      // rationals); the lower one is the hull's own when p is outside it, 0 inside.
+      mpq_class to_set = exact_d2(p, points[0], points[0]);
+      for (const Point2& x : points)
+        to_set = std::min(to_set, mpq_class(exact_d2(p, x, x)));
+      const NearestVertex nv = nearest_vertex(hull, p);
+      const double lower = hull_lower_bound(hull, p);
+      EXPECT_LE(mpq_class(lower), to_set);
+      EXPECT_GE(mpq_class(nv.d2), to_set * mpq_class(1 - 1e-15));
+      if (h >= 3) {
+        bool outside = false;
+        mpq_class to_hull = to_set;
+        for (std::size_t e = 0; e < h; ++e) {
+          outside = outside || exact_orientation(hull[e], hull[(e + 1) % h], p) < 0;
+          to_hull = std::min(to_hull, exact_d2(p, hull[e], hull[(e + 1) % h]));
+        }
+        if (!outside) {
+          EXPECT_EQ(lower, 0.0);
+        } else {
+          EXPECT_LE(mpq_class(lower), to_hull);
+          // Tight but for the rounding allowance (about 1e-14 of the coordinates).
+          if (to_hull > 1e-6) EXPECT_GE(mpq_class(lower), to_hull * mpq_class(1 - 1e-9));
+        }
+      }
       const bool is_far = std::hypot(p[0], p[1]) > 30;
       far += is_far;
-      if (i < 0) continue;
+      if (!nv.certified) continue;
+      const int i = int(nv.index);
+      EXPECT_LE(abs(mpq_class(nv.d2) - to_set), to_set * mpq_class(1e-15));
       ++certified;
       far_certified += is_far;
       const Point2& v = hull[std::size_t(i)];
@@ -145,7 +171,9 @@ TEST(ConvexHull, CertifiedNearestVertexIsTheHullsNearestPoint) {
   }
   EXPECT_GT(certified, 5000u);
   EXPECT_GT(far_certified, far / 2) << "most far points see a vertex nearest";
-  EXPECT_EQ(nearest_vertex_certified({}, {0, 0}), -1);
+  EXPECT_FALSE(nearest_vertex({}, {0, 0}).certified);
+  EXPECT_EQ(nearest_vertex({}, {0, 0}).d2, INFINITY);
+  EXPECT_EQ(hull_lower_bound({}, {0, 0}), INFINITY);
 }
 
 }  // namespace

@@ -168,12 +168,13 @@ TEST(LayerNearest, InterleavedFeaturesFromASidecar) {
 
 using Levels = std::vector<std::vector<HierarchyNode>>;
 using Tamper = std::function<void(Levels&, std::vector<HierarchyRoot>&)>;
+using HullTamper = std::function<void(std::vector<std::uint32_t>&, std::vector<Point2>&)>;
 
 // Writes a per-segment sidecar of `items` at `path` with the features' hierarchies stored, as
 // loci index writes it; `tamper` may change a copy of their nodes and roots first (the file's
 // checksums then hold for what it wrote: a forged file).
 void write_with_hierarchies(const LayerItems& items, const std::string& path,
-                            const Tamper& tamper = {}) {
+                            const Tamper& tamper = {}, const HullTamper& hull_tamper = {}) {
   const PackedRTree2 tree = PackedRTree2::build(items.boxes);
   const LayerIndex::Features f = LayerIndex::build_features(&tree, Per::segment, items.records);
   ASSERT_TRUE(f.hierarchical);
@@ -182,7 +183,10 @@ void write_with_hierarchies(const LayerItems& items, const std::string& path,
     levels.emplace_back(l.begin(), l.end());
   std::vector<HierarchyRoot> roots(f.roots.begin(), f.roots.end());
   if (tamper) tamper(levels, roots);
-  Hierarchies h{f.fid, {}, roots, &f.root_tree};
+  std::vector<std::uint32_t> hull_first(f.hull_first.begin(), f.hull_first.end());
+  std::vector<Point2> hull_points(f.hull_points.begin(), f.hull_points.end());
+  if (hull_tamper) hull_tamper(hull_first, hull_points);
+  Hierarchies h{f.fid, {}, roots, &f.root_tree, hull_first, hull_points};
   for (const auto& l : levels)
     h.levels.emplace_back(l);
   SidecarInfo info;
@@ -265,30 +269,53 @@ TEST(LayerNearest, ForgedHierarchiesAreRefusedWhenRead) {
            r = {63, 0};
        }},
   };
+  // The queries, and their answers from the sound file.
+  std::vector<Query> queries;
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> near(-5, 105);
+  for (int i = 0; i < 40; ++i) {
+    Query q;
+    q.kind = Query::Kind::nearest;
+    q.point = {near(rng), near(rng)};
+    q.k = 1 + i % 5;
+    queries.push_back(q);
+  }
+  std::vector<std::vector<Answer>> sound(queries.size());
+  {
+    const std::string path = scratch("sound");
+    write_with_hierarchies(l.items, path, {});
+    const LayerIndex index = LayerIndex::adopt(Sidecar::open(path));
+    LayerQuery query(index, "", "");
+    for (std::size_t i = 0; i < queries.size(); ++i)
+      query.run(queries[i], 1, false, sound[i]);
+    ::unlink(path.c_str());
+  }
   for (const auto& [what, tamper] : forgeries) {
     const std::string path = scratch("forged");
     write_with_hierarchies(l.items, path, tamper);
     const LayerIndex index = LayerIndex::adopt(Sidecar::open(path));
     LayerQuery query(index, "", "");
-    std::mt19937_64 rng(17);
-    std::uniform_real_distribution<double> near(-5, 105);
+    // Each query is refused, or answers from what it read of the file, all sound (a feature
+    // measured from its hull alone does not read its nodes).
     std::size_t refused = 0;
-    for (int i = 0; i < 40; ++i) {
-      Query q;
-      q.kind = Query::Kind::nearest;
-      q.point = {near(rng), near(rng)};
-      q.k = 1 + i % 5;
+    for (std::size_t i = 0; i < queries.size(); ++i) {
       std::vector<Answer> answers;
       try {
-        query.run(q, 1, false, answers);
+        query.run(queries[i], 1, false, answers);
       } catch (const Error& e) {
         ++refused;
         EXPECT_NE(std::string(e.what()).find(path + ": corrupt index file (feature hierarchies)"),
                   std::string::npos)
             << what << ": " << e.what();
+        continue;
+      }
+      ASSERT_EQ(answers.size(), sound[i].size()) << what;
+      for (std::size_t r = 0; r < answers.size(); ++r) {
+        EXPECT_EQ(answers[r].fid, sound[i][r].fid) << what;
+        EXPECT_EQ(answers[r].distance, sound[i][r].distance) << what;
       }
     }
-    EXPECT_EQ(refused, 40u) << what;
+    EXPECT_GE(refused, 20u) << what;
     // loci check finds it too.
     EXPECT_THROW(check_sidecar(path), Error) << what;
     ::unlink(path.c_str());
@@ -319,8 +346,13 @@ TEST(LayerNearest, CheckComparesTheStoredHierarchiesWithTheSegments) {
          slots ^= 1u << (16 + std::countr_zero(slots));
        }},
   };
-  for (const auto& [what, tamper] : tampers) {
-    write_with_hierarchies(l.items, path, tamper);
+  const std::vector<std::pair<const char*, HullTamper>> hull_tampers = {
+      {"a hull vertex moved",
+       [](std::vector<std::uint32_t>&, std::vector<Point2>& points) { points[4][0] += 1e-9; }},
+      {"a hull's vertex given to the next hull",
+       [](std::vector<std::uint32_t>& first, std::vector<Point2>&) { --first[2]; }},
+  };
+  auto refused = [&](const char* what) {
     try {
       check_sidecar(path);
       ADD_FAILURE() << what << ": a hierarchy unlike the segments' passed loci check";
@@ -328,7 +360,96 @@ TEST(LayerNearest, CheckComparesTheStoredHierarchiesWithTheSegments) {
       EXPECT_NE(std::string(e.what()).find("feature hierarchies do not match"), std::string::npos)
           << what << ": " << e.what();
     }
+  };
+  for (const auto& [what, tamper] : tampers) {
+    write_with_hierarchies(l.items, path, tamper);
+    refused(what);
   }
+  for (const auto& [what, tamper] : hull_tampers) {
+    write_with_hierarchies(l.items, path, {}, tamper);
+    refused(what);
+  }
+  ::unlink(path.c_str());
+}
+
+// Features far from the query are measured from their hulls alone: with every level-0 node of
+// the file forged out of range, a query far from all features still answers, exactly (brute
+// force), since a vertex of each hull is certainly nearest; a query inside a feature's hull,
+// which has to read its segments, is refused. Hull starts beyond the vertices are refused too.
+TEST(LayerNearest, FarFeaturesAreMeasuredFromTheirHullsAlone) {
+  // 100 jagged rings of 40 segments (more than a leaf, so that each root is above level 0),
+  // radius 1 to 3, on a grid 10 apart.
+  Layer l;
+  l.items.per = Per::segment;
+  l.items.layer_name = "rings";
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> radius(1, 3);
+  for (int f = 0; f < 100; ++f) {
+    const Point2 c{10.0 * (f % 10) + 5, 10.0 * (f / 10) + 5};
+    std::vector<Point2> ring;
+    for (int i = 0; i < 40; ++i) {
+      const double a = 2 * std::numbers::pi * i / 40, r = radius(rng);
+      ring.push_back({c[0] + r * std::cos(a), c[1] + r * std::sin(a)});
+    }
+    for (int i = 0; i < 40; ++i)
+      add_segment(l, 100 + f, ring[std::size_t(i)], ring[std::size_t((i + 1) % 40)]);
+  }
+  const Tamper leaves_out_of_range = [](Levels& levels, std::vector<HierarchyRoot>& roots) {
+    for (auto& n : levels[0])
+      n.first = n.last = 1u << 30;
+    for (const HierarchyRoot& r : roots)
+      ASSERT_GT(r.level, 0u);
+  };
+  const std::string path = scratch("hulls");
+  write_with_hierarchies(l.items, path, leaves_out_of_range);
+  const LayerIndex index = LayerIndex::adopt(Sidecar::open(path));
+  LayerQuery query(index, "", "");
+  std::size_t answered = 0;
+  for (const Point2 p : {Point2{-3000.3, 1234.5}, Point2{777.7, -2500.1}, Point2{4000.2, 4100.9}}) {
+    Query q;
+    q.kind = Query::Kind::nearest;
+    q.point = p;
+    q.k = 7;
+    std::vector<Answer> got;
+    query.run(q, 1, false, got);
+    const auto expected = brute(l, p);
+    ASSERT_EQ(got.size(), 7u);
+    for (std::size_t r = 0; r < got.size(); ++r) {
+      EXPECT_NEAR(got[r].distance, expected[r].first, 1e-12 * expected[r].first) << r;
+      EXPECT_EQ(got[r].fid, expected[r].second) << r;
+    }
+    ++answered;
+  }
+  EXPECT_EQ(answered, 3u);
+  Query inside;
+  inside.kind = Query::Kind::nearest;
+  inside.point = {55.2, 54.9};
+  inside.k = 2;
+  std::vector<Answer> got;
+  EXPECT_THROW(query.run(inside, 1, false, got), Error);
+  ::unlink(path.c_str());
+
+  write_with_hierarchies(
+      l.items, path, {},
+      [](std::vector<std::uint32_t>& first, std::vector<Point2>&) { first[50] = 1u << 30; });
+  const LayerIndex forged = LayerIndex::adopt(Sidecar::open(path));
+  LayerQuery near_forged(forged, "", "");
+  std::size_t refused = 0;
+  for (int i = 0; i < 100; ++i) {
+    Query q;
+    q.kind = Query::Kind::nearest;
+    q.point = {10.0 * (i % 10) + 5.5, 10.0 * (i / 10) + 1};
+    q.k = 100;
+    try {
+      near_forged.run(q, 1, false, got);
+    } catch (const Error& e) {
+      ++refused;
+      EXPECT_NE(std::string(e.what()).find("corrupt index file (feature hierarchies)"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(refused, 100u) << "every query meets every feature's hull (k = 100)";
   ::unlink(path.c_str());
 }
 

@@ -1851,19 +1851,20 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
   expect_error(query, "damaged index");
   // Sidecars of earlier formats: 2 (nearest-n built the hierarchies at every run), 3 (their
   // level-0 nodes did not say which of the leaf's slots are the feature's), 4 (ring segments
-  // without the number of the polygon their ring bounds), 5 (a direction bit there instead).
-  for (const int version : {2, 3, 4, 5}) {
+  // without the number of the polygon their ring bounds), 5 (a direction bit there instead),
+  // 6 (no hulls of the features).
+  for (const int version : {2, 3, 4, 5, 6}) {
     std::string older = good;
     older[8] = char(version);
     put(older);
     expect_error(query, "index format version " + std::to_string(version) +
-                            ", this loci reads 6; run 'loci index' to rebuild it");
+                            ", this loci reads 7; run 'loci index' to rebuild it");
   }
   std::string newer = good;
-  newer[8] = char(7);
+  newer[8] = char(8);
   put(newer);
   expect_error(query,
-               "index format version 7, written by a newer loci (this one reads 6); use "
+               "index format version 8, written by a newer loci (this one reads 7); use "
                "that loci, or run 'loci index' to rebuild it");
   put(good);
   EXPECT_EQ(run_loci(query).status, 0);

@@ -9,12 +9,12 @@
 // hull_candidates() first drops the points strictly inside the polygon of the eight extreme
 // points (Akl and Toussaint, 1978), which for the linework of a map layer leaves few.
 //
-// nearest_vertex_certified() answers, in O(h) for a hull of h vertices, whether the point of
-// the hull nearest to p is one of its vertices, and which: then, because the vertex is one of
-// the points and every point lies in the hull, the distance from p to the whole set is the
+// nearest_vertex() answers, in O(h) for a hull of h vertices, whether the point of the hull
+// nearest to p is one of its vertices, and which: then, because the vertex is one of the
+// points and every point lies in the hull, the distance from p to the whole set is the
 // distance to that vertex, found without reading the set. It says so only when the floating
-// tests leave no doubt (rounding is bounded, not assumed away); otherwise the caller measures
-// the set itself.
+// tests leave no doubt (rounding is bounded, not assumed away); otherwise hull_lower_bound()
+// bounds the distance from below, and the caller measures the set itself.
 #pragma once
 
 #include <algorithm>
@@ -25,6 +25,7 @@
 
 #include "loci/geom/point.hpp"
 #include "loci/geom/predicates.hpp"
+#include "loci/geom/segment.hpp"
 
 namespace loci {
 
@@ -115,23 +116,32 @@ inline void hull_candidates(std::span<const Point2> points, std::vector<Point2>&
     if (!inside(p)) out.push_back(p);
 }
 
-// For `hull` as convex_hull() gives it (at least one vertex) and p: the index of the vertex
-// nearest to p when that vertex is certainly the point of the hull nearest to p (p - v lies
-// in the cone of outward normals at v, which the two edges at v bound), else -1. Certain
-// means the signs of both dot products are beyond their rounding error; a p on the normal
-// through an edge's end, or inside the hull, gives -1.
-inline int nearest_vertex_certified(std::span<const Point2> hull, const Point2& p) {
+// The vertex of `hull` (as convex_hull() gives it, at least one vertex) nearest to p, its
+// squared distance, and whether it is certainly the point of the hull nearest to p: p - v
+// lies in the cone of outward normals at v, which the two edges at v bound. Certain means the
+// signs of both dot products are beyond their rounding error; a p on the normal through an
+// edge's end, or inside the hull, is not certified. For a set whose hull this is and which
+// holds its vertices (points, or segments between points), d2 bounds the set's squared
+// distance from above, and is that distance when certified.
+struct NearestVertex {
+  std::size_t index = 0;
+  double d2 = INFINITY;
+  bool certified = false;
+};
+
+inline NearestVertex nearest_vertex(std::span<const Point2> hull, const Point2& p) {
+  NearestVertex n;
   const std::size_t h = hull.size();
-  if (h == 0) return -1;
-  std::size_t best = 0;
-  double best2 = INFINITY;
   for (std::size_t i = 0; i < h; ++i) {
     const double dx = p[0] - hull[i][0], dy = p[1] - hull[i][1];
     const double d2 = dx * dx + dy * dy;
-    if (d2 < best2) best2 = d2, best = i;
+    if (d2 < n.d2) n.d2 = d2, n.index = i;
   }
-  if (h == 1) return 0;
-  const Point2& v = hull[best];
+  if (h <= 1) {
+    n.certified = h == 1;
+    return n;
+  }
+  const Point2& v = hull[n.index];
   const double px = p[0] - v[0], py = p[1] - v[1];
   // (p - v) . (w - v) < 0 for both neighbours w, beyond the error of the floating dot: each
   // difference is rounded once (relative error eps), each product and the sum once more, so
@@ -143,9 +153,26 @@ inline int nearest_vertex_certified(std::span<const Point2> hull, const Point2& 
     const double dot = a + b;
     return dot < -(8.9e-16 * (std::fabs(a) + std::fabs(b)) + 3e-300);
   };
-  const Point2& prev = hull[(best + h - 1) % h];
-  const Point2& next = hull[(best + 1) % h];
-  return away(prev) && away(next) ? int(best) : -1;
+  n.certified = away(hull[(n.index + h - 1) % h]) && away(hull[(n.index + 1) % h]);
+  return n;
+}
+
+// A lower bound on the squared distance from p to the hull: 0 when p lies in it (decided
+// exactly), else the least squared distance to its edges rounded down by a bound on their
+// rounding error. Infinity for an empty hull (no set to be near).
+inline double hull_lower_bound(std::span<const Point2> hull, const Point2& p) {
+  const std::size_t h = hull.size();
+  if (h == 0) return INFINITY;
+  if (h == 1) return squared_distance(p, hull[0]) * (1 - 1e-15);
+  double edge = INFINITY;
+  bool outside = h == 2;
+  for (std::size_t i = 0; i < h; ++i) {
+    const Segment2 s{hull[i], hull[i + 1 < h ? i + 1 : 0]};
+    const double e = std::sqrt(squared_distance(p, s)) - detail::distance_rounding(p, s);
+    edge = std::min(edge, e > 0 ? e * e * (1 - 1e-15) : 0.0);
+    outside = outside || orientation(s.a, s.b, p) == Orientation::clockwise;
+  }
+  return outside ? edge : 0.0;
 }
 
 }  // namespace loci

@@ -26,7 +26,10 @@
 // feature instead (Features), in two passes. First the candidates: the features come out of a
 // tree of their hierarchies' roots nearest box first, each with an upper bound on its distance
 // from one dive down its hierarchy (nearest child at every level, one leaf measured), until a
-// root is no nearer than the k-th smallest upper bound. Then each candidate, nearest bound
+// root is no nearer than the k-th smallest upper bound; a feature whose convex hull (stored
+// with the hierarchies) is certainly nearest to the query at one of its vertices is at that
+// vertex's distance, found from the hull alone (for a far query point, most features are
+// measured so, without reading their segments). Then each other candidate, nearest bound
 // first, is measured exactly by a depth-first descent of its own hierarchy, nearest child
 // first, that drops every node no nearer than the feature's bound or the k-th distance found
 // so far. A feature's many segments never come out one by one. --candidates answers from
@@ -165,6 +168,9 @@ class LayerIndex {
     // A packed tree over the roots' boxes (entry r: roots[r]), so that a query meets only
     // the features near it, however many the layer has.
     PackedRTree2 root_tree;
+    // Hierarchical: the convex hull of every feature's segment ends, read through hull().
+    std::span<const std::uint32_t> hull_first;  // features + 1 starts in hull_points
+    std::span<const Point2> hull_points;
 
     // Node i of `level`, checked: its feature, and its leaf or the range of its children
     // (at most 16), lie within the arrays. Throws loci::Error for a corrupt file.
@@ -194,6 +200,17 @@ class LayerIndex {
       if (check) check->touch(&roots[r], sizeof(HierarchyRoot));
       return roots[r];
     }
+    // The hull of feature f < fid.size() (geom/convex_hull.hpp), checked to lie within the
+    // array; empty when the hulls are not there.
+    std::span<const Point2> hull(std::uint32_t f) const {
+      if (hull_first.size() <= f + 1) return {};
+      if (check) check->touch(&hull_first[f], 2 * sizeof(std::uint32_t));
+      const std::uint32_t first = hull_first[f], last = hull_first[f + 1];
+      if (first > last || last > hull_points.size()) corrupt();
+      const std::span<const Point2> h = hull_points.subspan(first, last - first);
+      if (check) check->touch(h.data(), h.size_bytes());
+      return h;
+    }
     std::int64_t fid_of(std::uint32_t f) const {
       if (check) check->touch(&fid[f], sizeof(std::int64_t));
       return fid[f];
@@ -211,7 +228,7 @@ class LayerIndex {
       return &records[id];
     }
     // The arrays as write_sidecar stores them.
-    Hierarchies stored() const { return {fid, levels, roots, &root_tree}; }
+    Hierarchies stored() const { return {fid, levels, roots, &root_tree, hull_first, hull_points}; }
 
     const loci::detail::LazyCheck* check = nullptr;  // stored: what is read is touched first
     std::size_t leaves = 0;                          // hierarchical: the tree's leaves
@@ -225,6 +242,8 @@ class LayerIndex {
     std::vector<std::int64_t> own_fid;
     std::vector<loci::detail::LargeVector<Node>> own_levels;
     std::vector<HierarchyRoot> own_roots;
+    std::vector<std::uint32_t> own_hull_first;
+    std::vector<Point2> own_hull_points;
 
     // Throws loci::Error: the stored hierarchies are inconsistent.
     [[noreturn]] void corrupt() const;
@@ -346,6 +365,7 @@ class LayerQuery {
     double upper, lower;
     std::uint32_t root;
     std::uint32_t leaf;  // the leaf whose segments gave `upper`, not read again
+    bool exact;          // `upper` is the feature's distance (from its hull): not descended
   };
   std::vector<Candidate> candidates_;
 };
