@@ -453,27 +453,39 @@ LayerIndex::Features LayerIndex::build_features(const PackedRTree2* t, Per per,
     level[start[part.feature]++] = {t->levels() > 1 ? t->entry_box(1, part.leaf) : only_leaf,
                                     part.feature, part.leaf, part.leaf, slots_of(part)};
   parts = {};
-  // The hull of every feature's segment ends, from its level-0 nodes (in feature order).
+  // The hull of every feature's segment ends, from its level-0 nodes (in feature order),
+  // leaving out first those strictly inside the polygon of their extremes (whole leaves at a
+  // time where the leaf's box is).
   f.own_hull_first.assign(features + 1, 0);
   {
     std::vector<Point2> ends, kept;
+    std::vector<std::size_t> ends_at;  // where each of the feature's nodes' ends start
     std::size_t i = 0;
     for (std::uint32_t g = 0; g < features; ++g) {
       ends.clear();
-      kept.clear();
+      ends_at.clear();
+      const std::size_t from = i;
       for (; i < level.size() && level[i].feature == g; ++i) {
+        ends_at.push_back(ends.size());
         const std::size_t first = std::size_t(level[i].first) * kFanout;
         for (std::uint32_t mine = level[i].slots & 0xffffu; mine != 0; mine &= mine - 1) {
           const int e = std::countr_zero(mine);
           const bool anti = (level[i].slots >> (kFanout + e)) & 1;
           const Segment2 s = segment_of(t->box_at(first + e), anti ? item_antidiagonal : 0u);
-          ends.push_back(s.a);
+          // Along a line or ring, a segment's start is often the end of the one before.
+          if (ends.size() == ends_at.back() || !(ends.back() == s.a)) ends.push_back(s.a);
           ends.push_back(s.b);
         }
       }
-      hull_candidates(ends, kept);
-      const std::vector<Point2> hull = convex_hull(kept);
-      f.own_hull_points.insert(f.own_hull_points.end(), hull.begin(), hull.end());
+      ends_at.push_back(ends.size());
+      const ExtremesPolygon inner(ends);
+      kept.clear();
+      for (std::size_t k = from; k < i; ++k) {
+        if (inner.strictly_inside(level[k].box)) continue;
+        for (std::size_t e = ends_at[k - from]; e < ends_at[k - from + 1]; ++e)
+          if (!inner.strictly_inside(ends[e])) kept.push_back(ends[e]);
+      }
+      convex_hull(kept, f.own_hull_points);
       f.own_hull_first[g + 1] = std::uint32_t(f.own_hull_points.size());
     }
   }

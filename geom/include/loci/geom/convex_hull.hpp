@@ -23,97 +23,115 @@
 #include <span>
 #include <vector>
 
+#include "loci/geom/box.hpp"
 #include "loci/geom/point.hpp"
 #include "loci/geom/predicates.hpp"
 #include "loci/geom/segment.hpp"
 
 namespace loci {
 
-// The vertices of the convex hull of `points`, counterclockwise from the least point by
-// (x, y), with no three collinear: one vertex for a single distinct point, the two ends for
-// collinear points, none for none. Sorts `points` in place; coordinates must be finite.
-inline std::vector<Point2> convex_hull(std::span<Point2> points) {
+// Appends to `out` the vertices of the convex hull of `points`, counterclockwise from the
+// least point by (x, y), with no three collinear: one vertex for a single distinct point, the
+// two ends for collinear points, none for none. Sorts `points` in place; coordinates must be
+// finite. Allocates only when `out` grows.
+inline void convex_hull(std::span<Point2> points, std::vector<Point2>& out) {
   auto less = [](const Point2& a, const Point2& b) {
     return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]);
   };
   std::sort(points.begin(), points.end(), less);
   const auto end = std::unique(points.begin(), points.end());
   const std::size_t n = std::size_t(end - points.begin());
-  std::vector<Point2> hull;
-  if (n <= 2) return {points.begin(), end};
-  hull.reserve(2 * n);
+  if (n <= 2) {
+    out.insert(out.end(), points.begin(), end);
+    return;
+  }
+  const std::size_t base = out.size();
   // Lower chain left to right, then upper chain right to left; each keeps only left turns.
+  auto turns_left = [&](const Point2& p) {
+    return orientation(out[out.size() - 2], out.back(), p) == Orientation::counterclockwise;
+  };
   for (std::size_t i = 0; i < n; ++i) {
-    while (hull.size() >= 2 && orientation(hull[hull.size() - 2], hull.back(), points[i]) !=
-                                   Orientation::counterclockwise)
-      hull.pop_back();
-    hull.push_back(points[i]);
+    while (out.size() >= base + 2 && !turns_left(points[i]))
+      out.pop_back();
+    out.push_back(points[i]);
   }
-  const std::size_t lower = hull.size();
+  const std::size_t lower = out.size();
   for (std::size_t i = n - 1; i-- > 0;) {
-    while (hull.size() > lower && orientation(hull[hull.size() - 2], hull.back(), points[i]) !=
-                                      Orientation::counterclockwise)
-      hull.pop_back();
-    hull.push_back(points[i]);
+    while (out.size() > lower && !turns_left(points[i]))
+      out.pop_back();
+    out.push_back(points[i]);
   }
-  hull.pop_back();  // the first point again
+  out.pop_back();  // the first point again
+}
+
+// The same, as a vector of its own.
+inline std::vector<Point2> convex_hull(std::span<Point2> points) {
+  std::vector<Point2> hull;
+  convex_hull(points, hull);
   return hull;
 }
 
-// Appends to `out` the points of `points` that can be vertices of their convex hull: all but
-// those strictly inside the polygon of the extreme points in x, y, x + y and x - y (each
-// extreme is an input point, so that polygon lies in the hull and a point strictly inside it
-// is no vertex). The strictness is decided by the exact predicate.
-inline void hull_candidates(std::span<const Point2> points, std::vector<Point2>& out) {
-  if (points.empty()) return;
-  // Extremes in the directions at 45-degree steps, counterclockwise from -y.
-  Point2 e[8];
-  std::fill(e, e + 8, points[0]);
-  auto key = [](const Point2& p, int d) {
-    switch (d) {
-      case 0:
-        return -p[1];
-      case 1:
-        return p[0] - p[1];
-      case 2:
-        return p[0];
-      case 3:
-        return p[0] + p[1];
-      case 4:
-        return p[1];
-      case 5:
-        return p[1] - p[0];
-      case 6:
-        return -p[0];
-      default:
-        return -p[0] - p[1];
+// The polygon of a point set's extreme points in x, y, x + y and x - y (Akl and Toussaint):
+// each extreme is one of the points, so the polygon lies in their hull and a point strictly
+// inside it is no vertex of the hull. Strictness is decided by the exact predicate.
+class ExtremesPolygon {
+ public:
+  explicit ExtremesPolygon(std::span<const Point2> points) {
+    if (points.empty()) return;
+    // Extremes in the directions at 45-degree steps, counterclockwise from -y.
+    Point2 e[8];
+    std::fill(e, e + 8, points[0]);
+    double k[8];
+    keys(points[0], k);
+    for (const Point2& p : points) {
+      double q[8];
+      keys(p, q);
+      for (int d = 0; d < 8; ++d)
+        if (q[d] > k[d]) k[d] = q[d], e[d] = p;
     }
-  };
-  for (const Point2& p : points)
+    // The distinct extremes in order form a convex polygon (counterclockwise, possibly with
+    // collinear vertices); fewer than three distinct ones bound no area.
     for (int d = 0; d < 8; ++d)
-      if (key(p, d) > key(e[d], d)) e[d] = p;
-  // The distinct extremes in order form a convex polygon (counterclockwise, possibly with
-  // collinear vertices); fewer than three distinct ones bound no area: keep everything.
-  Point2 ring[8];
-  int m = 0;
-  for (int d = 0; d < 8; ++d)
-    if (m == 0 || !(e[d] == ring[m - 1])) ring[m++] = e[d];
-  while (m > 1 && ring[m - 1] == ring[0])
-    --m;
-  auto inside = [&](const Point2& p) {
-    for (int i = 0; i < m; ++i) {
-      const Point2& a = ring[i];
-      const Point2& b = ring[(i + 1) % m];
-      if (orientation(a, b, p) != Orientation::counterclockwise) return false;
-    }
-    return true;
-  };
-  if (m < 3) {
-    out.insert(out.end(), points.begin(), points.end());
-    return;
+      if (m_ == 0 || !(e[d] == ring_[m_ - 1])) ring_[m_++] = e[d];
+    while (m_ > 1 && ring_[m_ - 1] == ring_[0])
+      --m_;
+    ring_[m_] = ring_[0];
   }
+  // Whether p lies strictly inside (never, when the extremes bound no area).
+  bool strictly_inside(const Point2& p) const {
+    if (m_ < 3) return false;
+    for (int i = 0; i < m_; ++i)
+      if (orientation(ring_[i], ring_[i + 1], p) != Orientation::counterclockwise) return false;
+    return true;
+  }
+  // Whether the closed box lies strictly inside (its four corners do: the polygon is convex).
+  bool strictly_inside(const Box<2>& b) const {
+    return strictly_inside(b.min) && strictly_inside(b.max) &&
+           strictly_inside(Point2{b.min[0], b.max[1]}) &&
+           strictly_inside(Point2{b.max[0], b.min[1]});
+  }
+
+ private:
+  static void keys(const Point2& p, double* k) {
+    k[0] = -p[1];
+    k[1] = p[0] - p[1];
+    k[2] = p[0];
+    k[3] = p[0] + p[1];
+    k[4] = p[1];
+    k[5] = p[1] - p[0];
+    k[6] = -p[0];
+    k[7] = -p[0] - p[1];
+  }
+  Point2 ring_[9];
+  int m_ = 0;
+};
+
+// Appends to `out` the points of `points` that can be vertices of their convex hull: all but
+// those strictly inside their ExtremesPolygon.
+inline void hull_candidates(std::span<const Point2> points, std::vector<Point2>& out) {
+  const ExtremesPolygon inner(points);
   for (const Point2& p : points)
-    if (!inside(p)) out.push_back(p);
+    if (!inner.strictly_inside(p)) out.push_back(p);
 }
 
 // The vertex of `hull` (as convex_hull() gives it, at least one vertex) nearest to p, its
