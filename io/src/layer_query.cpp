@@ -562,6 +562,9 @@ std::vector<std::uint32_t> containing_features(const LayerIndex& index, const Po
   features.root_tree.query(Box2::of_point(p), [&](Id r, const Box2&) {
     const HierarchyRoot root = features.root(r);
     const LayerIndex::Features::Node& top = features.node(root.level, root.node);
+    // Outside the feature's hull, p is outside every polygon of it (without hulls: counted).
+    const std::span<const Point2> hull = features.hull(top.feature);
+    if (!hull.empty() && strictly_outside(hull, p)) return true;
     const Box2& reach = top.box;
     const double length[4] = {reach.max[0] - p[0], p[0] - reach.min[0], reach.max[1] - p[1],
                               p[1] - reach.min[1]};

@@ -138,6 +138,7 @@ TEST(ConvexHull, CertifiedNearestVertexIsTheHullsNearestPoint) {
           outside = outside || exact_orientation(hull[e], hull[(e + 1) % h], p) < 0;
           to_hull = std::min(to_hull, exact_d2(p, hull[e], hull[(e + 1) % h]));
         }
+        EXPECT_EQ(strictly_outside(hull, p), outside);
         if (!outside) {
           EXPECT_EQ(lower, 0.0);
         } else {
@@ -146,6 +147,7 @@ TEST(ConvexHull, CertifiedNearestVertexIsTheHullsNearestPoint) {
           if (to_hull > 1e-6) EXPECT_GE(mpq_class(lower), to_hull * mpq_class(1 - 1e-9));
         }
       }
+      if (h <= 2) EXPECT_EQ(strictly_outside(hull, p), exact_d2(p, hull[0], hull[h - 1]) > 0);
       const bool is_far = std::hypot(p[0], p[1]) > 30;
       far += is_far;
       if (!nv.certified) continue;

@@ -150,11 +150,15 @@ struct NearestVertex {
 inline NearestVertex nearest_vertex(std::span<const Point2> hull, const Point2& p) {
   NearestVertex n;
   const std::size_t h = hull.size();
+  double least = INFINITY;  // in a register, not through n
+  std::size_t at = 0;
   for (std::size_t i = 0; i < h; ++i) {
     const double dx = p[0] - hull[i][0], dy = p[1] - hull[i][1];
     const double d2 = dx * dx + dy * dy;
-    if (d2 < n.d2) n.d2 = d2, n.index = i;
+    if (d2 < least) least = d2, at = i;
   }
+  n.d2 = least;
+  n.index = at;
   if (h <= 1) {
     n.certified = h == 1;
     return n;
@@ -175,22 +179,55 @@ inline NearestVertex nearest_vertex(std::span<const Point2> hull, const Point2& 
   return n;
 }
 
+// Whether p lies strictly outside `hull` (as convex_hull() gives it), decided exactly: for a
+// polygon, on the outer side of one of its edges; for two vertices, off the segment between
+// them; for one, elsewhere. Always true for an empty hull.
+inline bool strictly_outside(std::span<const Point2> hull, const Point2& p) {
+  const std::size_t h = hull.size();
+  if (h == 0) return true;
+  if (h == 1) return !(p == hull[0]);
+  if (h == 2) {
+    const Point2 &a = hull[0], &b = hull[1];
+    return orientation(a, b, p) != Orientation::collinear || p[0] < std::min(a[0], b[0]) ||
+           p[0] > std::max(a[0], b[0]) || p[1] < std::min(a[1], b[1]) ||
+           p[1] > std::max(a[1], b[1]);
+  }
+  for (std::size_t i = 0; i < h; ++i)
+    if (orientation(hull[i], hull[i + 1 < h ? i + 1 : 0], p) == Orientation::clockwise) return true;
+  return false;
+}
+
 // A lower bound on the squared distance from p to the hull: 0 when p lies in it (decided
 // exactly), else the least squared distance to its edges rounded down by a bound on their
-// rounding error. Infinity for an empty hull (no set to be near).
+// rounding error. Infinity for an empty hull (no set to be near). Only the edges that p may
+// lie outside of are measured: the hull's nearest point to an outside p lies on one of them
+// (p is strictly outside an edge through it, and at a vertex, of one of the two edges there).
 inline double hull_lower_bound(std::span<const Point2> hull, const Point2& p) {
   const std::size_t h = hull.size();
   if (h == 0) return INFINITY;
-  if (h == 1) return squared_distance(p, hull[0]) * (1 - 1e-15);
-  double edge = INFINITY;
-  bool outside = h == 2;
-  for (std::size_t i = 0; i < h; ++i) {
-    const Segment2 s{hull[i], hull[i + 1 < h ? i + 1 : 0]};
-    const double e = std::sqrt(squared_distance(p, s)) - detail::distance_rounding(p, s);
-    edge = std::min(edge, e > 0 ? e * e * (1 - 1e-15) : 0.0);
-    outside = outside || orientation(s.a, s.b, p) == Orientation::clockwise;
+  double least = INFINITY, reach = 0;
+  bool outside = h <= 2;
+  for (std::size_t i = 0; i < (h <= 2 ? 1 : h); ++i) {
+    const Point2& a = hull[i];
+    const Point2& b = hull[i + 1 < h ? i + 1 : 0];
+    if (h >= 3) {
+      // The floating orientation with its error bound (predicates.hpp): clearly inside this
+      // edge's line skips it.
+      const double left = (b[0] - a[0]) * (p[1] - a[1]);
+      const double right = (b[1] - a[1]) * (p[0] - a[0]);
+      const double det = left - right;
+      const double bound = 3.3306690738754716e-16 * (std::fabs(left) + std::fabs(right));
+      if (det > bound) continue;
+      outside = outside || -det > bound || orientation(a, b, p) == Orientation::clockwise;
+    }
+    least = std::min(least, squared_distance(p, Segment2{a, b}));
+    reach = std::max(reach, std::fabs(a[0]) + std::fabs(a[1]) + std::fabs(b[0]) + std::fabs(b[1]));
   }
-  return outside ? edge : 0.0;
+  if (!outside) return 0.0;
+  // Each measured edge's distance is within detail::distance_rounding of the truth.
+  const double e =
+      std::sqrt(least) - (1e-14 * (std::fabs(p[0]) + std::fabs(p[1]) + reach) + 1e-150);
+  return e > 0 ? e * e * (1 - 1e-15) : 0.0;
 }
 
 }  // namespace loci
