@@ -330,8 +330,7 @@ int run_draw(const Args& a) {
   o.path = layer_arg(a, "draw");
   o.layer_name = a.get("--layer");
   o.index_path = a.get("--index");
-  if (!a.has("--output")) throw UsageError("loci draw needs -o OUT.svg");
-  o.out_path = a.get("--output");
+  o.out_path = a.get("--output");  // empty: stdout
   if (a.has("--levels") && a.has("--cells"))
     throw UsageError(
         "loci draw takes --levels (index nodes) or --cells (quadtree cells), not both");
@@ -344,9 +343,9 @@ int run_draw(const Args& a) {
   o.progress = progress_bar(a, o.cell_levels >= 0 ? "cells" : "indexing");
   const std::size_t n = draw_index(o);
   if (!a.has("--quiet"))
-    std::fprintf(stderr, "loci: %s drawn into %s\n",
+    std::fprintf(stderr, "loci: %s drawn%s\n",
                  counted(n, o.cell_levels >= 0 ? "cell" : "node").c_str(),
-                 printable(o.out_path).c_str());
+                 o.out_path.empty() ? "" : (" into " + printable(o.out_path)).c_str());
   return 0;
 }
 
@@ -646,11 +645,11 @@ const std::vector<Command>& commands() {
        "  loci join ports.shp coast.shp --predicate dwithin:0.05 -f csv\n",
        run_join},
       {"draw",
-       "loci draw LAYER|LAYER.loci -o OUT.svg [--index FILE] [--levels N | --cells L] "
+       "loci draw LAYER|LAYER.loci [-o OUT.svg] [--index FILE] [--levels N | --cells L] "
        "[--width PX]",
        "SVG of the layer's linework and the packed index's nodes, one colour per level, or "
        "its region quadtree cells",
-       {{"--output", "-o", "OUT.svg", "the drawing"},
+       {{"--output", "-o", "OUT.svg", "the drawing (whole or not at all) instead of stdout", true},
         {"--levels", nullptr, "N",
          "how many levels to draw, from the root down (1 to 64, default 3)"},
         {"--cells", nullptr, "L",

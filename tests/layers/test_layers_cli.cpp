@@ -627,6 +627,16 @@ TEST_F(LayersCli, DrawWritesAnSvg) {
   EXPECT_NE(svg.find("<rect x="), std::string::npos);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
   EXPECT_EQ(svg.find("<circle"), std::string::npos) << "a layer of lines has no dots";
+  // Without -o, or with -o -, the same drawing goes to stdout.
+  for (const char* to : {"", " -o -"}) {
+    const CliRun piped = run_loci("draw " + path("lines.shp") + " -q --levels 2" + to);
+    ASSERT_EQ(piped.status, 0) << piped.err;
+    EXPECT_EQ(piped.out, svg) << to;
+  }
+  const CliRun told = run_loci("draw " + path("lines.shp") + " --levels 2");
+  ASSERT_EQ(told.status, 0) << told.err;
+  EXPECT_EQ(told.out, svg);
+  EXPECT_NE(told.err.find("nodes drawn\n"), std::string::npos) << told.err;
   // The isolated points of a layer are drawn as dots, one per point, a collection's too.
   const std::string points = path("draw-points.geojson");
   std::ofstream(points) << R"({"type":"FeatureCollection","features":[
