@@ -420,9 +420,10 @@ std::string check_sidecar(const std::string& arg) {
       const LayerIndex::Features built =
           LayerIndex::build_features(index.packed(), index.per(), index.records());
       if (!same_hierarchies(index.features(), built))
-        throw Error(path +
-                    ": corrupt index file (the feature hierarchies do not match the segments); "
-                    "run 'loci index' to rebuild it");
+        throw Error(
+            path +
+            ": corrupt index file (the feature hierarchies or hulls do not match the segments); "
+            "run 'loci index' to rebuild it");
     }
   } catch (const Error& e) {
     const std::string what = e.what();

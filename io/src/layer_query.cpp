@@ -807,8 +807,12 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     if (!(c.lower < limit)) continue;
     const auto [level, i] = features.root(c.root);
     const std::uint32_t f = features.node(level, i).feature;
-    // Not descended when its hull is no nearer than the k-th distance.
-    if (!c.exact && !candidates_only && !(hull_lower_bound(features.hull(f), p) < limit)) continue;
+    // Not descended when its hull is no nearer than the k-th distance (a bound that is not
+    // finite, from a forged hull of coordinates that are not, rules nothing out).
+    if (!c.exact && !candidates_only) {
+      const double hull_lower = hull_lower_bound(features.hull(f), p);
+      if (!(hull_lower < limit) && hull_lower < std::numeric_limits<double>::infinity()) continue;
+    }
     double best = std::min(c.upper, limit);
     if (!c.exact && (level > 0 || i != c.leaf)) descend(level, i, best, false, c.leaf);
     if (best < limit) keep(best, f);

@@ -357,7 +357,7 @@ TEST(LayerNearest, CheckComparesTheStoredHierarchiesWithTheSegments) {
       check_sidecar(path);
       ADD_FAILURE() << what << ": a hierarchy unlike the segments' passed loci check";
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("feature hierarchies do not match"), std::string::npos)
+      EXPECT_NE(std::string(e.what()).find("do not match the segments"), std::string::npos)
           << what << ": " << e.what();
     }
   };
@@ -429,6 +429,42 @@ TEST(LayerNearest, FarFeaturesAreMeasuredFromTheirHullsAlone) {
   EXPECT_THROW(query.run(inside, 1, false, got), Error);
   ::unlink(path.c_str());
 
+  // A hull emptied (every feature has one of at least one vertex): refused when read, not
+  // taken for a feature too far to rank.
+  write_with_hierarchies(
+      l.items, path, {},
+      [](std::vector<std::uint32_t>& first, std::vector<Point2>&) { first[7] = first[6]; });
+  {
+    const LayerIndex emptied = LayerIndex::adopt(Sidecar::open(path));
+    LayerQuery q_emptied(emptied, "", "");
+    Query all;
+    all.kind = Query::Kind::nearest;
+    all.point = {50.5, 50.5};
+    all.k = 100;
+    EXPECT_THROW(q_emptied.run(all, 1, false, got), Error);
+  }
+  // Hull vertices that are not numbers: the feature is measured from its segments (and loci
+  // check refuses the file).
+  write_with_hierarchies(l.items, path, {},
+                         [](std::vector<std::uint32_t>& first, std::vector<Point2>& points) {
+                           for (std::uint32_t v = first[3]; v < first[4]; ++v)
+                             points[v] = {NAN, NAN};
+                         });
+  {
+    const LayerIndex nan_hull = LayerIndex::adopt(Sidecar::open(path));
+    LayerQuery q_nan(nan_hull, "", "");
+    Query all;
+    all.kind = Query::Kind::nearest;
+    all.point = {-3000.3, 1234.5};
+    all.k = 100;
+    got.clear();
+    q_nan.run(all, 1, false, got);
+    ASSERT_EQ(got.size(), 100u);
+    const auto expected = brute(l, all.point);
+    for (std::size_t r = 0; r < got.size(); ++r)
+      EXPECT_NEAR(got[r].distance, expected[r].first, 1e-12 * expected[r].first) << r;
+    EXPECT_THROW(check_sidecar(path), Error);
+  }
   write_with_hierarchies(
       l.items, path, {},
       [](std::vector<std::uint32_t>& first, std::vector<Point2>&) { first[50] = 1u << 30; });

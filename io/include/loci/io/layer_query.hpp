@@ -201,12 +201,13 @@ class LayerIndex {
       return roots[r];
     }
     // The hull of feature f < fid.size() (geom/convex_hull.hpp), checked to lie within the
-    // array; empty when the hulls are not there.
+    // array and to hold a vertex (every feature has a segment); empty when the hulls are not
+    // there.
     std::span<const Point2> hull(std::uint32_t f) const {
       if (hull_first.size() <= f + 1) return {};
       if (check) check->touch(&hull_first[f], 2 * sizeof(std::uint32_t));
       const std::uint32_t first = hull_first[f], last = hull_first[f + 1];
-      if (first > last || last > hull_points.size()) corrupt();
+      if (first >= last || last > hull_points.size()) corrupt();
       const std::span<const Point2> h = hull_points.subspan(first, last - first);
       if (check) check->touch(h.data(), h.size_bytes());
       return h;
