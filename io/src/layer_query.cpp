@@ -725,6 +725,17 @@ struct FeatureDescent {
 
 }  // namespace
 
+void LayerQuery::next_generation(std::size_t features) {
+  if (state_.size() != features) {
+    state_.assign(features, FeatureState{});
+    generation_ = 0;
+  }
+  if (++generation_ == 0) {  // wrapped: forget every stamp
+    std::fill(state_.begin(), state_.end(), FeatureState{});
+    generation_ = 1;
+  }
+}
+
 void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
                                              bool candidates_only,
                                              const LayerIndex::Features& features,
@@ -746,14 +757,7 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
   };
   // Every feature has one root; one met twice is a forged file, refused (its hull would
   // otherwise answer for roots that are not its own).
-  if (state_.size() != features.fid.size()) {
-    state_.assign(features.fid.size(), FeatureState{});
-    generation_ = 0;
-  }
-  if (++generation_ == 0) {  // wrapped: forget every stamp
-    std::fill(state_.begin(), state_.end(), FeatureState{});
-    generation_ = 1;
-  }
+  next_generation(features.fid.size());
   // A polygon holding p is at 0, for candidates too (its boxes need not reach p).
   std::vector<std::uint32_t> inside;
   for (const std::uint32_t f : containing_features(index_, p, features)) {
@@ -834,14 +838,7 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       nearest_through_hierarchies(q, number, candidates_only, features, out);
       return;
     }
-    if (state_.size() != features.fid.size()) {
-      state_.assign(features.fid.size(), FeatureState{});
-      generation_ = 0;
-    }
-    if (++generation_ == 0) {  // wrapped: forget every stamp
-      std::fill(state_.begin(), state_.end(), FeatureState{});
-      generation_ = 1;
-    }
+    next_generation(features.fid.size());
     constexpr double kInf = std::numeric_limits<double>::infinity();
     // The state of feature f in this query (fresh: not seen, best infinite).
     auto state = [&](std::uint32_t f) -> FeatureState& {

@@ -358,6 +358,8 @@ class LayerQuery {
   };
   std::vector<FeatureState> state_;
   std::uint32_t generation_ = 0;
+  // A new query's stamp, state_ sized for `features` (every stamp forgotten when it wraps).
+  void next_generation(std::size_t features);
   // Nearest-n's arrays, kept between queries: the k best (squared distance, feature), the k
   // smallest upper bounds, and the candidate features (squared bounds, root).
   std::vector<std::pair<double, std::uint32_t>> top_;
