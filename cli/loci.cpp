@@ -1,26 +1,21 @@
-// loci: the command-line face of the library (DESIGN.md section 6).
+// loci-full: the command-line face of the library (DESIGN.md section 6), every command, with
+// GDAL. The `loci` front (front.cpp) hands it what it does not answer itself.
 //
 // This file only parses arguments, draws progress and prints; the work is done by the
 // functions of loci/io/commands.hpp, one per sub-command. Every command's flags are declared
 // once, in the table at the bottom, and that table is also what `--help` prints, so the help
 // cannot drift from what is accepted. Failures print one line `loci: error: ...` and exit 1.
-#include <unistd.h>
-
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <exception>
-#include <map>
 #include <optional>
-#include <set>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "bench.hpp"
+#include "command_line.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/atomic_file.hpp"
 #include "loci/io/commands.hpp"
@@ -32,6 +27,7 @@
 namespace {
 
 using namespace loci;
+using namespace loci::cli;
 using namespace loci::io;
 
 // "1 pair", "2 pairs".
@@ -39,102 +35,19 @@ std::string counted(std::uint64_t n, const char* noun) {
   return std::to_string(n) + ' ' + noun + (n == 1 ? "" : "s");
 }
 
-struct Flag {
-  const char* name;   // "--bbox"
-  const char* alias;  // "-b" or nullptr
-  const char* value;  // "XMIN,YMIN,XMAX,YMAX", nullptr for a switch
-  const char* help;
-  // For --output: the output is text that may go to stdout, so `-o -` means stdout (commands
-  // that write a file refuse it).
-  bool stdout_allowed = false;
-};
-
-struct Args {
-  std::vector<std::string> positional;
-  std::map<std::string, std::string> values;  // by long name
-  bool has(const char* name) const { return values.count(name) != 0; }
-  std::string get(const char* name, const std::string& fallback = {}) const {
-    auto it = values.find(name);
-    return it == values.end() ? fallback : it->second;
-  }
-};
-
-struct Command {
-  const char* name;
-  const char* usage;
-  const char* summary;
-  std::vector<Flag> flags;
-  const char* examples;
-  int (*run)(const Args&);
-};
-
-const std::vector<Command>& commands();
-
-constexpr std::size_t kMaxK = 1000000;
 // A drawing of 2^L x 2^L cells: past 12 levels (16 million cells) the SVG stops being something
 // a viewer opens.
 constexpr std::size_t kMaxCellLevels = 12;
 
-class UsageError : public loci::Error {
- public:
-  using Error::Error;
-};
-
-// Progress on stderr, only on a terminal and without -q.
-Progress progress_bar(const Args& a, const char* what) {
-  if (a.has("--quiet") || !::isatty(STDERR_FILENO)) return {};
-  return [what](double f) {
-    const int width = 30, filled = int(f * width + 0.5);
-    std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", what, filled,
-                 "==============================", width - filled, "", int(f * 100 + 0.5));
-    if (f >= 1.0) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-  };
-}
-
-const std::string& layer_arg(const Args& a, const char* command, const char* what = "LAYER") {
-  if (a.positional.size() != 1)
-    throw UsageError(std::string("loci ") + command + " needs exactly one " + what + " (see loci " +
-                     command + " --help)");
-  return a.positional[0];
-}
-
-// A whole number in [lo, hi] given to `flag`; the error names the flag and the range.
-std::size_t parse_count(const char* flag, const std::string& text, std::size_t lo, std::size_t hi) {
-  long long v = 0;  // signed, so that "-3" is out of range rather than not a number
-  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
-  const std::string shown = "'" + text.substr(0, 40) + "'";
-  if (text.empty() || r.ptr != text.data() + text.size() ||
-      (r.ec != std::errc() && r.ec != std::errc::result_out_of_range))
-    throw UsageError(std::string("bad ") + flag + " " + shown + ": expected a whole number from " +
-                     std::to_string(lo) + " to " + std::to_string(hi));
-  if (r.ec != std::errc() || v < 0 || std::size_t(v) < lo || std::size_t(v) > hi)
-    throw UsageError(std::string(flag) + " must be >= " + std::to_string(lo) +
-                     " and <= " + std::to_string(hi) + " (got " + shown + ")");
-  return v;
-}
-
-// A flag's value run through the io parser that owns its vocabulary, the message prefixed
-// with the flag's name.
-template <class Parse>
-auto parse_flag(const char* flag, const std::string& text, Parse parse) {
-  try {
-    return parse(text);
-  } catch (const loci::Error& e) {
-    throw UsageError(std::string(flag) + ": " + e.what());
+// A text or GeoJSON output that would replace a dataset is refused before the work (the
+// refusal came after a join or conflict search had run to its end); an index and a clip judge
+// their targets themselves.
+void refuse_replacing_output(const Command& c, const Args& args) {
+  const std::string command = c.name;
+  if (args.has("--output") && command != "index" && command != "clip") {
+    refuse_replacing_layers(args.get("--output"));
+    refuse_replacing_binary_dataset(args.get("--output"));
   }
-}
-
-LoadOptions load_options(const Args& a, const std::string& layer) {
-  LoadOptions o;
-  o.layer_path = layer;
-  o.layer_name = a.get("--layer");
-  o.index_path = a.get("--index");
-  if (a.has("--structure"))
-    o.structure = parse_flag("--structure", a.get("--structure"), parse_structure);
-  if (a.has("--per")) o.per = parse_flag("--per", a.get("--per"), parse_per);
-  o.progress = progress_bar(a, "indexing");
-  return o;
 }
 
 int run_info(const Args& a) {
@@ -178,67 +91,6 @@ int run_index(const Args& a) {
 int run_check(const Args& a) {
   const std::string out = check_sidecar(layer_arg(a, "check", "FILE.loci | LAYER"));
   std::printf("%s\n", out.c_str());
-  return 0;
-}
-
-int run_query(const Args& a) {
-  QueryOptions o;
-  const std::string& layer = layer_arg(a, "query");
-  o.load = load_options(a, layer);
-  const char* kinds[] = {"--bbox",   "--bbox-file", "--nearest", "--nearest-file",
-                         "--within", "--segment",   "--point",   "--point-file"};
-  int given = 0;
-  for (const char* k : kinds)
-    given += a.has(k);
-  if (given != 1)
-    throw UsageError(
-        "loci query needs exactly one of --bbox, --bbox-file, --nearest, "
-        "--nearest-file, --within, --segment, --point, --point-file");
-  if (a.has("-k") && !a.has("--nearest") && !a.has("--nearest-file"))
-    throw UsageError("-k counts the neighbours of --nearest or --nearest-file");
-  const std::size_t k = a.has("-k") ? parse_count("-k", a.get("-k"), 1, kMaxK) : 1;
-  Query q;
-  q.k = k;
-  if (a.has("--bbox")) {
-    q.kind = Query::Kind::bbox;
-    q.box = parse_bbox(a.get("--bbox"));
-  } else if (a.has("--nearest")) {
-    q.kind = Query::Kind::nearest;
-    q.point = parse_point(a.get("--nearest"));
-  } else if (a.has("--within")) {
-    q = parse_within(a.get("--within"));
-  } else if (a.has("--segment")) {
-    q.kind = Query::Kind::segment;
-    q.segment = parse_segment(a.get("--segment"));
-    q.first = a.has("--first");
-  } else if (a.has("--point")) {
-    q.kind = Query::Kind::point;
-    q.point = parse_point(a.get("--point"));
-  }
-  if (a.has("--first") && !a.has("--segment"))
-    throw UsageError("--first goes with --segment (the feature the segment meets first)");
-  for (const char* file : {"--bbox-file", "--nearest-file", "--point-file"})
-    if (a.has(file) && a.has("--output"))
-      refuse_overwriting(a.get("--output"), a.get(file), "query file");
-  if (a.has("--bbox-file")) {
-    o.queries = read_query_file(a.get("--bbox-file"), Query::Kind::bbox, k);
-    o.numbered = true;
-  } else if (a.has("--nearest-file")) {
-    o.queries = read_query_file(a.get("--nearest-file"), Query::Kind::nearest, k);
-    o.numbered = true;
-  } else if (a.has("--point-file")) {
-    o.queries = read_query_file(a.get("--point-file"), Query::Kind::point, k);
-    o.numbered = true;
-  } else {
-    o.queries.emplace_back(1, q);
-  }
-  o.candidates = a.has("--candidates");
-  o.format = parse_flag("--format", a.get("--format", "ids"), parse_format);
-  o.out_path = a.get("--output");
-  o.progress = progress_bar(a, "querying");
-  if (a.has("--jobs"))
-    o.jobs = static_cast<unsigned>(parse_count("--jobs", a.get("--jobs"), 1, 1024));
-  query_layer(o, stdout);
   return 0;
 }
 
@@ -514,18 +366,6 @@ int run_fleet_simulate(const Args& a) {
   return 0;
 }
 
-const Flag kLayer{"--layer", nullptr, "NAME",
-                  "layer of a multi-layer dataset (default: the first)"};
-const Flag kQuiet{"--quiet", "-q", nullptr, "no progress bar and no summary line"};
-const Flag kStructure{
-    "--structure", nullptr, "S",
-    "packed-hilbert (default), packed-str, rstar or rtree (the last two in memory)"};
-const Flag kPer{"--per", nullptr, "feature|segment",
-                "one box per feature or one per segment of the linework (loci index: per "
-                "segment when features average 64 segments or more; queries without a "
-                "sidecar: per feature)"};
-const Flag kIndex{"--index", nullptr, "FILE", "sidecar to use (default: LAYER.loci when present)"};
-
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
       {"info",
@@ -552,41 +392,7 @@ const std::vector<Command>& commands() {
        "  loci check countries.shp.loci\n  loci check countries.shp      (its sidecar "
        "countries.shp.loci)\n",
        run_check},
-      {"query",
-       "loci query LAYER (--bbox ... | --bbox-file F | --nearest X,Y [-k N] | ...) [-f FMT] [-o "
-       "OUT]",
-       "features whose exact geometry meets the query (the index gives candidates)",
-       {{"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX", "features meeting the closed window"},
-        {"--bbox-file", nullptr, "F", "one window per line; rows start with the line number"},
-        {"--nearest", "-n", "X,Y", "the k features nearest to the point, nearest first"},
-        {"--nearest-file", nullptr, "F", "one X,Y per line; rows start with the line number"},
-        {"-k", nullptr, "N", "how many neighbours, 1 to 1000000 (default 1)"},
-        {"--within", nullptr, "X,Y,D",
-         "features at distance <= D from the point (planar, in the layer's units)"},
-        {"--segment", nullptr, "X0,Y0,X1,Y1",
-         "features meeting the closed segment, with the first point of each (csv: x,y)"},
-        {"--first", nullptr, nullptr,
-         "with --segment: only the feature met first from X0,Y0 (line of sight), the point and "
-         "the distance along the segment"},
-        {"--point", nullptr, "X,Y", "features containing or touching the point"},
-        {"--point-file", nullptr, "F",
-         "point location in batch: one X,Y per line; rows start with the line number"},
-        {"--candidates", nullptr, nullptr,
-         "the index's answer before the exact test (it holds the exact answer)"},
-        {"--format", "-f", "ids|csv|geojson",
-         "output: FIDs (default), CSV with attributes, GeoJSON"},
-        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
-        {"--jobs", "-j", "N", "threads for a batch file (default: one per core)"},
-        kIndex,
-        kStructure,
-        kPer,
-        kLayer,
-        kQuiet},
-       "  loci query countries.shp --bbox 5,45,15,55\n"
-       "  loci query countries.shp --nearest 2.35,48.85 -k 3 -f csv\n"
-       "  loci query countries.shp --bbox-file windows.txt -o hits.txt\n"
-       "  loci query coast.shp --segment 8,55,12,55 --first -f csv\n",
-       run_query},
+      query_command(),
       {"clip",
        "loci clip LAYER (--bbox XMIN,YMIN,XMAX,YMAX | --wkt POLYGON | --window-layer POLYGONS) "
        "-o OUT",
@@ -780,17 +586,6 @@ const std::vector<Command>& commands() {
   return table;
 }
 
-void print_command_help(const Command& c) {
-  std::printf("usage: %s\n\n%s\n\noptions:\n", c.usage, c.summary);
-  for (const Flag& f : c.flags) {
-    std::string left =
-        f.alias ? std::string(f.alias) + ", " + f.name : std::string("    ") + f.name;
-    if (f.value) left += std::string(" ") + f.value;
-    std::printf("  %-34s %s\n", left.c_str(), f.help);
-  }
-  std::printf("  %-34s %s\n\nexamples:\n%s", "    --help", "this text", c.examples);
-}
-
 void print_help() {
   std::printf(
       "usage: loci COMMAND [options]\n\n"
@@ -812,65 +607,6 @@ void print_fleet_help() {
   for (const auto& c : commands())
     if (std::strncmp(c.name, "fleet ", 6) == 0) std::printf("  %-10s %s\n", c.name + 6, c.summary);
   std::printf("\nloci fleet SUBCOMMAND --help documents every option.\n");
-}
-
-Args parse(const Command& c, int first, int argc, char** argv) {
-  Args a;
-  std::set<std::string> given;  // options with a value seen so far, by long name
-  const auto find = [&](std::string_view name) -> const Flag* {
-    for (const Flag& f : c.flags)
-      if (name == f.name || (f.alias && name == f.alias)) return &f;
-    return nullptr;
-  };
-  for (int i = first; i < argc; ++i) {
-    std::string arg = argv[i];
-    if (arg.size() < 2 || arg[0] != '-') {
-      a.positional.push_back(arg);
-      continue;
-    }
-    const Flag* flag = find(arg);
-    // A value joined to its option: --name=VALUE, or -kVALUE for a one-letter option.
-    std::optional<std::string> joined;
-    if (!flag) {
-      const std::size_t eq = arg.find('=');
-      const std::size_t at = arg.rfind("--", 0) == 0 ? eq : arg[1] != '-' ? 2 : std::string::npos;
-      if (at != std::string::npos && at < arg.size()) {
-        if (const Flag* f = find(std::string_view(arg).substr(0, at)); f && f->value) {
-          flag = f;
-          joined = arg.substr(at + (at == eq ? 1 : 0));
-          arg.resize(at);
-        }
-      }
-    }
-    if (!flag)
-      throw UsageError("unknown option " + arg + " for loci " + c.name + " (see loci " + c.name +
-                       " --help)");
-    if (!flag->value) {
-      a.values[flag->name] = "";
-      continue;
-    }
-    if (!joined && i + 1 >= argc) throw UsageError(arg + " needs a value: " + flag->value);
-    const std::string value = joined ? *joined : argv[i + 1];
-    if (!joined) ++i;
-    // An option's value is taken once: a second one would silently replace the first (two
-    // --bbox are not two windows).
-    if (!given.insert(flag->name).second)
-      throw UsageError(arg + " is given twice; loci " + c.name + " takes one " + flag->name);
-    if (value.empty())  // `-o ""` would otherwise mean stdout or a default
-      throw UsageError(arg + " needs a value: " + flag->value + ", not an empty one");
-    // `-o -` is stdout, as usual, where the output is text that may go there; a command that
-    // writes a file says so (a file named "-" is ./-).
-    if (!std::strcmp(flag->name, "--output") && value == "-") {
-      if (flag->stdout_allowed) {
-        a.values.erase(flag->name);
-        continue;
-      }
-      throw UsageError(arg + " -: loci " + c.name +
-                       " writes a file, not stdout; name it (./- for a file named -)");
-    }
-    a.values[flag->name] = value;
-  }
-  return a;
 }
 
 }  // namespace
@@ -902,35 +638,8 @@ int main(int argc, char** argv) {
     name += std::string(" ") + argv[2];
     first = 3;
   }
-  for (const auto& c : commands()) {
-    if (c.name != name) continue;
-    for (int i = first; i < argc; ++i)
-      if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
-        print_command_help(c);
-        return 0;
-      }
-    try {
-      const Args args = parse(c, first, argc, argv);
-      // A text or GeoJSON output that would replace a dataset is refused before the work
-      // (the refusal came after a join or conflict search had run to its end); an index and a
-      // clip judge their targets themselves.
-      const std::string command = c.name;
-      if (args.has("--output") && command != "index" && command != "clip") {
-        refuse_replacing_layers(args.get("--output"));
-        refuse_replacing_binary_dataset(args.get("--output"));
-      }
-      const int status = c.run(args);
-      // Output that did not reach its destination (a full disk, a closed pipe) is a failure.
-      if (std::fflush(stdout) != 0 || std::ferror(stdout))
-        throw loci::Error(std::string("cannot write output (") +
-                          std::strerror(errno ? errno : EIO) + ")");
-      return status;
-    } catch (const std::exception& e) {
-      std::fflush(stdout);
-      std::fprintf(stderr, "loci: error: %s\n", printable(e.what()).c_str());
-      return 1;
-    }
-  }
+  for (const auto& c : commands())
+    if (c.name == name) return run_command(c, first, argc, argv, refuse_replacing_output);
   const std::string shown = printable(name.substr(0, 40));
   const bool fleet = name.rfind("fleet ", 0) == 0;
   std::fprintf(stderr, "loci: error: unknown command '%s' (see loci %s--help)\n", shown.c_str(),

@@ -11,11 +11,10 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "gdal_layer.hpp"
+#include "gdal_seam.hpp"
 #include "loci/geom/convex_hull.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/exact.hpp"
-#include "shapefile_polygons.hpp"
 
 namespace loci::io {
 
@@ -117,21 +116,14 @@ void LayerGeometries::adopt(std::unordered_map<std::int64_t, FlatGeometry>&& all
 }
 
 const FlatGeometry* LayerGeometries::find(std::int64_t fid) {
-  std::call_once(once_, [&] {
-    const detail::OpenLayer ol = detail::open_layer(path_, name_);
-    whole_ = !detail::fast_random_read(*ol.dataset);
-    if (!whole_) return;
-    // Text formats find a feature by FID by parsing the file from its start: one pass that
-    // keeps every geometry costs what the first lookup would.
-    ol.layer->ResetReading();
-    for (auto& f : *ol.layer)
-      all_.emplace(f->GetFID(),
-                   detail::flatten(f->GetGeometryRef(), detail::where(path_, f->GetFID())));
-  });
+  // Text formats find a feature by FID by parsing the file from its start: one pass that keeps
+  // every geometry costs what the first lookup would.
+  std::call_once(once_, [&] { whole_ = detail::read_whole_layer(path_, name_, all_); });
   if (!whole_) return nullptr;
   const auto it = all_.find(fid);
   if (it == all_.end())
-    throw Error(detail::where(path_, fid) + " is not in the layer: the index does not match it");
+    throw Error(path_ + ": feature " + std::to_string(fid) +
+                " is not in the layer: the index does not match it");
   return &it->second;
 }
 
@@ -139,22 +131,14 @@ struct LayerQuery::Geometries {
   std::string path;
   std::string name;
   std::shared_ptr<LayerGeometries> shared;
-  std::optional<detail::OpenLayer> layer;
-  std::unique_ptr<detail::ShapefilePolygons> polygons;  // of `layer`
+  std::unique_ptr<detail::FeatureReader> reader;  // opened on the first feature read by FID
   std::unordered_map<std::int64_t, FlatGeometry> cache;
 
   const FlatGeometry& get(std::int64_t fid) {
     if (const FlatGeometry* g = shared->find(fid)) return *g;
     if (auto it = cache.find(fid); it != cache.end()) return it->second;
-    if (!layer) {
-      layer = detail::open_layer(path, name);
-      polygons = std::make_unique<detail::ShapefilePolygons>(path, *layer->layer);
-    }
-    OGRFeatureUniquePtr f(polygons->fetch(fid));
-    if (!f)
-      throw Error(detail::where(path, fid) + " is not in the layer: the index does not match it");
-    return cache.emplace(fid, detail::flatten(f->GetGeometryRef(), detail::where(path, fid)))
-        .first->second;
+    if (!reader) reader = detail::open_feature_reader(path, name);
+    return cache.emplace(fid, reader->read(fid)).first->second;
   }
 
   // The feature prepared for point tests (its edges bucketed by y), made on first use.
@@ -169,8 +153,8 @@ LayerQuery::LayerQuery(const LayerIndex& index, std::string layer_path, std::str
                        std::shared_ptr<LayerGeometries> shared)
     : index_(index) {
   if (!shared) shared = std::make_shared<LayerGeometries>(layer_path, layer_name);
-  geometries_.reset(new Geometries{
-      std::move(layer_path), std::move(layer_name), std::move(shared), {}, {}, {}, {}});
+  geometries_.reset(
+      new Geometries{std::move(layer_path), std::move(layer_name), std::move(shared), {}, {}, {}});
 }
 
 LayerQuery::~LayerQuery() = default;

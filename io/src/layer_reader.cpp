@@ -195,16 +195,6 @@ LayerItems read_items_choosing(const std::string& path, const std::string& layer
   return by_feature;
 }
 
-std::string default_layer_name(const std::string& path) {
-  std::string ext = path.substr(
-      path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'));
-  for (char& c : ext)
-    c = char(std::tolower(static_cast<unsigned char>(c)));
-  for (const char* single : {".shp", ".geojson", ".json", ".fgb", ".geojsonl", ".geojsons"})
-    if (ext == single) return "";
-  return open_layer(path, "").layer->GetName();
-}
-
 LayerSummary summarize_layer(const std::string& path, const std::string& layer,
                              const Progress& progress) {
   auto ol = open_layer(path, layer);

@@ -328,6 +328,13 @@ Fingerprint fingerprint_of(const std::string& layer_path) {
   return f;
 }
 
+std::string stale_reason(const Fingerprint& was, const Fingerprint& now) {
+  if (was.size != now.size)
+    return "size " + std::to_string(was.size) + " -> " + std::to_string(now.size) + " bytes";
+  if (was.hash != now.hash) return "contents changed";
+  return "modified after the index was written";
+}
+
 bool still_fresh(const std::string& layer_path, const Fingerprint& was, Fingerprint* now) {
   bool regular = false;
   const auto stat = stat_fingerprint(layer_path, regular);

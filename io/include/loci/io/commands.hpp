@@ -119,6 +119,12 @@ struct QueryReport {
 
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 
+// Whether query_layer answers `options` from its sidecar alone, without reading the layer
+// through GDAL: a fresh sidecar per segment (or --candidates), ids written to stdout. Reads no
+// query file and writes nothing; false when unsure, and on any failure (the command run in
+// full says what is wrong). For the `loci` front, which runs such queries without loading GDAL.
+bool answers_without_gdal(const QueryOptions& options);
+
 struct ClipOptions {
   LoadOptions load;
   Box2 window{};                  // the window, unless one of the two below is given

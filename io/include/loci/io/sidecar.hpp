@@ -201,6 +201,10 @@ class StreamHash {
 // measured (for messages).
 bool still_fresh(const std::string& layer_path, const Fingerprint& was, Fingerprint* now = nullptr);
 
+// What changed between `was` and `now` (still_fresh's measure), as messages say it: "size A ->
+// B bytes", "contents changed" or "modified after the index was written".
+std::string stale_reason(const Fingerprint& was, const Fingerprint& now);
+
 // XXH3-64 of a byte range.
 std::uint64_t hash_bytes(const void* data, std::size_t size, std::uint64_t seed = 0);
 

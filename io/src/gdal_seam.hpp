@@ -1,0 +1,61 @@
+// The seam between io/'s GDAL-free core and its GDAL part.
+//
+// A query on a sidecar per segment (or for candidates only) reads nothing but the sidecar: it
+// runs without GDAL, whose 115 libraries take about 30 ms to load. The core (the sidecar, the
+// queries, the ids output, atomic files) calls GDAL only through the functions declared here
+// and those of the public headers listed below. The full library (loci::io) defines them with
+// GDAL; the `loci` front (cli/front.cpp), which does not link GDAL, is linked with
+// without_gdal.cpp instead, where each throws NeedsGdal, and hands any command that meets one
+// to `loci-full` before it has read its input or written anything.
+//
+// Also on the seam, declared where their callers find them: read_items (layer_reader.hpp) and
+// refuse_replacing_layers (atomic_file.hpp). A core file that calls any other GDAL function
+// fails to link into the front.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <span>
+#include <string>
+#include <unordered_map>
+
+#include "loci/geom/error.hpp"
+#include "loci/io/exact.hpp"
+#include "loci/io/output.hpp"
+
+namespace loci::io::detail {
+
+// The work asked for needs GDAL, which this process has not loaded.
+class NeedsGdal : public Error {
+ public:
+  NeedsGdal() : Error("this needs GDAL, which this process does not load") {}
+};
+
+// The name GDAL gives the layer `name` of `path` (the first layer when empty): a name matched
+// without regard to case comes back as the layer spells it. Throws loci::Error as open_layer.
+std::string layer_name_in(const std::string& path, const std::string& name);
+
+// A layer's features by FID, each flattened for the exact tests; a shapefile's polygons of many
+// rings are built without GDAL's sorting of rings.
+class FeatureReader {
+ public:
+  virtual ~FeatureReader() = default;
+  // Throws loci::Error for a FID not in the layer, InvalidGeometry for a bad coordinate.
+  virtual FlatGeometry read(std::int64_t fid) = 0;
+};
+std::unique_ptr<FeatureReader> open_feature_reader(const std::string& path,
+                                                   const std::string& name);
+
+// For a layer whose driver finds a feature by FID by parsing the file from its start (GeoJSON,
+// CSV, GML...): every geometry, flattened, into `all`, and true. False, with `all` untouched,
+// for a layer read by FID in place.
+bool read_whole_layer(const std::string& path, const std::string& name,
+                      std::unordered_map<std::int64_t, FlatGeometry>& all);
+
+// write_answers' csv and GeoJSON formats, which read the features' attributes and geometries.
+void write_feature_answers(const AnswerSource& source, std::span<const Answer> answers,
+                           Format format, bool numbered, bool with_distance, bool with_point,
+                           const std::string& out_path, std::FILE* fallback);
+
+}  // namespace loci::io::detail

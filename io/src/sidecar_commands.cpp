@@ -1,0 +1,405 @@
+// The commands that read a sidecar: query (with its parsers and query files), check, and the
+// load that finds a query's index. None of them reads the layer through GDAL when the sidecar
+// answers (see gdal_seam.hpp): the `loci` front runs them without loading GDAL.
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <atomic>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include "gdal_seam.hpp"
+#include "loci/geom/error.hpp"
+#include "loci/index/detail/hilbert.hpp"
+#include "loci/io/atomic_file.hpp"
+#include "loci/io/commands.hpp"
+#include "loci/io/sidecar.hpp"
+
+namespace loci::io {
+
+std::string printable(std::string_view text) {
+  std::string out(text);
+  for (char& c : out)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return out;
+}
+
+namespace {
+
+// The text as a message may quote it: at most 60 characters, printable.
+std::string quoted(const std::string& text) {
+  return "'" + printable(text.substr(0, 60)) + (text.size() > 60 ? "...'" : "'");
+}
+
+// "A,B,..." as n finite numbers; spaces around each are allowed. std::from_chars reads the
+// C locale's format whatever the process locale (a user's decimal comma does not change it).
+std::vector<double> parse_numbers(const std::string& text, std::size_t n, const char* what,
+                                  const char* form) {
+  auto bad = [&] {
+    return InvalidArgument(std::string("bad ") + what + " " + quoted(text) + ": expected " + form);
+  };
+  std::vector<double> v;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    std::size_t first = text.find_first_not_of(" \t", at), last = comma;
+    while (last > at && (text[last - 1] == ' ' || text[last - 1] == '\t' || text[last - 1] == '\r'))
+      --last;
+    if (first == std::string::npos || first >= last) throw bad();
+    if (text[first] == '+') ++first;  // from_chars takes no leading plus
+    double d = 0;
+    const auto r = std::from_chars(text.data() + first, text.data() + last, d);
+    if (r.ec != std::errc() || r.ptr != text.data() + last || !std::isfinite(d)) throw bad();
+    if (std::abs(d) > kMaxCoordinate)
+      throw InvalidArgument(std::string("bad ") + what + " " + quoted(text) +
+                            ": values beyond +-1e150 are too large for exact distances");
+    v.push_back(d);
+    at = comma + 1;
+  }
+  if (v.size() != n) throw bad();
+  return v;
+}
+
+bool file_exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+}  // namespace
+
+Box2 parse_bbox(const std::string& text) {
+  const auto v = parse_numbers(text, 4, "bbox", "XMIN,YMIN,XMAX,YMAX");
+  const Box2 b{{v[0], v[1]}, {v[2], v[3]}};
+  if (v[0] > v[2] || v[1] > v[3])
+    throw InvalidArgument("bad bbox " + quoted(text) + ": XMIN > XMAX or YMIN > YMAX");
+  return b;
+}
+
+Point2 parse_point(const std::string& text) {
+  const auto v = parse_numbers(text, 2, "point", "X,Y");
+  return {v[0], v[1]};
+}
+
+Segment2 parse_segment(const std::string& text) {
+  const auto v = parse_numbers(text, 4, "segment", "X0,Y0,X1,Y1");
+  return {{v[0], v[1]}, {v[2], v[3]}};
+}
+
+Query parse_within(const std::string& text) {
+  const auto v = parse_numbers(text, 3, "--within", "X,Y,D");
+  if (v[2] < 0) throw InvalidArgument("bad --within " + quoted(text) + ": D must be >= 0");
+  Query q;
+  q.kind = Query::Kind::within;
+  q.point = {v[0], v[1]};
+  q.radius = v[2];
+  return q;
+}
+
+std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& path,
+                                                           Query::Kind kind, std::size_t k) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw Error(path + ": is a directory, not a query file");
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot read the query file");
+  std::vector<std::pair<std::size_t, Query>> out;
+  std::string line;
+  for (std::size_t n = 1; std::getline(in, line); ++n) {
+    // A UTF-8 byte order mark, as editors on some systems write it, is not part of the text.
+    if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' '))
+      line.pop_back();
+    Query q;
+    q.kind = kind;
+    q.k = k;
+    try {
+      if (kind == Query::Kind::bbox)
+        q.box = parse_bbox(line);
+      else
+        q.point = parse_point(line);
+    } catch (const Error& e) {
+      throw Error(path + ": line " + std::to_string(n) + ": " + e.what());
+    }
+    out.emplace_back(n, q);
+  }
+  return out;
+}
+namespace {
+
+// Whether the stored hierarchies are those the tree and records give (the sidecar verified).
+bool same_hierarchies(const LayerIndex::Features& stored, const LayerIndex::Features& built) {
+  auto same = [](auto a, auto b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
+  };
+  if (!built.hierarchical || !same(stored.fid, built.fid) || !same(stored.roots, built.roots) ||
+      stored.levels.size() != built.levels.size() ||
+      !same(stored.root_tree.blocks(), built.root_tree.blocks()) ||
+      !same(stored.root_tree.item_indices(), built.root_tree.item_indices()) ||
+      !same(stored.hull_first, built.hull_first) || !same(stored.hull_points, built.hull_points))
+    return false;
+  for (std::size_t l = 0; l < built.levels.size(); ++l)
+    if (!same(stored.levels[l], built.levels[l])) return false;
+  return true;
+}
+
+// The order in which a batch's queries run: by the Hilbert key, over the layer's extent, of
+// each query's point (a window's centre, a segment's start), ties in query order. The grid
+// takes any point (one outside the extent, or a centre that overflows, keys to its border).
+std::vector<std::size_t> run_order(const std::vector<std::pair<std::size_t, Query>>& queries,
+                                   const Box2& extent) {
+  const loci::detail::HilbertGrid<2> grid(extent);
+  auto point = [](const Query& q) {
+    return q.kind == Query::Kind::bbox      ? q.box.center()
+           : q.kind == Query::Kind::segment ? q.segment.a
+                                            : q.point;
+  };
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(queries.size());
+  for (std::size_t i = 0; i < queries.size(); ++i)
+    keyed[i] = {grid.key(point(queries[i].second)), i};
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::size_t> order(queries.size());
+  for (std::size_t i = 0; i < keyed.size(); ++i)
+    order[i] = keyed[i].second;
+  return order;
+}
+
+}  // namespace
+
+std::string check_sidecar(const std::string& arg) {
+  // A layer given for its sidecar checks the sidecar; a sidecar beside the layer it is named
+  // after is checked against it too, as every query checks it.
+  std::string path = arg, layer;
+  const std::string beside = default_sidecar_path(arg);
+  std::error_code ec;
+  const bool plain = std::filesystem::is_regular_file(arg, ec) ||
+                     std::filesystem::is_directory(arg, ec);  // never opens a FIFO
+  if (plain && !starts_as_sidecar(arg)) {
+    if (!file_exists(beside))
+      throw Error(arg + ": not a loci index file, and " + beside +
+                  " does not exist; run 'loci index " + arg + "'");
+    path = beside;
+    layer = arg;
+  } else if (path.size() > 5 && path.ends_with(".loci") &&
+             file_exists(path.substr(0, path.size() - 5))) {
+    layer = path.substr(0, path.size() - 5);
+  }
+  Sidecar sc = Sidecar::open(path);
+  const SidecarInfo info = sc.info();
+  const std::size_t chunks = sc.check().chunks();
+  try {
+    sc.verify();
+    if (sc.hierarchies()) {
+      const LayerIndex index = LayerIndex::adopt(std::move(sc));
+      const LayerIndex::Features built =
+          LayerIndex::build_features(index.packed(), index.per(), index.records());
+      if (!same_hierarchies(index.features(), built))
+        throw Error(
+            path +
+            ": corrupt index file (the feature hierarchies or hulls do not match the segments); "
+            "run 'loci index' to rebuild it");
+    }
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    if (what.rfind(path, 0) == 0) throw;
+    throw Error(path + ": corrupt index file (" + what + "); run 'loci index' to rebuild it");
+  }
+  Fingerprint now;
+  if (!layer.empty() && !still_fresh(layer, info.source, &now))
+    throw Error(path + ": intact but stale, " + layer + " changed since it was indexed (" +
+                stale_reason(info.source, now) + "); run 'loci index " + layer + "'");
+  const auto& i = info;
+  return path + ": ok, " + (i.packing == Packing::str ? "packed-str" : "packed-hilbert") + " per " +
+         to_string(i.per) + ", layer " + i.layer_name + ", " + std::to_string(i.items) +
+         " entries, " + std::to_string(chunks) + " chunks verified, " +
+         std::to_string(i.file_size) + " bytes";
+}
+
+std::string default_layer_name(const std::string& path) {
+  std::string ext = path.substr(
+      path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'));
+  for (char& c : ext)
+    c = char(std::tolower(static_cast<unsigned char>(c)));
+  for (const char* single : {".shp", ".geojson", ".json", ".fgb", ".geojsonl", ".geojsons"})
+    if (ext == single) return "";
+  return detail::layer_name_in(path, "");
+}
+
+std::string sidecar_path_of(const LoadOptions& o) {
+  return o.index_path.empty() ? default_sidecar_path(o.layer_path) : o.index_path;
+}
+
+LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries* geometries) {
+  const bool dynamic =
+      o.structure && (*o.structure == Structure::rstar || *o.structure == Structure::rtree);
+  const std::string path = sidecar_path_of(o);
+  if (!o.index_path.empty() && !file_exists(path)) throw Error(path + ": no such index file");
+  if (!dynamic && file_exists(path)) {
+    Sidecar sc = Sidecar::open(path);
+    Fingerprint now;
+    if (!still_fresh(o.layer_path, sc.info().source, &now)) {
+      // A sidecar of another layer altogether says so, rather than "stale".
+      std::string actual;
+      try {
+        actual = detail::layer_name_in(o.layer_path, o.layer_name);
+      } catch (const detail::NeedsGdal&) {
+        throw;
+      } catch (const Error&) {
+      }
+      if (!actual.empty() && actual != sc.info().layer_name)
+        throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + actual +
+                    "' of " + o.layer_path + "; run 'loci index " + o.layer_path +
+                    "' or give its own index with --index");
+      // An index given with --index may be another file's as well as a stale one: the command
+      // offered rewrites that index, not the layer's default sidecar.
+      if (!o.index_path.empty())
+        throw Error(path + ": does not match " + o.layer_path + " (" +
+                    stale_reason(sc.info().source, now) +
+                    "): the index of another file, or of this one before it changed; run 'loci "
+                    "index " +
+                    o.layer_path + " -o " + path + "'");
+      throw Error(path + ": stale index, " + o.layer_path + " changed since it was indexed (" +
+                  stale_reason(sc.info().source, now) + "); run 'loci index " + o.layer_path + "'");
+    }
+    // --layer as GDAL finds it: a name it does not know is said so, and one differing only in
+    // case names the layer indexed.
+    if (!o.layer_name.empty() && o.layer_name != sc.info().layer_name) {
+      const std::string actual = detail::layer_name_in(o.layer_path, o.layer_name);
+      if (actual != sc.info().layer_name)
+        throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + actual +
+                    "'; give another index file with --index");
+    }
+    // No --layer means the dataset's first layer; a sidecar of another layer must not answer.
+    if (o.layer_name.empty()) {
+      const std::string first = default_layer_name(o.layer_path);
+      if (!first.empty() && first != sc.info().layer_name)
+        throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not the default '" +
+                    first + "'; give --layer " + sc.info().layer_name +
+                    ", or another index file with --index");
+    }
+    const bool same_per = !o.per || *o.per == sc.info().per;
+    const bool same_packing = !o.structure || (*o.structure == Structure::packed_str) ==
+                                                  (sc.info().packing == Packing::str);
+    if (same_per && same_packing) {
+      if (origin) *origin = "sidecar " + path;
+      return LayerIndex::adopt(std::move(sc));
+    }
+  }
+  if (origin) *origin = "built in memory";
+  LayerItems items = read_items(o.layer_path, o.layer_name, o.per.value_or(Per::feature),
+                                o.progress, geometries != nullptr);
+  if (geometries && !items.geometries.empty()) geometries->adopt(std::move(items.geometries));
+  return LayerIndex::build(std::move(items), o.structure.value_or(Structure::packed_hilbert));
+}
+
+bool answers_without_gdal(const QueryOptions& options) {
+  if (options.format != Format::ids || !options.out_path.empty() ||
+      !file_exists(sidecar_path_of(options.load)))
+    return false;
+  try {
+    const LayerIndex index = load_index(options.load);
+    return options.candidates || index.per() == Per::segment;
+  } catch (...) {  // the command run in full says what is wrong
+    return false;
+  }
+}
+
+QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
+  refuse_overwriting(options.out_path, options.load.layer_path);
+  refuse_overwriting(options.out_path, sidecar_path_of(options.load), "index");
+  QueryReport report;
+  // A text layer is read whole once, for every thread; an index built in memory hands over
+  // the geometries it read.
+  const auto geometries =
+      std::make_shared<LayerGeometries>(options.load.layer_path, options.load.layer_name);
+  const LayerIndex index = load_index(options.load, &report.index_origin, geometries.get());
+  bool with_distance = false, with_point = false;
+  for (const auto& [number, q] : options.queries) {
+    with_distance |= q.kind == Query::Kind::within || q.kind == Query::Kind::nearest || q.first;
+    with_point |= q.kind == Query::Kind::segment && !options.candidates;
+  }
+  const std::size_t n = options.queries.size();
+  ProgressTicker ticker(options.progress, double(n));
+  // The queries run in the order of their points along a Hilbert curve, cut into chunks that
+  // threads take in turn, each thread with its own LayerQuery (its geometry cache and layer
+  // handle) over the one immutable index; the answers are joined in query order. Queries
+  // near each other in that order read the same nodes and pages of the index: on a large
+  // sidecar a batch of random points runs about twice as fast as in file order.
+  const std::vector<std::size_t> order = run_order(options.queries, index.bounds());
+  constexpr std::size_t kChunk = 64;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<Answer>> parts(chunks);
+  struct Place {
+    std::size_t chunk, begin, end;  // query i's answers: parts[chunk][begin, end)
+  };
+  std::vector<Place> place(n);
+  auto run_chunk = [&](LayerQuery& lq, std::size_t c) {
+    const std::size_t end = std::min(n, (c + 1) * kChunk);
+    for (std::size_t s = c * kChunk; s < end; ++s) {
+      const std::size_t i = order[s];
+      const auto& [number, q] = options.queries[i];
+      const std::size_t begin = parts[c].size();
+      lq.run(q, number, options.candidates, parts[c]);
+      place[i] = {c, begin, parts[c].size()};
+    }
+    return end - c * kChunk;
+  };
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t jobs = std::min<std::size_t>(options.jobs ? options.jobs : cores, chunks);
+  if (jobs <= 1) {
+    LayerQuery lq(index, options.load.layer_path, index.layer_name(), geometries);
+    std::size_t done = 0;
+    for (std::size_t c = 0; c < chunks; ++c) {
+      done += run_chunk(lq, c);
+      ticker.tick(double(done));
+    }
+  } else {
+    std::atomic<std::size_t> next{0}, done{0};
+    std::atomic<bool> failed{false};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    // Every thread takes chunks; this one also reports progress between its chunks.
+    auto work = [&](bool reporting) {
+      try {
+        LayerQuery lq(index, options.load.layer_path, index.layer_name(), geometries);
+        for (std::size_t c; !failed && (c = next++) < chunks;) {
+          done += run_chunk(lq, c);
+          if (reporting) ticker.tick(double(done));
+        }
+      } catch (...) {
+        const std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        failed = true;
+      }
+    };
+    std::vector<std::thread> threads;
+    for (std::size_t t = 1; t < jobs; ++t)
+      threads.emplace_back(work, false);
+    work(true);
+    for (auto& t : threads)
+      t.join();
+    if (error) std::rethrow_exception(error);
+    ticker.tick(double(n));
+  }
+  std::vector<Answer> answers;
+  std::size_t total = 0;
+  for (const auto& p : parts)
+    total += p.size();
+  answers.reserve(total);
+  for (const Place& at : place)
+    answers.insert(answers.end(), parts[at.chunk].begin() + std::ptrdiff_t(at.begin),
+                   parts[at.chunk].begin() + std::ptrdiff_t(at.end));
+  parts = {};  // not held while the answers are written
+  write_answers({options.load.layer_path, index.layer_name()}, answers, options.format,
+                options.numbered, with_distance, with_point, options.out_path, fallback);
+  report.answers = answers.size();
+  return report;
+}
+
+}  // namespace loci::io

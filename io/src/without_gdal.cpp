@@ -1,0 +1,39 @@
+// The seam of gdal_seam.hpp without GDAL: every function that would read or write through
+// GDAL throws NeedsGdal. Linked only into the `loci` front, in place of the GDAL part of
+// loci::io, so that a query its sidecar answers starts without loading GDAL.
+#include "gdal_seam.hpp"
+#include "loci/io/atomic_file.hpp"
+#include "loci/io/layer_reader.hpp"
+
+namespace loci::io {
+
+LayerItems read_items(const std::string&, const std::string&, Per, const Progress&, bool) {
+  throw detail::NeedsGdal();
+}
+
+void refuse_replacing_layers(const std::string&) {
+  throw detail::NeedsGdal();
+}
+
+namespace detail {
+
+std::string layer_name_in(const std::string&, const std::string&) {
+  throw NeedsGdal();
+}
+
+std::unique_ptr<FeatureReader> open_feature_reader(const std::string&, const std::string&) {
+  throw NeedsGdal();
+}
+
+bool read_whole_layer(const std::string&, const std::string&,
+                      std::unordered_map<std::int64_t, FlatGeometry>&) {
+  throw NeedsGdal();
+}
+
+void write_feature_answers(const AnswerSource&, std::span<const Answer>, Format, bool, bool, bool,
+                           const std::string&, std::FILE*) {
+  throw NeedsGdal();
+}
+
+}  // namespace detail
+}  // namespace loci::io
