@@ -2133,3 +2133,104 @@ TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {
   const CliRun info = run_loci("info " + layer);
   EXPECT_NE(info.out.find("stale"), std::string::npos) << info.out;
 }
+
+// `loci` answers a query its sidecar serves (per segment, or --candidates; ids on stdout)
+// without GDAL, and hands every other command to loci-full beside it. A copy of `loci` alone
+// in a directory shows which is which: it answers the first kind as the whole program does,
+// and cannot run the second.
+TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
+  const std::string seg = path("front.geojson"), feat = path("front.shp");
+  fs::copy_file(std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson", seg,
+                fs::copy_options::overwrite_existing);
+  for (const char* ext : {".shp", ".shx", ".dbf"})
+    fs::copy_file(path(std::string("polys") + ext), path(std::string("front") + ext),
+                  fs::copy_options::overwrite_existing);
+  ASSERT_EQ(run_loci("index -q --per segment " + seg).status, 0);
+  ASSERT_EQ(run_loci("index -q --per feature " + feat).status, 0);
+  const std::string points = path("front-points.txt");
+  {
+    std::ofstream out(points);
+    std::mt19937_64 rng(77);
+    std::uniform_real_distribution<double> x(7.5, 13.0), y(54.4, 57.9);
+    for (int i = 0; i < 200; ++i)
+      out << x(rng) << ',' << y(rng) << '\n';
+  }
+  const fs::path alone = g_dir / "front-alone";
+  fs::create_directories(alone);
+  fs::copy_file(LOCI_EXE, alone / "loci", fs::copy_options::overwrite_existing);
+  const std::string front = (alone / "loci").string();
+  auto run_with = [](const std::string& exe, const std::string& args) {
+    const std::string cmd = exe + " " + args + " 2>&1";
+    CliRun r;
+    std::FILE* p = ::popen(cmd.c_str(), "r");
+    char buf[65536];
+    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;)
+      r.out.append(buf, n);
+    const int st = ::pclose(p);
+    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
+    return r;
+  };
+  const std::string answered[] = {
+      "query " + seg + " --nearest 10.5,56 -k 7",
+      "query " + seg + " --nearest-file " + points + " -k 3 -j 2",
+      "query " + seg + " --bbox 9,55,11,57",
+      "query " + seg + " --point 9.5,56.2",
+      "query " + seg + " --within 10.5,56,0.3",
+      "query " + seg + " --segment 8,55,12,57 --first",
+      "query " + feat + " --bbox 20,20,60,60 --candidates",
+  };
+  for (const std::string& args : answered) {
+    const CliRun whole = run_loci(args), part = run_with(front, args);
+    ASSERT_EQ(whole.status, 0) << args << ": " << whole.err;
+    EXPECT_FALSE(whole.out.empty()) << args;
+    EXPECT_EQ(part.status, 0) << args << ": " << part.out;
+    EXPECT_EQ(part.out, whole.out) << args;
+  }
+  // Work that needs the layer or GDAL: the copy alone says it cannot run loci-full, and
+  // nothing else (it neither answers nor half-answers).
+  const std::string handed[] = {
+      "query " + feat + " --bbox 20,20,60,60",
+      "query " + seg + " --nearest 10.5,56 -f csv",
+      "query " + seg + " --nearest 10.5,56 -o " + path("front-out.txt"),
+      "query " + seg + " --nearest 10.5,56 --per feature",
+      "query " + seg + " --bbox 1,2",
+      "query " + seg + " --help",
+      "info " + seg,
+      "--help",
+  };
+  for (const std::string& args : handed) {
+    const CliRun r = run_with(front, args);
+    EXPECT_EQ(r.status, 1) << args;
+    EXPECT_EQ(lines(r.out).size(), 1u) << args << ": " << r.out;
+    EXPECT_NE(r.out.find("loci: error: cannot run "), std::string::npos) << args << ": " << r.out;
+    EXPECT_NE(r.out.find("loci is not installed whole"), std::string::npos) << args;
+  }
+  EXPECT_FALSE(fs::exists(path("front-out.txt")));
+  // A query file on a pipe is read once, by whichever program answers.
+  for (const std::string& layer : {seg, feat}) {
+    const std::string args = "query " + layer + " --nearest-file /dev/stdin -k 2";
+    const CliRun from_file = run_loci("query " + layer + " --nearest-file " + points + " -k 2");
+    const CliRun piped =
+        run_with("cat " + shell_quote(points) + " | " + std::string(LOCI_EXE), args);
+    ASSERT_EQ(from_file.status, 0) << from_file.err;
+    EXPECT_EQ(piped.status, 0) << piped.out;
+    EXPECT_EQ(piped.out, from_file.out) << layer;
+  }
+  // A stale sidecar is the whole program's to report.
+  { std::ofstream(seg, std::ios::app) << "\n"; }
+  const CliRun stale = run_with(front, "query " + seg + " --nearest 10.5,56");
+  EXPECT_NE(stale.out.find("loci is not installed whole"), std::string::npos) << stale.out;
+  const CliRun said = run_loci("query " + seg + " --nearest 10.5,56");
+  EXPECT_EQ(said.status, 1);
+  EXPECT_NE(said.err.find("stale index"), std::string::npos) << said.err;
+  // The front does not load GDAL's libraries at all.
+  const CliRun libs = run_with("ldd", LOCI_EXE);
+  ASSERT_EQ(libs.status, 0) << libs.out;
+  EXPECT_EQ(libs.out.find("libgdal"), std::string::npos) << libs.out;
+  fs::remove_all(alone);
+  for (const char* ext : {".shp", ".shx", ".dbf", ".shp.loci"})
+    fs::remove(path(std::string("front") + ext));
+  fs::remove(seg + ".loci");
+  fs::remove(seg);
+  fs::remove(points);
+}

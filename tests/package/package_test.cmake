@@ -16,6 +16,15 @@ function(run what)
   set(last_output "${out}" PARENT_SCOPE)
 endfunction()
 run("install" "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix")
+# The installed command: loci answers a query its sidecar serves by itself, and hands the rest
+# (here, indexing) to loci-full where it is installed.
+run("index with the installed loci" "${WORK_DIR}/prefix/bin/loci" index -q "${LAYER}"
+    -o "${WORK_DIR}/sample.loci")
+run("query with the installed loci" "${WORK_DIR}/prefix/bin/loci" query "${LAYER}"
+    --index "${WORK_DIR}/sample.loci" --nearest 10,56 -k 2)
+if(NOT last_output MATCHES "^[0-9]+\n[0-9]+\n$")
+  message(FATAL_ERROR "the installed loci answered:\n${last_output}")
+endif()
 run("configure the consumer" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}" -B "${WORK_DIR}/build"
     -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_COMPILER=${CXX}"
     "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix")
