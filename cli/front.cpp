@@ -9,7 +9,9 @@
 #include <climits>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "command_line.hpp"
 
@@ -17,48 +19,66 @@ namespace {
 
 using namespace loci::cli;
 
-// Whether this process answers: a `loci query` its sidecar answers without GDAL. Parses the
-// arguments and opens the sidecar, but reads no query file and writes nothing, so that a
-// command handed over starts afresh (a query file on a pipe is read once).
+// The sidecar this process answers from (answers_without_gdal's), loaded once: the query
+// file is read after it was chosen, and nothing can be handed over from then on.
+std::shared_ptr<const loci::io::LayerIndex> g_index;
+
+// Whether this process answers: a `loci query` its sidecar answers without GDAL (g_index set).
+// Parses the arguments and opens the sidecar, but reads no query file and writes nothing, so
+// that a command handed over starts afresh (a query file on a pipe is read once).
 bool answered_here(int argc, char** argv) {
   if (argc < 3 || std::strcmp(argv[1], "query") != 0) return false;
   for (int i = 2; i < argc; ++i)
     if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) return false;
   try {
     const Args a = parse(query_command(), 2, argc, argv);
-    return loci::io::answers_without_gdal(query_options(a, false));
+    g_index = loci::io::answers_without_gdal(query_options(a, false));
+    return g_index != nullptr;
   } catch (...) {  // loci-full says what is wrong
     return false;
   }
 }
 
-// The directory this program is in, with its trailing '/'.
-std::string own_directory() {
-  char buf[PATH_MAX];
-  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return "./";
-  const std::string path(buf, std::size_t(n));
-  return path.substr(0, path.rfind('/') + 1);
+int run_query_here(const Args& a) {
+  loci::io::QueryOptions o = query_options(a, true);
+  o.index = g_index;
+  loci::io::query_layer(o, stdout);
+  return 0;
 }
 
 // Runs loci-full in place of this process: beside this program (the build tree), or where it
-// is installed (LOCI_FULL_FROM_BIN, relative to the directory of programs).
+// is installed (LOCI_FULL_FROM_BIN, relative to the directory of programs). Without
+// /proc/self/exe to say where this program is, only the installed path (LOCI_FULL_INSTALLED)
+// is tried, never a file the current directory happens to hold.
 [[noreturn]] void hand_over(char** argv) {
-  const std::string dir = own_directory();
-  const std::string places[] = {dir + "loci-full", dir + LOCI_FULL_FROM_BIN + "/loci-full"};
+  std::vector<std::string> places;
+  char buf[PATH_MAX];
+  if (const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1); n > 0) {
+    std::string dir(buf, std::size_t(n));
+    dir.resize(dir.rfind('/') + 1);
+    places = {dir + "loci-full", dir + LOCI_FULL_FROM_BIN + "/loci-full"};
+  } else {
+    places = {LOCI_FULL_INSTALLED};
+  }
+  // The failure told is the first that is not a missing file, else the last place's.
+  std::string failed;
   int error = 0;
   for (const std::string& full : places) {
     ::execv(full.c_str(), argv);
-    if (!error || errno != ENOENT) error = errno;
+    if (failed.empty() || error == ENOENT) failed = full, error = errno;
   }
   std::fprintf(stderr, "loci: error: cannot run %s (%s): loci is not installed whole\n",
-               places[1].c_str(), std::strerror(error));
+               failed.c_str(), std::strerror(error));
   std::exit(1);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (answered_here(argc, argv)) return run_command(query_command(), 2, argc, argv);
+  if (answered_here(argc, argv)) {
+    Command here = query_command();
+    here.run = run_query_here;
+    return run_command(here, 2, argc, argv);
+  }
   hand_over(argv);
 }

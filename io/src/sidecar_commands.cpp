@@ -298,16 +298,16 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
   return LayerIndex::build(std::move(items), o.structure.value_or(Structure::packed_hilbert));
 }
 
-bool answers_without_gdal(const QueryOptions& options) {
+std::shared_ptr<const LayerIndex> answers_without_gdal(const QueryOptions& options) {
   if (options.format != Format::ids || !options.out_path.empty() ||
       !file_exists(sidecar_path_of(options.load)))
-    return false;
+    return nullptr;
   try {
-    const LayerIndex index = load_index(options.load);
-    return options.candidates || index.per() == Per::segment;
+    auto index = std::make_shared<const LayerIndex>(load_index(options.load));
+    if (options.candidates || index->per() == Per::segment) return index;
   } catch (...) {  // the command run in full says what is wrong
-    return false;
   }
+  return nullptr;
 }
 
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
@@ -318,7 +318,13 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   // the geometries it read.
   const auto geometries =
       std::make_shared<LayerGeometries>(options.load.layer_path, options.load.layer_name);
-  const LayerIndex index = load_index(options.load, &report.index_origin, geometries.get());
+  std::shared_ptr<const LayerIndex> loaded = options.index;
+  if (loaded)
+    report.index_origin = "sidecar " + sidecar_path_of(options.load);
+  else
+    loaded = std::make_shared<const LayerIndex>(
+        load_index(options.load, &report.index_origin, geometries.get()));
+  const LayerIndex& index = *loaded;
   bool with_distance = false, with_point = false;
   for (const auto& [number, q] : options.queries) {
     with_distance |= q.kind == Query::Kind::within || q.kind == Query::Kind::nearest || q.first;

@@ -6,6 +6,7 @@
 // truncation, corruption and a layer that changed after indexing.
 #include <gdal_utils.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
@@ -2215,6 +2216,36 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
     ASSERT_EQ(from_file.status, 0) << from_file.err;
     EXPECT_EQ(piped.status, 0) << piped.out;
     EXPECT_EQ(piped.out, from_file.out) << layer;
+  }
+  // A loci-full that cannot run is named as the file that failed.
+  {
+    std::ofstream(alone / "loci-full") << "#!/bin/sh\n";
+    fs::permissions(alone / "loci-full", fs::perms::owner_read | fs::perms::owner_write);
+    const CliRun r = run_with(front, "info " + seg);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.out.find("cannot run " + (alone / "loci-full").string() + " ("), std::string::npos)
+        << r.out;
+    fs::remove(alone / "loci-full");
+  }
+  // The sidecar chosen is the one answering: replaced by one per feature (which the front
+  // would hand over) while the front waits for its query file on a FIFO, the query still
+  // answers, exactly.
+  {
+    const std::string fifo = path("front.fifo"), status = path("front-status.txt");
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const std::string script = std::string(LOCI_EXE) + " query " + shell_quote(seg) +
+                               " --bbox-file " + fifo + " > " + path("front-race.txt") +
+                               " 2>&1 & sleep 0.5; " + LOCI_EXE + " index -q --per feature " +
+                               shell_quote(seg) + "; printf '9,55,11,57\\n8,56,8.5,56.5\\n' > " +
+                               fifo + "; wait $!; echo $? > " + status;
+    ASSERT_EQ(std::system(("sh -c " + shell_quote(script)).c_str()), 0);
+    EXPECT_EQ(read_text(status), "0\n") << read_text(path("front-race.txt"));
+    std::ofstream(path("front-windows.txt")) << "9,55,11,57\n8,56,8.5,56.5\n";
+    const CliRun expected = run_loci("query " + seg + " --bbox-file " + path("front-windows.txt"));
+    ASSERT_EQ(expected.status, 0) << expected.err;
+    EXPECT_EQ(read_text(path("front-race.txt")), expected.out);
+    for (const char* f : {"front.fifo", "front-status.txt", "front-race.txt", "front-windows.txt"})
+      fs::remove(path(f));
   }
   // A stale sidecar is the whole program's to report.
   { std::ofstream(seg, std::ios::app) << "\n"; }

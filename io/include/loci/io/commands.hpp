@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -110,6 +111,9 @@ struct QueryOptions {
   std::string out_path;  // empty: `fallback`
   Progress progress;     // over the queries of a batch
   unsigned jobs = 0;     // threads for a batch; 0: one per core
+  // Set: the index to answer from, already loaded from `load` (answers_without_gdal's), not
+  // loaded again.
+  std::shared_ptr<const LayerIndex> index;
 };
 
 struct QueryReport {
@@ -119,11 +123,13 @@ struct QueryReport {
 
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 
-// Whether query_layer answers `options` from its sidecar alone, without reading the layer
-// through GDAL: a fresh sidecar per segment (or --candidates), ids written to stdout. Reads no
-// query file and writes nothing; false when unsure, and on any failure (the command run in
-// full says what is wrong). For the `loci` front, which runs such queries without loading GDAL.
-bool answers_without_gdal(const QueryOptions& options);
+// The index query_layer answers `options` from without reading the layer through GDAL: a
+// fresh sidecar per segment (or for --candidates), when ids go to stdout; null otherwise, and
+// on any failure (the command run in full says what is wrong). Reads no query file and writes
+// nothing. For the `loci` front, which runs such queries without loading GDAL: it gives the
+// index to query_layer (QueryOptions::index), which then does not load it again (a sidecar
+// replaced meanwhile, by one per feature say, would need GDAL after the queries were read).
+std::shared_ptr<const LayerIndex> answers_without_gdal(const QueryOptions& options);
 
 struct ClipOptions {
   LoadOptions load;
