@@ -25,6 +25,21 @@
 namespace fs = std::filesystem;
 
 namespace loci::io {
+
+#ifdef LOCI_HASH_AVX2
+namespace detail {
+// hash_avx2.cpp: XXH3 with AVX2, about twice the bytes per instruction of SSE2 (the chunks a
+// query reads are checked on first touch; `loci check` and `loci index` hash whole files).
+std::uint64_t hash_bytes_avx2(const void* data, std::size_t size, std::uint64_t seed);
+void hash_update_avx2(XXH3_state_t* state, const void* data, std::size_t size);
+}  // namespace detail
+namespace {
+bool has_avx2() {
+  static const bool avx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
+  return avx2;
+}
+}  // namespace
+#endif
 namespace {
 
 constexpr char kMagic[8] = {'\x89', 'L', 'O', 'C', 'I', '\r', '\n', '\x1a'};
@@ -196,6 +211,9 @@ void write_all(int fd, const void* data, std::size_t size, const std::string& pa
 }  // namespace
 
 std::uint64_t hash_bytes(const void* data, std::size_t size, std::uint64_t seed) {
+#ifdef LOCI_HASH_AVX2
+  if (has_avx2()) return detail::hash_bytes_avx2(data, size, seed);
+#endif
   return XXH3_64bits_withSeed(data, size, seed);
 }
 
@@ -293,6 +311,9 @@ StreamHash::StreamHash(std::uint64_t seed) : state_(std::make_unique<State>()) {
 }
 StreamHash::~StreamHash() = default;
 void StreamHash::update(const void* data, std::size_t size) {
+#ifdef LOCI_HASH_AVX2
+  if (has_avx2()) return detail::hash_update_avx2(&state_->xxh, data, size);
+#endif
   XXH3_64bits_update(&state_->xxh, data, size);
 }
 std::uint64_t StreamHash::digest() const {

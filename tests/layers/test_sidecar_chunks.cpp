@@ -15,6 +15,10 @@
 #include "loci/io/sidecar.hpp"
 #include "support/scratch.hpp"
 
+// The reference: XXH3 as the header computes it in this file (its default instructions).
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
 namespace loci::io {
 namespace {
 
@@ -149,6 +153,34 @@ TEST(SidecarChunks, CorruptFrontIsRefusedAtOpen) {
   }
   put(f, f.bytes);
   EXPECT_NO_THROW(Sidecar::open(f.path).verify());
+}
+
+// The checksums are XXH3-64 whatever instructions compute them (AVX2 where the processor has
+// them): whole buffers and streams fed in uneven pieces, of every length around XXH3's
+// internal sizes (16, 128, 240 bytes, 1 KB stripes, 64 KB), against the header's own values.
+TEST(SidecarHash, IsXxh3WhateverTheInstructions) {
+  EXPECT_EQ(hash_bytes("", 0), 0x2D06800538D394C2ull);  // XXH3-64 of nothing, seed 0
+  std::mt19937_64 rng(21);
+  std::vector<unsigned char> data(300000);
+  for (auto& b : data)
+    b = static_cast<unsigned char>(rng());
+  std::vector<std::size_t> sizes;
+  for (std::size_t n = 0; n <= 1100; ++n)
+    sizes.push_back(n);
+  for (std::size_t n : {4095, 4096, 4097, 65535, 65536, 65537, 200003, 300000})
+    sizes.push_back(n);
+  for (const std::size_t n : sizes) {
+    const std::uint64_t seed = n % 3 == 0 ? 0 : rng();
+    const std::uint64_t want = XXH3_64bits_withSeed(data.data(), n, seed);
+    ASSERT_EQ(hash_bytes(data.data(), n, seed), want) << n;
+    StreamHash stream(seed);
+    for (std::size_t at = 0; at < n;) {
+      const std::size_t piece = std::min<std::size_t>(n - at, 1 + rng() % 5000);
+      stream.update(data.data() + at, piece);
+      at += piece;
+    }
+    ASSERT_EQ(stream.digest(), want) << n;
+  }
 }
 
 }  // namespace
