@@ -1,8 +1,9 @@
 // loci: the command users run. A query its sidecar answers (per segment, or --candidates; FIDs
-// on stdout) runs here, without GDAL: loading GDAL's libraries takes about 30 ms, several times
-// such a query. Every other command, and a query that needs the layer (a stale or missing
-// sidecar, one per feature, csv or GeoJSON output, -o), is handed to loci-full with the same
-// arguments (exec): it has every command and GDAL, and says what is wrong with a command.
+// on stdout or into a new file) runs here, without GDAL: loading GDAL's libraries takes about
+// 30 ms, several times such a query. Every other command, and a query that needs the layer or
+// GDAL (a stale or missing sidecar, one per feature, csv or GeoJSON output, -o onto a file
+// that is there), is handed to loci-full with the same arguments (exec): it has every command
+// and GDAL, and says what is wrong with a command.
 #include <unistd.h>
 
 #include <cerrno>

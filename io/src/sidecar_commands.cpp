@@ -299,8 +299,13 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
 }
 
 std::shared_ptr<const LayerIndex> answers_without_gdal(const QueryOptions& options) {
-  if (options.format != Format::ids || !options.out_path.empty() ||
-      !file_exists(sidecar_path_of(options.load)))
+  // An output file is written here only where nothing is yet (not even a dangling link): one
+  // that is there may be a dataset of several layers, which GDAL tells (refuse_replacing_layers).
+  std::error_code ec;
+  const bool output_taken =
+      !options.out_path.empty() && std::filesystem::symlink_status(options.out_path, ec).type() !=
+                                       std::filesystem::file_type::not_found;
+  if (options.format != Format::ids || output_taken || !file_exists(sidecar_path_of(options.load)))
     return nullptr;
   try {
     auto index = std::make_shared<const LayerIndex>(load_index(options.load));

@@ -2192,13 +2192,14 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
   const std::string handed[] = {
       "query " + feat + " --bbox 20,20,60,60",
       "query " + seg + " --nearest 10.5,56 -f csv",
-      "query " + seg + " --nearest 10.5,56 -o " + path("front-out.txt"),
+      "query " + seg + " --nearest 10.5,56 -o " + path("front-taken.txt"),
       "query " + seg + " --nearest 10.5,56 --per feature",
       "query " + seg + " --bbox 1,2",
       "query " + seg + " --help",
       "info " + seg,
       "--help",
   };
+  std::ofstream(path("front-taken.txt")) << "kept\n";  // there already: may be a dataset
   for (const std::string& args : handed) {
     const CliRun r = run_with(front, args);
     EXPECT_EQ(r.status, 1) << args;
@@ -2206,7 +2207,18 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
     EXPECT_NE(r.out.find("loci: error: cannot run "), std::string::npos) << args << ": " << r.out;
     EXPECT_NE(r.out.find("loci is not installed whole"), std::string::npos) << args;
   }
-  EXPECT_FALSE(fs::exists(path("front-out.txt")));
+  EXPECT_EQ(read_text(path("front-taken.txt")), "kept\n");
+  // An output file not there yet is written by the front, as the whole program writes it.
+  {
+    const std::string args = "query " + seg + " --nearest-file " + points + " -k 3 -o ";
+    const CliRun part = run_with(front, args + path("front-new.txt"));
+    EXPECT_EQ(part.status, 0) << part.out;
+    ASSERT_EQ(run_loci(args + path("front-whole.txt")).status, 0);
+    EXPECT_FALSE(read_text(path("front-whole.txt")).empty());
+    EXPECT_EQ(read_text(path("front-new.txt")), read_text(path("front-whole.txt")));
+    for (const char* f : {"front-taken.txt", "front-new.txt", "front-whole.txt"})
+      fs::remove(path(f));
+  }
   // A query file on a pipe is read once, by whichever program answers.
   for (const std::string& layer : {seg, feat}) {
     const std::string args = "query " + layer + " --nearest-file /dev/stdin -k 2";

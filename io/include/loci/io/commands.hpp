@@ -124,11 +124,12 @@ struct QueryReport {
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 
 // The index query_layer answers `options` from without reading the layer through GDAL: a
-// fresh sidecar per segment (or for --candidates), when ids go to stdout; null otherwise, and
-// on any failure (the command run in full says what is wrong). Reads no query file and writes
-// nothing. For the `loci` front, which runs such queries without loading GDAL: it gives the
-// index to query_layer (QueryOptions::index), which then does not load it again (a sidecar
-// replaced meanwhile, by one per feature say, would need GDAL after the queries were read).
+// fresh sidecar per segment (or for --candidates), when ids go to stdout or to a file not
+// there yet (one that is may be a dataset of several layers, which GDAL tells); null
+// otherwise, and on any failure (the command run in full says what is wrong). Reads no query
+// file and writes nothing. For the `loci` front, which runs such queries without loading GDAL: it
+// gives the index to query_layer (QueryOptions::index), which then does not load it again (a
+// sidecar replaced meanwhile, by one per feature say, would need GDAL after the queries were read).
 std::shared_ptr<const LayerIndex> answers_without_gdal(const QueryOptions& options);
 
 struct ClipOptions {
