@@ -10,7 +10,7 @@
 #include <climits>
 #include <cstdio>
 #include <cstring>
-#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,9 +22,9 @@ using namespace loci::cli;
 
 // The sidecar this process answers from (answers_without_gdal's), loaded once: the query
 // file is read after it was chosen, and nothing can be handed over from then on.
-std::shared_ptr<const loci::io::LayerIndex> g_index;
+std::optional<loci::io::LoadedIndex> g_loaded;
 
-// Whether this process answers: a `loci query` its sidecar answers without GDAL (g_index set).
+// Whether this process answers: a `loci query` its sidecar answers without GDAL (g_loaded set).
 // Parses the arguments and opens the sidecar, but reads no query file and writes nothing, so
 // that a command handed over starts afresh (a query file on a pipe is read once).
 bool answered_here(int argc, char** argv) {
@@ -33,8 +33,8 @@ bool answered_here(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) return false;
   try {
     const Args a = parse(query_command(), 2, argc, argv);
-    g_index = loci::io::answers_without_gdal(query_options(a, false));
-    return g_index != nullptr;
+    g_loaded = loci::io::answers_without_gdal(query_options(a, false));
+    return g_loaded.has_value();
   } catch (...) {  // loci-full says what is wrong
     return false;
   }
@@ -42,15 +42,15 @@ bool answered_here(int argc, char** argv) {
 
 int run_query_here(const Args& a) {
   loci::io::QueryOptions o = query_options(a, true);
-  o.index = g_index;
+  o.loaded = g_loaded;
   loci::io::query_layer(o, stdout);
   return 0;
 }
 
 // Runs loci-full in place of this process: beside this program (the build tree), or where it
 // is installed (LOCI_FULL_FROM_BIN, relative to the directory of programs). Without
-// /proc/self/exe to say where this program is, only the installed path (LOCI_FULL_INSTALLED)
-// is tried, never a file the current directory happens to hold.
+// /proc/self/exe to say where this program is, only the path of the install prefix configured
+// (LOCI_FULL_INSTALLED) is tried, never a file the current directory happens to hold.
 [[noreturn]] void hand_over(char** argv) {
   std::vector<std::string> places;
   char buf[PATH_MAX];

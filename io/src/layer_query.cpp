@@ -93,6 +93,7 @@ LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
   x.has_polygons_ = info.has_polygons;
   x.bounds_ = info.bounds;
   x.layer_name_ = info.layer_name;
+  x.source_ = info.source;
   x.records_ = sidecar.mapped_records();
   x.keep_alive_ = sidecar.keep_alive();
   x.check_ = &sidecar.check();

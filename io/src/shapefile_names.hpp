@@ -1,5 +1,6 @@
-// The names of a shapefile's files, shared by the writers that replace them (atomic_file.cpp)
-// and those that guard them (refuse_overwriting).
+// The names of a shapefile's files, shared by the writer that replaces them
+// (AtomicDataset::commit, atomic_dataset.cpp) and the guard against overwriting an input
+// (refuse_overwriting, atomic_file.cpp).
 #pragma once
 
 #include <string>

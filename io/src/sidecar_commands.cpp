@@ -235,6 +235,40 @@ std::string sidecar_path_of(const LoadOptions& o) {
   return o.index_path.empty() ? default_sidecar_path(o.layer_path) : o.index_path;
 }
 
+namespace {
+
+// Throws the error of an index (at `path`, of layer `indexed`) whose layer changed since
+// (`was`, now `now`): "stale", or, when GDAL names the layer otherwise, the index of another
+// layer. Without GDAL loaded, `gdal_or_hand_over` says whether to hand the command over
+// (NeedsGdal) for that name, or to say "stale" without it (the input is read: no hand-over).
+[[noreturn]] void refuse_stale(const LoadOptions& o, const std::string& path,
+                               const std::string& indexed, const Fingerprint& was,
+                               const Fingerprint& now, bool gdal_or_hand_over) {
+  // A sidecar of another layer altogether says so, rather than "stale".
+  std::string actual;
+  try {
+    actual = detail::layer_name_in(o.layer_path, o.layer_name);
+  } catch (const detail::NeedsGdal&) {
+    if (gdal_or_hand_over) throw;
+  } catch (const Error&) {
+  }
+  if (!actual.empty() && actual != indexed)
+    throw Error(path + ": indexes layer '" + indexed + "', not '" + actual + "' of " +
+                o.layer_path + "; run 'loci index " + o.layer_path +
+                "' or give its own index with --index");
+  // An index given with --index may be another file's as well as a stale one: the command
+  // offered rewrites that index, not the layer's default sidecar.
+  if (!o.index_path.empty())
+    throw Error(path + ": does not match " + o.layer_path + " (" + stale_reason(was, now) +
+                "): the index of another file, or of this one before it changed; run 'loci "
+                "index " +
+                o.layer_path + " -o " + path + "'");
+  throw Error(path + ": stale index, " + o.layer_path + " changed since it was indexed (" +
+              stale_reason(was, now) + "); run 'loci index " + o.layer_path + "'");
+}
+
+}  // namespace
+
 LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries* geometries) {
   const bool dynamic =
       o.structure && (*o.structure == Structure::rstar || *o.structure == Structure::rtree);
@@ -243,30 +277,8 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
   if (!dynamic && file_exists(path)) {
     Sidecar sc = Sidecar::open(path);
     Fingerprint now;
-    if (!still_fresh(o.layer_path, sc.info().source, &now)) {
-      // A sidecar of another layer altogether says so, rather than "stale".
-      std::string actual;
-      try {
-        actual = detail::layer_name_in(o.layer_path, o.layer_name);
-      } catch (const detail::NeedsGdal&) {
-        throw;
-      } catch (const Error&) {
-      }
-      if (!actual.empty() && actual != sc.info().layer_name)
-        throw Error(path + ": indexes layer '" + sc.info().layer_name + "', not '" + actual +
-                    "' of " + o.layer_path + "; run 'loci index " + o.layer_path +
-                    "' or give its own index with --index");
-      // An index given with --index may be another file's as well as a stale one: the command
-      // offered rewrites that index, not the layer's default sidecar.
-      if (!o.index_path.empty())
-        throw Error(path + ": does not match " + o.layer_path + " (" +
-                    stale_reason(sc.info().source, now) +
-                    "): the index of another file, or of this one before it changed; run 'loci "
-                    "index " +
-                    o.layer_path + " -o " + path + "'");
-      throw Error(path + ": stale index, " + o.layer_path + " changed since it was indexed (" +
-                  stale_reason(sc.info().source, now) + "); run 'loci index " + o.layer_path + "'");
-    }
+    if (!still_fresh(o.layer_path, sc.info().source, &now))
+      refuse_stale(o, path, sc.info().layer_name, sc.info().source, now, true);
     // --layer as GDAL finds it: a name it does not know is said so, and one differing only in
     // case names the layer indexed.
     if (!o.layer_name.empty() && o.layer_name != sc.info().layer_name) {
@@ -298,21 +310,28 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
   return LayerIndex::build(std::move(items), o.structure.value_or(Structure::packed_hilbert));
 }
 
-std::shared_ptr<const LayerIndex> answers_without_gdal(const QueryOptions& options) {
+std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options) {
   // An output file is written here only where nothing is yet (not even a dangling link): one
   // that is there may be a dataset of several layers, which GDAL tells (refuse_replacing_layers).
   std::error_code ec;
   const bool output_taken =
       !options.out_path.empty() && std::filesystem::symlink_status(options.out_path, ec).type() !=
                                        std::filesystem::file_type::not_found;
-  if (options.format != Format::ids || output_taken || !file_exists(sidecar_path_of(options.load)))
-    return nullptr;
+  const std::string path = sidecar_path_of(options.load);
+  if (options.format != Format::ids || output_taken || !file_exists(path)) return std::nullopt;
   try {
-    auto index = std::make_shared<const LayerIndex>(load_index(options.load));
-    if (options.candidates || index->per() == Per::segment) return index;
+    // Per feature, exact answers read the layer: said from the header, before the layer is
+    // hashed to tell it fresh (loci-full would hash it again).
+    const Per per = Sidecar::open(path).info().per;
+    if (!options.candidates && per != Per::segment) return std::nullopt;
+    if (options.load.per && *options.load.per != per) return std::nullopt;
+    LoadedIndex loaded;
+    loaded.layer = fingerprint_stat(options.load.layer_path);
+    loaded.index = std::make_shared<const LayerIndex>(load_index(options.load));
+    if (options.candidates || loaded.index->per() == Per::segment) return loaded;
   } catch (...) {  // the command run in full says what is wrong
   }
-  return nullptr;
+  return std::nullopt;
 }
 
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
@@ -323,12 +342,23 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   // the geometries it read.
   const auto geometries =
       std::make_shared<LayerGeometries>(options.load.layer_path, options.load.layer_name);
-  std::shared_ptr<const LayerIndex> loaded = options.index;
-  if (loaded)
+  std::shared_ptr<const LayerIndex> loaded;
+  if (options.loaded) {
+    loaded = options.loaded->index;
     report.index_origin = "sidecar " + sidecar_path_of(options.load);
-  else
+    // The layer changed while the queries were read (from a pipe, say): stale, as load_index
+    // would have found it then. Hashed again only when its size, time or inode changed.
+    const Fingerprint* was = loaded->source();
+    if (was && !(fingerprint_stat(options.load.layer_path) == options.loaded->layer)) {
+      Fingerprint now;
+      if (!still_fresh(options.load.layer_path, *was, &now))
+        refuse_stale(options.load, sidecar_path_of(options.load), loaded->layer_name(), *was, now,
+                     false);
+    }
+  } else {
     loaded = std::make_shared<const LayerIndex>(
         load_index(options.load, &report.index_origin, geometries.get()));
+  }
   const LayerIndex& index = *loaded;
   bool with_distance = false, with_point = false;
   for (const auto& [number, q] : options.queries) {

@@ -11,7 +11,10 @@ LayerItems read_items(const std::string&, const std::string&, Per, const Progres
   throw detail::NeedsGdal();
 }
 
-void refuse_replacing_layers(const std::string&) {
+// Met only by a text output onto an SQLite database or a TIFF (AtomicFile), which appeared
+// after the front chose to answer: refused as loci-full refuses any text output there.
+void refuse_replacing_layers(const std::string& out) {
+  refuse_replacing_binary_dataset(out);
   throw detail::NeedsGdal();
 }
 

@@ -4,6 +4,7 @@
 // features through OGR's geometry (GEOS), for both granularities, with and without a sidecar;
 // then every error the command line promises to report, and the sidecar's defences against
 // truncation, corruption and a layer that changed after indexing.
+#include <fcntl.h>
 #include <gdal_utils.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <tuple>
@@ -2181,8 +2183,8 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
       "query " + feat + " --bbox 20,20,60,60 --candidates",
   };
   for (const std::string& args : answered) {
-    const CliRun whole = run_loci(args), part = run_with(front, args);
-    ASSERT_EQ(whole.status, 0) << args << ": " << whole.err;
+    const CliRun whole = run_with(LOCI_FULL_EXE, args), part = run_with(front, args);
+    ASSERT_EQ(whole.status, 0) << args << ": " << whole.out;
     EXPECT_FALSE(whole.out.empty()) << args;
     EXPECT_EQ(part.status, 0) << args << ": " << part.out;
     EXPECT_EQ(part.out, whole.out) << args;
@@ -2213,7 +2215,7 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
     const std::string args = "query " + seg + " --nearest-file " + points + " -k 3 -o ";
     const CliRun part = run_with(front, args + path("front-new.txt"));
     EXPECT_EQ(part.status, 0) << part.out;
-    ASSERT_EQ(run_loci(args + path("front-whole.txt")).status, 0);
+    ASSERT_EQ(run_with(LOCI_FULL_EXE, args + path("front-whole.txt")).status, 0);
     EXPECT_FALSE(read_text(path("front-whole.txt")).empty());
     EXPECT_EQ(read_text(path("front-new.txt")), read_text(path("front-whole.txt")));
     for (const char* f : {"front-taken.txt", "front-new.txt", "front-whole.txt"})
@@ -2239,28 +2241,61 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
         << r.out;
     fs::remove(alone / "loci-full");
   }
+  // Runs `loci ARGS` whose query file is the FIFO `fifo`: once loci has opened it (having
+  // chosen its sidecar), `meanwhile` runs, then `queries` are written.
+  const std::string fifo = path("front.fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto queries_late = [&](const std::string& args, const std::string& queries,
+                          const std::function<void()>& meanwhile) {
+    CliRun r;
+    std::FILE* p = ::popen((std::string(LOCI_EXE) + " " + args + " 2>&1").c_str(), "r");
+    int fd = -1;
+    for (int tries = 0; fd < 0 && tries < 3000; ++tries)  // 30 s at most
+      if ((fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK)) < 0) ::usleep(10000);
+    EXPECT_GE(fd, 0) << "loci did not open its query file";
+    if (fd >= 0) {
+      meanwhile();
+      EXPECT_EQ(::write(fd, queries.data(), queries.size()), ssize_t(queries.size()));
+      ::close(fd);
+    } else {
+      ::close(::open(fifo.c_str(), O_RDWR));  // lets a reader still opening it go
+    }
+    char buf[65536];
+    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;)
+      r.out.append(buf, n);
+    const int st = ::pclose(p);
+    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
+    return r;
+  };
+  const std::string windows = "9,55,11,57\n8,56,8.5,56.5\n";
+  std::ofstream(path("front-windows.txt")) << windows;
   // The sidecar chosen is the one answering: replaced by one per feature (which the front
-  // would hand over) while the front waits for its query file on a FIFO, the query still
-  // answers, exactly.
+  // would hand over) while the front waits for its queries, they are still answered, exactly.
   {
-    const std::string fifo = path("front.fifo"), status = path("front-status.txt");
-    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-    const std::string script = std::string(LOCI_EXE) + " query " + shell_quote(seg) +
-                               " --bbox-file " + fifo + " > " + path("front-race.txt") +
-                               " 2>&1 & sleep 0.5; " + LOCI_EXE + " index -q --per feature " +
-                               shell_quote(seg) + "; printf '9,55,11,57\\n8,56,8.5,56.5\\n' > " +
-                               fifo + "; wait $!; echo $? > " + status;
-    ASSERT_EQ(std::system(("sh -c " + shell_quote(script)).c_str()), 0);
-    EXPECT_EQ(read_text(status), "0\n") << read_text(path("front-race.txt"));
-    std::ofstream(path("front-windows.txt")) << "9,55,11,57\n8,56,8.5,56.5\n";
-    const CliRun expected = run_loci("query " + seg + " --bbox-file " + path("front-windows.txt"));
-    ASSERT_EQ(expected.status, 0) << expected.err;
-    EXPECT_EQ(read_text(path("front-race.txt")), expected.out);
-    for (const char* f : {"front.fifo", "front-status.txt", "front-race.txt", "front-windows.txt"})
-      fs::remove(path(f));
+    const CliRun r = queries_late("query " + seg + " --bbox-file " + fifo, windows, [&] {
+      ASSERT_EQ(run_loci("index -q --per feature " + seg).status, 0);
+    });
+    const CliRun expected =
+        run_with(LOCI_FULL_EXE, "query " + seg + " --bbox-file " + path("front-windows.txt"));
+    ASSERT_EQ(expected.status, 0) << expected.out;
+    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_EQ(r.out, expected.out);
   }
+  // A layer changed while the front waits for its queries is stale, as loci-full finds it
+  // when it reads them first.
+  {
+    ASSERT_EQ(run_loci("index -q --per segment " + seg).status, 0);
+    const CliRun r = queries_late("query " + seg + " --bbox-file " + fifo, windows,
+                                  [&] { std::ofstream(seg, std::ios::app) << "\n"; });
+    const CliRun expected =
+        run_with(LOCI_FULL_EXE, "query " + seg + " --bbox-file " + path("front-windows.txt"));
+    EXPECT_EQ(r.status, 1) << r.out;
+    EXPECT_NE(r.out.find("stale index"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out, expected.out);
+  }
+  for (const char* f : {"front.fifo", "front-windows.txt"})
+    fs::remove(path(f));
   // A stale sidecar is the whole program's to report.
-  { std::ofstream(seg, std::ios::app) << "\n"; }
   const CliRun stale = run_with(front, "query " + seg + " --nearest 10.5,56");
   EXPECT_NE(stale.out.find("loci is not installed whole"), std::string::npos) << stale.out;
   const CliRun said = run_loci("query " + seg + " --nearest 10.5,56");

@@ -102,6 +102,13 @@ std::string sidecar_path_of(const LoadOptions& options);
 LayerIndex load_index(const LoadOptions& options, std::string* origin = nullptr,
                       LayerGeometries* geometries = nullptr);
 
+// An index loaded before its queries are read, and the layer's size, time and inode then
+// (fingerprint_stat): a layer changed meanwhile is found stale as load_index finds it.
+struct LoadedIndex {
+  std::shared_ptr<const LayerIndex> index;
+  Fingerprint layer;
+};
+
 struct QueryOptions {
   LoadOptions load;
   std::vector<std::pair<std::size_t, Query>> queries;  // number, query
@@ -111,9 +118,9 @@ struct QueryOptions {
   std::string out_path;  // empty: `fallback`
   Progress progress;     // over the queries of a batch
   unsigned jobs = 0;     // threads for a batch; 0: one per core
-  // Set: the index to answer from, already loaded from `load` (answers_without_gdal's), not
-  // loaded again.
-  std::shared_ptr<const LayerIndex> index;
+  // Set: the index to answer from, loaded from `load` before the queries were read
+  // (answers_without_gdal's), not loaded again.
+  std::optional<LoadedIndex> loaded;
 };
 
 struct QueryReport {
@@ -125,12 +132,13 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 
 // The index query_layer answers `options` from without reading the layer through GDAL: a
 // fresh sidecar per segment (or for --candidates), when ids go to stdout or to a file not
-// there yet (one that is may be a dataset of several layers, which GDAL tells); null
+// there yet (one that is may be a dataset of several layers, which GDAL tells); nullopt
 // otherwise, and on any failure (the command run in full says what is wrong). Reads no query
-// file and writes nothing. For the `loci` front, which runs such queries without loading GDAL: it
-// gives the index to query_layer (QueryOptions::index), which then does not load it again (a
-// sidecar replaced meanwhile, by one per feature say, would need GDAL after the queries were read).
-std::shared_ptr<const LayerIndex> answers_without_gdal(const QueryOptions& options);
+// file and writes nothing. For the `loci` front, which runs such queries without loading
+// GDAL: it gives the index to query_layer (QueryOptions::loaded), which does not load it
+// again (a sidecar replaced meanwhile, by one per feature say, would need GDAL once the
+// queries were read) but checks again that the layer has not changed.
+std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options);
 
 struct ClipOptions {
   LoadOptions load;

@@ -43,6 +43,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <unordered_map>
@@ -82,6 +83,9 @@ class LayerIndex {
   std::size_t size() const { return records_.size(); }
   Box2 bounds() const { return bounds_; }
   const std::string& layer_name() const { return layer_name_; }
+  // The layer's fingerprint when the sidecar was written (SidecarInfo::source); null for an
+  // index built in memory.
+  const Fingerprint* source() const { return source_ ? &*source_ : nullptr; }
   // Every record (from a sidecar: verified first, once).
   std::span<const ItemRecord> records() const {
     if (check_) check_->touch(records_.data(), records_.size_bytes());
@@ -262,6 +266,7 @@ class LayerIndex {
   bool has_polygons_ = false;
   Box2 bounds_ = Box2::empty();
   std::string layer_name_;
+  std::optional<Fingerprint> source_;
   std::vector<ItemRecord> own_records_;
   std::span<const ItemRecord> records_;
   std::shared_ptr<const void> keep_alive_;
