@@ -346,14 +346,23 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
   if (options.loaded) {
     loaded = options.loaded->index;
     report.index_origin = "sidecar " + sidecar_path_of(options.load);
-    // The layer changed while the queries were read (from a pipe, say): stale, as load_index
-    // would have found it then. Hashed again only when its size, time or inode changed.
+    // The layer changed while the queries were read (from a pipe, say): its index is loaded
+    // again, as load_index loads it after reading them (indexed again meanwhile, it answers);
+    // one that needs GDAL to tell or to answer is stale. Hashed again only when the layer's
+    // size, time or inode changed.
     const Fingerprint* was = loaded->source();
     if (was && !(fingerprint_stat(options.load.layer_path) == options.loaded->layer)) {
       Fingerprint now;
-      if (!still_fresh(options.load.layer_path, *was, &now))
-        refuse_stale(options.load, sidecar_path_of(options.load), loaded->layer_name(), *was, now,
-                     false);
+      if (!still_fresh(options.load.layer_path, *was, &now)) {
+        try {
+          auto again = std::make_shared<const LayerIndex>(load_index(options.load));
+          if (!options.candidates && again->per() != Per::segment) throw detail::NeedsGdal();
+          loaded = std::move(again);
+        } catch (const detail::NeedsGdal&) {
+          refuse_stale(options.load, sidecar_path_of(options.load), loaded->layer_name(), *was, now,
+                       false);
+        }
+      }
     }
   } else {
     loaded = std::make_shared<const LayerIndex>(

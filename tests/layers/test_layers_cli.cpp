@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -2241,24 +2242,29 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
         << r.out;
     fs::remove(alone / "loci-full");
   }
-  // Runs `loci ARGS` whose query file is the FIFO `fifo`: once loci has opened it (having
-  // chosen its sidecar), `meanwhile` runs, then `queries` are written.
+  // Runs the front alone (`front`: it cannot hand over) on ARGS whose query file is the FIFO
+  // `fifo`: once it has opened it (having chosen its sidecar), `meanwhile` runs, then
+  // `queries` are written.
   const std::string fifo = path("front.fifo");
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   auto queries_late = [&](const std::string& args, const std::string& queries,
                           const std::function<void()>& meanwhile) {
     CliRun r;
-    std::FILE* p = ::popen((std::string(LOCI_EXE) + " " + args + " 2>&1").c_str(), "r");
+    std::FILE* p = ::popen((front + " " + args + " 2>&1").c_str(), "r");
     int fd = -1;
     for (int tries = 0; fd < 0 && tries < 3000; ++tries)  // 30 s at most
       if ((fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK)) < 0) ::usleep(10000);
     EXPECT_GE(fd, 0) << "loci did not open its query file";
     if (fd >= 0) {
       meanwhile();
+      const auto pipe_handler = std::signal(SIGPIPE, SIG_IGN);  // a reader gone: a failure
       EXPECT_EQ(::write(fd, queries.data(), queries.size()), ssize_t(queries.size()));
+      std::signal(SIGPIPE, pipe_handler);
       ::close(fd);
     } else {
-      ::close(::open(fifo.c_str(), O_RDWR));  // lets a reader still opening it go
+      // A reader blocked in open() goes on (to end of file); a later one finds no FIFO.
+      ::unlink(fifo.c_str());
+      ::close(::open(fifo.c_str(), O_RDWR));
     }
     char buf[65536];
     for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;)
@@ -2269,26 +2275,37 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
   };
   const std::string windows = "9,55,11,57\n8,56,8.5,56.5\n";
   std::ofstream(path("front-windows.txt")) << windows;
+  const std::string batch = "query " + seg + " --bbox-file ";
   // The sidecar chosen is the one answering: replaced by one per feature (which the front
   // would hand over) while the front waits for its queries, they are still answered, exactly.
   {
-    const CliRun r = queries_late("query " + seg + " --bbox-file " + fifo, windows, [&] {
+    const CliRun r = queries_late(batch + fifo, windows, [&] {
       ASSERT_EQ(run_loci("index -q --per feature " + seg).status, 0);
     });
-    const CliRun expected =
-        run_with(LOCI_FULL_EXE, "query " + seg + " --bbox-file " + path("front-windows.txt"));
+    const CliRun expected = run_with(LOCI_FULL_EXE, batch + path("front-windows.txt"));
     ASSERT_EQ(expected.status, 0) << expected.out;
     EXPECT_EQ(r.status, 0) << r.out;
     EXPECT_EQ(r.out, expected.out);
   }
-  // A layer changed while the front waits for its queries is stale, as loci-full finds it
-  // when it reads them first.
+  // A layer changed and indexed again while the front waits: answered from the new sidecar,
+  // as loci-full, which reads its queries first, answers.
   {
     ASSERT_EQ(run_loci("index -q --per segment " + seg).status, 0);
-    const CliRun r = queries_late("query " + seg + " --bbox-file " + fifo, windows,
-                                  [&] { std::ofstream(seg, std::ios::app) << "\n"; });
-    const CliRun expected =
-        run_with(LOCI_FULL_EXE, "query " + seg + " --bbox-file " + path("front-windows.txt"));
+    const CliRun r = queries_late(batch + fifo, windows, [&] {
+      std::ofstream(seg, std::ios::app) << "\n";
+      ASSERT_EQ(run_loci("index -q --per segment " + seg).status, 0);
+    });
+    const CliRun expected = run_with(LOCI_FULL_EXE, batch + path("front-windows.txt"));
+    ASSERT_EQ(expected.status, 0) << expected.out;
+    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_EQ(r.out, expected.out);
+  }
+  // A layer changed while the front waits is stale, as loci-full finds it when it reads its
+  // queries first.
+  {
+    const CliRun r =
+        queries_late(batch + fifo, windows, [&] { std::ofstream(seg, std::ios::app) << "\n"; });
+    const CliRun expected = run_with(LOCI_FULL_EXE, batch + path("front-windows.txt"));
     EXPECT_EQ(r.status, 1) << r.out;
     EXPECT_NE(r.out.find("stale index"), std::string::npos) << r.out;
     EXPECT_EQ(r.out, expected.out);

@@ -103,7 +103,7 @@ LayerIndex load_index(const LoadOptions& options, std::string* origin = nullptr,
                       LayerGeometries* geometries = nullptr);
 
 // An index loaded before its queries are read, and the layer's size, time and inode then
-// (fingerprint_stat): a layer changed meanwhile is found stale as load_index finds it.
+// (fingerprint_stat), to tell a layer changed meanwhile (see answers_without_gdal).
 struct LoadedIndex {
   std::shared_ptr<const LayerIndex> index;
   Fingerprint layer;
@@ -137,7 +137,9 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 // file and writes nothing. For the `loci` front, which runs such queries without loading
 // GDAL: it gives the index to query_layer (QueryOptions::loaded), which does not load it
 // again (a sidecar replaced meanwhile, by one per feature say, would need GDAL once the
-// queries were read) but checks again that the layer has not changed.
+// queries were read) but checks again that the layer has not changed: changed, its index is
+// loaded again as loci-full loads it, and where that needs GDAL the query is refused as stale
+// (loci-full would name another layer when GDAL names the layer otherwise).
 std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options);
 
 struct ClipOptions {
