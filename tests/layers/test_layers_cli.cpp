@@ -2163,16 +2163,18 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
   fs::create_directories(alone);
   fs::copy_file(LOCI_EXE, alone / "loci", fs::copy_options::overwrite_existing);
   const std::string front = (alone / "loci").string();
-  auto run_with = [](const std::string& exe, const std::string& args) {
-    const std::string cmd = exe + " " + args + " 2>&1";
+  // The output (stderr joined) and exit status of a command started by popen.
+  auto finish = [](std::FILE* p) {
     CliRun r;
-    std::FILE* p = ::popen(cmd.c_str(), "r");
     char buf[65536];
     for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;)
       r.out.append(buf, n);
     const int st = ::pclose(p);
     r.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
     return r;
+  };
+  auto run_with = [&](const std::string& exe, const std::string& args) {
+    return finish(::popen((exe + " " + args + " 2>&1").c_str(), "r"));
   };
   const std::string answered[] = {
       "query " + seg + " --nearest 10.5,56 -k 7",
@@ -2249,7 +2251,6 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   auto queries_late = [&](const std::string& args, const std::string& queries,
                           const std::function<void()>& meanwhile) {
-    CliRun r;
     std::FILE* p = ::popen((front + " " + args + " 2>&1").c_str(), "r");
     int fd = -1;
     for (int tries = 0; fd < 0 && tries < 3000; ++tries)  // 30 s at most
@@ -2263,15 +2264,10 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
       ::close(fd);
     } else {
       // A reader blocked in open() goes on (to end of file); a later one finds no FIFO.
-      ::unlink(fifo.c_str());
       ::close(::open(fifo.c_str(), O_RDWR));
+      ::unlink(fifo.c_str());
     }
-    char buf[65536];
-    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;)
-      r.out.append(buf, n);
-    const int st = ::pclose(p);
-    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
-    return r;
+    return finish(p);
   };
   const std::string windows = "9,55,11,57\n8,56,8.5,56.5\n";
   std::ofstream(path("front-windows.txt")) << windows;
