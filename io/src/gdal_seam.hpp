@@ -6,7 +6,9 @@
 // and those of the public headers listed below. The full library (loci::io) defines them with
 // GDAL; the `loci` front (cli/front.cpp), which does not link GDAL, is linked with
 // without_gdal.cpp instead, where each throws NeedsGdal, and hands any command that meets one
-// to `loci-full` before it has read its input or written anything.
+// to `loci-full` before it has read its input or written anything. What changes while it
+// reads its queries (the layer, an output file appearing) is met as loci-full meets it where
+// that needs no GDAL, or refused (query_layer, refuse_replacing_layers in without_gdal.cpp).
 //
 // Also on the seam, declared where their callers find them: read_items (layer_reader.hpp) and
 // refuse_replacing_layers (atomic_file.hpp). A core file that calls any other GDAL function
