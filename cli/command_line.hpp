@@ -2,8 +2,8 @@
 // per command (the table that `--help` prints, so the help cannot drift from what is accepted),
 // their parsing, progress bars, and running a command with its one-line failure and exit 1.
 //
-// `loci` (front.cpp) runs the queries a sidecar answers without loading GDAL and hands every
-// other command to `loci-full` (loci.cpp), the whole table, which loads it.
+// `loci` (front.cpp) runs the queries a sidecar answers and `loci check` without loading GDAL,
+// and hands every other command to `loci-full` (loci.cpp), the whole table, which loads it.
 #pragma once
 
 #include <cstddef>
@@ -87,6 +87,9 @@ Args parse(const Command& c, int first, int argc, char** argv);
 // as is output that did not reach stdout. Returns the exit status.
 int run_command(const Command& c, int first, int argc, char** argv,
                 void (*before)(const Command&, const Args&) = nullptr);
+
+// `loci check` (check_command.cpp), which needs no GDAL.
+const Command& check_command();
 
 // `loci query`: the command, and its options (the query file read when `read_queries`).
 const Command& query_command();

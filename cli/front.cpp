@@ -1,9 +1,10 @@
 // loci: the command users run. A query its sidecar answers (per segment, or --candidates; FIDs
 // on stdout or into a new file) runs here, without GDAL: loading GDAL's libraries takes about
-// 30 ms, several times such a query. Every other command, and a query that needs the layer or
-// GDAL (a stale or missing sidecar, one per feature, csv or GeoJSON output, -o onto a file
-// that is there), is handed to loci-full with the same arguments (exec): it has every command
-// and GDAL, and says what is wrong with a command.
+// 30 ms, several times such a query; so does `loci check`, which reads only the sidecar and the
+// layer's files. Every other command, and a query that needs the layer or GDAL (a stale or
+// missing sidecar, one per feature, csv or GeoJSON output, -o onto a file that is there), is
+// handed to loci-full with the same arguments (exec): it has every command and GDAL, and says
+// what is wrong with a command.
 #include <unistd.h>
 
 #include <cerrno>
@@ -76,6 +77,8 @@ int run_query_here(const Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && !std::strcmp(argv[1], "check"))
+    return run_command(check_command(), 2, argc, argv);
   if (answered_here(argc, argv)) {
     Command here = query_command();
     here.run = run_query_here;

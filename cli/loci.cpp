@@ -88,12 +88,6 @@ int run_index(const Args& a) {
   return 0;
 }
 
-int run_check(const Args& a) {
-  const std::string out = check_sidecar(layer_arg(a, "check", "FILE.loci | LAYER"));
-  std::printf("%s\n", out.c_str());
-  return 0;
-}
-
 int run_clip(const Args& a) {
   ClipOptions o;
   o.load = load_options(a, layer_arg(a, "clip"));
@@ -384,14 +378,7 @@ const std::vector<Command>& commands() {
         kQuiet},
        "  loci index countries.shp\n  loci index coastline.geojson --per segment -o coast.loci\n",
        run_index},
-      {"check",
-       "loci check FILE.loci | LAYER",
-       "verifies a sidecar index completely: every checksum and the tree's invariants, and that "
-       "the layer it is named after (FILE) has not changed since",
-       {},
-       "  loci check countries.shp.loci\n  loci check countries.shp      (its sidecar "
-       "countries.shp.loci)\n",
-       run_check},
+      check_command(),
       query_command(),
       {"clip",
        "loci clip LAYER (--bbox XMIN,YMIN,XMAX,YMAX | --wkt POLYGON | --window-layer POLYGONS) "

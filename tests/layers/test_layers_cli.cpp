@@ -2184,6 +2184,8 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
       "query " + seg + " --within 10.5,56,0.3",
       "query " + seg + " --segment 8,55,12,57 --first",
       "query " + feat + " --bbox 20,20,60,60 --candidates",
+      "check " + seg,
+      "check " + feat + ".loci",
   };
   for (const std::string& args : answered) {
     const CliRun whole = run_with(LOCI_FULL_EXE, args), part = run_with(front, args);
