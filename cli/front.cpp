@@ -1,10 +1,14 @@
 // loci: the command users run. A query its sidecar answers (per segment, or --candidates; FIDs
 // on stdout or into a new file) runs here, without GDAL: loading GDAL's libraries takes about
 // 30 ms, several times such a query; so does `loci check`, which reads only the sidecar and the
-// layer's files. Every other command, and a query that needs the layer or GDAL (a stale or
-// missing sidecar, one per feature, csv or GeoJSON output, -o onto a file that is there), is
-// handed to loci-full with the same arguments (exec): it has every command and GDAL, and says
-// what is wrong with a command.
+// layer's files. So does a query per feature of a shapefile, whose records are read directly
+// (shapefile_records.hpp), when its queries come from the command line or a regular file: a
+// record only GDAL reads hands the command over then, before anything is written, and
+// loci-full reads the queries again. Every other command, and a query that needs the layer or
+// GDAL (a stale or missing sidecar, one per feature of another format, csv or GeoJSON output,
+// -o onto a file that is there), is handed to loci-full with the same arguments (exec): it has
+// every command and GDAL, and says what is wrong with a command.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -34,17 +38,33 @@ bool answered_here(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) return false;
   try {
     const Args a = parse(query_command(), 2, argc, argv);
-    g_loaded = loci::io::answers_without_gdal(query_options(a, false));
+    // The queries can be read again by loci-full when none comes from a file other than a
+    // regular one (a pipe, a terminal, a FIFO is read once).
+    bool rereadable = true;
+    for (const char* file : {"--bbox-file", "--nearest-file", "--point-file"}) {
+      struct stat st {};
+      if (a.has(file)) rereadable &= ::stat(a.get(file).c_str(), &st) == 0 && S_ISREG(st.st_mode);
+    }
+    g_loaded = loci::io::answers_without_gdal(query_options(a, false), rereadable);
     return g_loaded.has_value();
   } catch (...) {  // loci-full says what is wrong
     return false;
   }
 }
 
+[[noreturn]] void hand_over(char** argv);
+char** g_argv = nullptr;
+
 int run_query_here(const Args& a) {
   loci::io::QueryOptions o = query_options(a, true);
   o.loaded = g_loaded;
-  loci::io::query_layer(o, stdout);
+  try {
+    loci::io::query_layer(o, stdout);
+  } catch (const loci::io::NeedsGdal&) {
+    // A feature only GDAL reads: nothing was written, and loci-full reads the queries again.
+    if (g_loaded->features_here) hand_over(g_argv);
+    throw;
+  }
   return 0;
 }
 
@@ -79,6 +99,7 @@ int run_query_here(const Args& a) {
 int main(int argc, char** argv) {
   if (argc >= 2 && !std::strcmp(argv[1], "check"))
     return run_command(check_command(), 2, argc, argv);
+  g_argv = argv;
   if (answered_here(argc, argv)) {
     Command here = query_command();
     here.run = run_query_here;

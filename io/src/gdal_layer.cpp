@@ -106,15 +106,6 @@ OpenLayer open_layer(const std::string& path, const std::string& name) {
   return ol;
 }
 
-void check_layer_point(const Point2& p, const std::string& what) {
-  if (!is_finite(p)) throw InvalidGeometry(what + " has a NaN or infinite coordinate");
-  if (!within_coordinate_range(p)) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, " has coordinate (%.6g, %.6g), beyond +-1e150", p[0], p[1]);
-    throw InvalidGeometry(what + buf + ": too large for exact distances");
-  }
-}
-
 bool same_layer(const std::string& path_a, const std::string& name_a, const std::string& path_b,
                 const std::string& name_b) {
   if (!same_file(path_a, path_b)) return false;
@@ -123,10 +114,6 @@ bool same_layer(const std::string& path_a, const std::string& name_a, const std:
   OGRLayer* b =
       name_b.empty() ? ol.dataset->GetLayer(0) : ol.dataset->GetLayerByName(name_b.c_str());
   return b == ol.layer;
-}
-
-std::string where(const std::string& path, std::int64_t fid) {
-  return path + ": feature " + std::to_string(fid);
 }
 
 namespace {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "layer_points.hpp"
 #include "loci/io/exact.hpp"
 #include "loci/io/layer_reader.hpp"
 
@@ -30,16 +31,10 @@ OpenLayer open_layer(const std::string& path, const std::string& name);
 bool same_layer(const std::string& path_a, const std::string& name_a, const std::string& path_b,
                 const std::string& name_b);
 
-std::string where(const std::string& path, std::int64_t fid);
-
 // Whether the dataset's driver reads a feature by FID in place (shapefile, GeoPackage,
 // FlatGeobuf...); the others (GeoJSON, CSV, GML, KML...) parse from the start of the file for
 // each lookup.
 bool fast_random_read(GDALDataset& ds);
-
-// Throws InvalidGeometry naming `what` for a NaN or infinite coordinate, or one beyond
-// +-kMaxCoordinate (1e150), which loci's distance arithmetic cannot carry.
-void check_layer_point(const Point2& p, const std::string& what);
 
 // A coordinate system's authority and code ("EPSG:4326"), empty when it has none.
 std::string authority_code(const OGRSpatialReference& srs);

@@ -23,16 +23,14 @@
 #include <unordered_map>
 
 #include "loci/geom/error.hpp"
+#include "loci/io/commands.hpp"
 #include "loci/io/exact.hpp"
 #include "loci/io/output.hpp"
 
 namespace loci::io::detail {
 
-// The work asked for needs GDAL, which this process has not loaded.
-class NeedsGdal : public Error {
- public:
-  NeedsGdal() : Error("this needs GDAL, which this process does not load") {}
-};
+// The work asked for needs GDAL, which this process has not loaded (commands.hpp).
+using loci::io::NeedsGdal;
 
 // The name GDAL gives the layer `name` of `path` (the first layer when empty): a name matched
 // without regard to case comes back as the layer spells it. Throws loci::Error as open_layer.

@@ -20,6 +20,7 @@
 #include "loci/io/atomic_file.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/sidecar.hpp"
+#include "shapefile_records.hpp"
 
 namespace loci::io {
 
@@ -310,7 +311,7 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
   return LayerIndex::build(std::move(items), o.structure.value_or(Structure::packed_hilbert));
 }
 
-std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options) {
+std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options, bool rereadable) {
   // An output file is written here only where nothing is yet (not even a dangling link): one
   // that is there may be a dataset of several layers, which GDAL tells (refuse_replacing_layers).
   std::error_code ec;
@@ -320,15 +321,19 @@ std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options) {
   const std::string path = sidecar_path_of(options.load);
   if (options.format != Format::ids || output_taken || !file_exists(path)) return std::nullopt;
   try {
-    // Per feature, exact answers read the layer: said from the header, before the layer is
-    // hashed to tell it fresh (loci-full would hash it again).
+    // Per feature, exact answers read the layer's features: here only a shapefile's, whose
+    // records the direct reader takes (said from the headers, before the layer is hashed to
+    // tell it fresh, which loci-full would do again).
     const Per per = Sidecar::open(path).info().per;
-    if (!options.candidates && per != Per::segment) return std::nullopt;
+    const bool features_here = !options.candidates && per != Per::segment && rereadable &&
+                               detail::shp::ShapefileFeatures(options.load.layer_path).active();
+    if (!options.candidates && per != Per::segment && !features_here) return std::nullopt;
     if (options.load.per && *options.load.per != per) return std::nullopt;
     LoadedIndex loaded;
     loaded.layer = fingerprint_stat(options.load.layer_path);
     loaded.index = std::make_shared<const LayerIndex>(load_index(options.load));
-    if (options.candidates || loaded.index->per() == Per::segment) return loaded;
+    loaded.features_here = features_here;
+    if (options.candidates || loaded.index->per() == Per::segment || features_here) return loaded;
   } catch (...) {  // the command run in full says what is wrong
   }
   return std::nullopt;
@@ -348,17 +353,20 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
     report.index_origin = "sidecar " + sidecar_path_of(options.load);
     // The layer changed while the queries were read (from a pipe, say): its index is loaded
     // again, as load_index loads it after reading them (indexed again meanwhile, it answers);
-    // one that needs GDAL to tell or to answer is stale. Hashed again only when the layer's
-    // size, time or inode changed.
+    // one that needs GDAL to tell or to answer is stale, or, when the queries can be read
+    // again (features_here), handed over. Hashed again only when the layer's size, time or
+    // inode changed.
     const Fingerprint* was = loaded->source();
     if (was && !(fingerprint_stat(options.load.layer_path) == options.loaded->layer)) {
       Fingerprint now;
       if (!still_fresh(options.load.layer_path, *was, &now)) {
         try {
           auto again = std::make_shared<const LayerIndex>(load_index(options.load));
-          if (!options.candidates && again->per() != Per::segment) throw detail::NeedsGdal();
+          if (!options.candidates && again->per() != Per::segment && !options.loaded->features_here)
+            throw detail::NeedsGdal();
           loaded = std::move(again);
         } catch (const detail::NeedsGdal&) {
+          if (options.loaded->features_here) throw;  // the command can run again in full
           refuse_stale(options.load, sidecar_path_of(options.load), loaded->layer_name(), *was, now,
                        false);
         }

@@ -2149,9 +2149,23 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
   for (const char* ext : {".shp", ".shx", ".dbf"})
     fs::copy_file(path(std::string("polys") + ext), path(std::string("front") + ext),
                   fs::copy_options::overwrite_existing);
+  // Lines and points indexed per feature too (polys.shp has holes and polygons of two parts).
+  for (const char* name : {"lines", "points"})
+    for (const char* ext : {".shp", ".shx", ".dbf"})
+      fs::copy_file(path(std::string(name) + ext), path(std::string("front-") + name + ext),
+                    fs::copy_options::overwrite_existing);
+  const std::string lines_layer = path("front-lines.shp"), points_layer = path("front-points.shp");
   ASSERT_EQ(run_loci("index -q --per segment " + seg).status, 0);
-  ASSERT_EQ(run_loci("index -q --per feature " + feat).status, 0);
-  const std::string points = path("front-points.txt");
+  for (const std::string& layer : {feat, lines_layer, points_layer})
+    ASSERT_EQ(run_loci("index -q --per feature " + layer).status, 0);
+  const std::string points = path("front-points.txt"), spots = path("front-spots.txt");
+  {
+    std::ofstream out(spots);
+    std::mt19937_64 rng(78);
+    std::uniform_real_distribution<double> c(0, 100);
+    for (int i = 0; i < 300; ++i)
+      out << c(rng) << ',' << c(rng) << '\n';
+  }
   {
     std::ofstream out(points);
     std::mt19937_64 rng(77);
@@ -2184,6 +2198,17 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
       "query " + seg + " --within 10.5,56,0.3",
       "query " + seg + " --segment 8,55,12,57 --first",
       "query " + feat + " --bbox 20,20,60,60 --candidates",
+      // Per feature of a shapefile: its records read without GDAL.
+      "query " + feat + " --bbox 20,20,60,60",
+      "query " + feat + " --nearest 50,50 -k 6",
+      "query " + feat + " --nearest-file " + spots + " -k 2 -j 2",
+      "query " + feat + " --point-file " + spots,
+      "query " + feat + " --within 50,50,12",
+      "query " + feat + " --segment 0,0,100,100 --first",
+      "query " + lines_layer + " --bbox 20,20,60,60",
+      "query " + lines_layer + " --nearest-file " + spots + " -k 2",
+      "query " + points_layer + " --within 50,50,20",
+      "query " + points_layer + " --nearest 50,50 -k 4",
       "check " + seg,
       "check " + feat + ".loci",
   };
@@ -2197,7 +2222,7 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
   // Work that needs the layer or GDAL: the copy alone says it cannot run loci-full, and
   // nothing else (it neither answers nor half-answers).
   const std::string handed[] = {
-      "query " + feat + " --bbox 20,20,60,60",
+      "query " + feat + " --bbox 20,20,60,60 -f csv",
       "query " + seg + " --nearest 10.5,56 -f csv",
       "query " + seg + " --nearest 10.5,56 -o " + path("front-taken.txt"),
       "query " + seg + " --nearest 10.5,56 --per feature",
@@ -2235,6 +2260,56 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
     ASSERT_EQ(from_file.status, 0) << from_file.err;
     EXPECT_EQ(piped.status, 0) << piped.out;
     EXPECT_EQ(piped.out, from_file.out) << layer;
+  }
+  // A shapefile record the direct reader leaves to GDAL (a hole starting on its outer ring)
+  // hands a query per feature over when the query meets it, before anything is written;
+  // loci-full reads the queries again (from a regular file), or has read them all (a pipe,
+  // handed over at once). The other records are still answered by the front alone.
+  {
+    const std::string odd = path("front-odd.shp");
+    write_layer(
+        odd, wkbPolygon,
+        [](int i) -> std::unique_ptr<OGRGeometry> {
+          auto p = std::make_unique<OGRPolygon>();
+          const double x = i == 0 ? 200 : 0;
+          OGRLinearRing outer;
+          for (const auto& [px, py] :
+               {std::pair{x, 0.0}, {x, 10.0}, {x + 10, 10.0}, {x + 10, 0.0}, {x, 0.0}})
+            outer.addPoint(px, py);
+          p->addRing(&outer);
+          if (i == 1) {
+            OGRLinearRing hole;
+            for (const auto& [px, py] : {std::pair{0.0, 5.0}, {5.0, 2.0}, {5.0, 8.0}, {0.0, 5.0}})
+              hole.addPoint(px, py);
+            p->addRing(&hole);
+          }
+          return p;
+        },
+        2);
+    ASSERT_EQ(run_loci("index -q --per feature " + odd).status, 0);
+    const std::string far = "query " + odd + " --bbox 199,-1,201,1";
+    const CliRun whole_far = run_with(LOCI_FULL_EXE, far);
+    EXPECT_EQ(whole_far.out, "0\n");
+    EXPECT_EQ(run_with(front, far).out, whole_far.out);
+    const CliRun met = run_with(front, "query " + odd + " --bbox 1,4,2,6");
+    EXPECT_EQ(met.status, 1);
+    EXPECT_EQ(lines(met.out).size(), 1u) << met.out;
+    EXPECT_NE(met.out.find("loci is not installed whole"), std::string::npos) << met.out;
+    const std::string windows_file = path("front-odd-windows.txt");
+    std::ofstream(windows_file) << "199,-1,201,1\n1,4,2,6\n3,4,4,6\n";
+    const std::string batch_args = "query " + odd + " --bbox-file ";
+    const CliRun expected = run_with(LOCI_FULL_EXE, batch_args + windows_file);
+    ASSERT_EQ(expected.status, 0) << expected.out;
+    EXPECT_EQ(expected.out, "1 0\n2 1\n");  // the window inside the hole meets nothing
+    EXPECT_EQ(run_with(LOCI_EXE, batch_args + windows_file + " -o " + path("front-odd.txt")).status,
+              0);
+    EXPECT_EQ(read_text(path("front-odd.txt")), expected.out);
+    EXPECT_EQ(run_with("cat " + shell_quote(windows_file) + " | " + std::string(LOCI_EXE),
+                       batch_args + "/dev/stdin")
+                  .out,
+              expected.out);
+    for (const char* ext : {".shp", ".shx", ".dbf", ".shp.loci", "-windows.txt", ".txt"})
+      fs::remove(path(std::string("front-odd") + ext));
   }
   // A loci-full that cannot run is named as the file that failed.
   {
@@ -2321,9 +2396,11 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
   ASSERT_EQ(libs.status, 0) << libs.out;
   EXPECT_EQ(libs.out.find("libgdal"), std::string::npos) << libs.out;
   fs::remove_all(alone);
-  for (const char* ext : {".shp", ".shx", ".dbf", ".shp.loci"})
-    fs::remove(path(std::string("front") + ext));
+  for (const char* name : {"front", "front-lines", "front-points"})
+    for (const char* ext : {".shp", ".shx", ".dbf", ".shp.loci"})
+      fs::remove(path(std::string(name) + ext));
   fs::remove(seg + ".loci");
   fs::remove(seg);
   fs::remove(points);
+  fs::remove(spots);
 }

@@ -24,10 +24,12 @@
 #include <string>
 #include <vector>
 
+#include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/layer_reader.hpp"
 #include "loci/io/sidecar.hpp"
 #include "shapefile_polygons.hpp"
+#include "shapefile_records.hpp"
 #include "support/scratch.hpp"
 
 namespace {
@@ -222,9 +224,50 @@ void reverse_parts(const std::string& shp, int fid, std::initializer_list<int> p
       .write(bytes.data(), std::streamsize(bytes.size()));
 }
 
+// The direct reader of features (for the `loci` front, without GDAL) gives, for every record it
+// takes, the geometry GDAL gives flattened as the GDAL path flattens it: the same points, in
+// the same parts, in the same order, the rings numbered by the same polygons. Returns how many
+// records it took (the others it leaves to GDAL).
+int expect_features_like_gdal(const std::string& path) {
+  SCOPED_TRACE(path);
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+  if (!ds) {
+    ADD_FAILURE() << "GDAL cannot open " << path;
+    return 0;
+  }
+  OGRLayer* layer = ds->GetLayer(0);
+  loci::io::detail::shp::ShapefileFeatures direct(path);
+  if (!direct.active()) return 0;
+  int taken = 0;
+  const GIntBig count = layer->GetFeatureCount();
+  for (GIntBig fid = -1; fid <= count; ++fid) {
+    const auto ours = direct.read(fid);
+    OGRFeatureUniquePtr f(fid >= 0 && fid < count ? layer->GetFeature(fid) : nullptr);
+    if (!f) {  // deleted, or no such FID
+      EXPECT_FALSE(ours) << "feature " << fid;
+      continue;
+    }
+    if (!ours) continue;
+    ++taken;
+    const loci::io::FlatGeometry ref =
+        loci::io::detail::flatten(f->GetGeometryRef(), loci::io::detail::where(path, fid));
+    EXPECT_EQ(ours->points, ref.points) << "feature " << fid;
+    EXPECT_EQ(ours->polygons, ref.polygons) << "feature " << fid;
+    EXPECT_EQ(ours->parts.size(), ref.parts.size()) << "feature " << fid;
+    for (std::size_t i = 0; i < std::min(ours->parts.size(), ref.parts.size()); ++i) {
+      const auto &a = ours->parts[i], &b = ref.parts[i];
+      EXPECT_TRUE(a.begin == b.begin && a.end == b.end && a.kind == b.kind &&
+                  a.polygon == b.polygon)
+          << "feature " << fid << " part " << i;
+    }
+  }
+  return taken;
+}
+
 void expect_like_gdal(const std::string& path) {
   SCOPED_TRACE(path);
   expect_summary_like_gdal(path);
+  EXPECT_GT(expect_features_like_gdal(path), 0);
   const auto direct = loci::io::read_shapefile_boxes(path);
   ASSERT_TRUE(direct) << "handed back to GDAL";
   const Reference ref = gdal_reference(path);
@@ -509,6 +552,7 @@ void expect_polygons_like_gdal(const std::string& path, int* built_out) {
     if (g && ref) EXPECT_EQ(wkb(*g), wkb(*ref)) << "feature " << fid;
   }
   *built_out = built;
+  EXPECT_GE(expect_features_like_gdal(path), built);
   // The per-segment read numbers each ring's polygon as GDAL's sorting does (or leaves the
   // record to GDAL).
   if (const auto segments = loci::io::read_shapefile_segments(path))
@@ -715,6 +759,81 @@ TEST(ShapefileBoxes, PolygonsOfManyRingsAreBuiltAsGdalBuildsThem) {
       23);
   expect_polygons_like_gdal(lines, &built);
   EXPECT_EQ(built, 0);
+}
+
+// The direct readers place a hole in an outer ring as GDAL's ring predicates place it, to the
+// rounding: points on vertices, on edges (midpoints, points a few units in the last place off
+// them), near and far, against OGRLinearRing's own tests, on rings of random, lattice and
+// sliver shapes.
+TEST(ShapefileBoxes, RingPredicatesAreGdals) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int boundary = 0, inside = 0, outside = 0;
+  for (int round = 0; round < 300; ++round) {
+    const int n = 3 + int(rng() % 12);
+    const double scale = round % 3 == 0 ? 1e-3 : (round % 3 == 1 ? 1 : 1e6);
+    std::vector<std::pair<double, double>> pts;
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * M_PI * i / n, radius = 0.2 + 0.8 * std::abs(u(rng));
+      double x = scale * radius * std::cos(a), y = scale * radius * std::sin(a);
+      if (round % 4 == 2)
+        x = std::round(x * 4 / scale) * scale / 4, y = std::round(y * 4 / scale) * scale / 4;
+      pts.emplace_back(x, y);
+    }
+    pts.push_back(pts.front());
+    // The record content of one polygon of one ring: what PolygonRings reads.
+    std::string c(44, '\0');
+    const auto put32 = [&](std::size_t at, std::uint32_t v) { std::memcpy(&c[at], &v, 4); };
+    put32(0, 5);
+    put32(36, 1);
+    put32(40, std::uint32_t(pts.size()));
+    c.append(4, '\0');
+    for (const auto& [x, y] : pts) {
+      c.append(reinterpret_cast<const char*>(&x), 8);
+      c.append(reinterpret_cast<const char*>(&y), 8);
+    }
+    const loci::io::detail::shp::PolygonRings rings(
+        reinterpret_cast<const unsigned char*>(c.data()));
+    OGRLinearRing ring;
+    for (const auto& [x, y] : pts)
+      ring.addPoint(x, y);
+    std::vector<std::pair<double, double>> probes;
+    for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+      const auto [ax, ay] = pts[i];
+      const auto [bx, by] = pts[i + 1];
+      probes.emplace_back(ax, ay);
+      for (const double t : {0.5, 0.25, 1.0 / 3}) {
+        const double x = ax + t * (bx - ax), y = ay + t * (by - ay);
+        probes.emplace_back(x, y);
+        for (int k = 1; k <= 3; ++k) {
+          probes.emplace_back(std::nextafter(x, x + k), y);
+          probes.emplace_back(x, std::nextafter(y, y - k));
+        }
+      }
+      probes.emplace_back(ax, by);
+      probes.emplace_back(bx, ay);
+    }
+    for (int i = 0; i < 20; ++i)
+      probes.emplace_back(scale * u(rng), scale * u(rng));
+    for (const auto& [x, y] : probes) {
+      OGRPoint p(x, y);
+      const loci::io::Location gdal =
+          ring.isPointOnRingBoundary(&p, FALSE)
+              ? loci::io::Location::boundary
+              : (ring.isPointInRing(&p, FALSE) ? loci::io::Location::inside
+                                               : loci::io::Location::outside);
+      const loci::io::Location ours =
+          loci::io::detail::shp::gdal_ring_location(rings, 0, loci::Point2{x, y});
+      ASSERT_EQ(ours, gdal) << "round " << round << " point (" << x << ", " << y << ")";
+      boundary += gdal == loci::io::Location::boundary;
+      inside += gdal == loci::io::Location::inside;
+      outside += gdal == loci::io::Location::outside;
+    }
+  }
+  // Each answer met many times: the test tells them apart.
+  EXPECT_GT(boundary, 1000);
+  EXPECT_GT(inside, 1000);
+  EXPECT_GT(outside, 1000);
 }
 
 TEST(ShapefileBoxes, ARingSortingMethodChosenByTheUserGoesToGdal) {

@@ -107,6 +107,17 @@ LayerIndex load_index(const LoadOptions& options, std::string* origin = nullptr,
 struct LoadedIndex {
   std::shared_ptr<const LayerIndex> index;
   Fingerprint layer;
+  // Per feature: the exact tests read the layer's features without GDAL (a shapefile's
+  // records), and query_layer throws NeedsGdal, having written nothing, at a record that needs
+  // GDAL to be read.
+  bool features_here = false;
+};
+
+// Thrown by io/'s GDAL-free build (the `loci` front's) where the work needs GDAL, which that
+// process has not loaded; never by loci::io.
+class NeedsGdal : public Error {
+ public:
+  NeedsGdal() : Error("this needs GDAL, which this process does not load") {}
 };
 
 struct QueryOptions {
@@ -131,16 +142,19 @@ struct QueryReport {
 QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 
 // The index query_layer answers `options` from without reading the layer through GDAL: a
-// fresh sidecar per segment (or for --candidates), when ids go to stdout or to a file not
-// there yet (one that is may be a dataset of several layers, which GDAL tells); nullopt
-// otherwise, and on any failure (the command run in full says what is wrong). Reads no query
-// file and writes nothing. For the `loci` front, which runs such queries without loading
-// GDAL: it gives the index to query_layer (QueryOptions::loaded), which does not load it
-// again (a sidecar replaced meanwhile, by one per feature say, would need GDAL once the
+// fresh sidecar per segment (or for --candidates), or per feature of a shapefile whose
+// records the direct reader takes when `rereadable` (the queries can be read again, by the
+// command run in full, should a record need GDAL: see LoadedIndex::features_here), when ids
+// go to stdout or to a file not there yet (one that is may be a dataset of several layers,
+// which GDAL tells); nullopt otherwise, and on any failure (the command run in full says what
+// is wrong). Reads no query file and writes nothing. For the `loci` front, which runs such queries
+// without loading GDAL: it gives the index to query_layer (QueryOptions::loaded), which does not
+// load it again (a sidecar replaced meanwhile, by one per feature say, would need GDAL once the
 // queries were read) but checks again that the layer has not changed: changed, its index is
 // loaded again as loci-full loads it, and where that needs GDAL the query is refused as stale
 // (loci-full would name another layer when GDAL names the layer otherwise).
-std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options);
+std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options,
+                                                bool rereadable = false);
 
 struct ClipOptions {
   LoadOptions load;
