@@ -9,6 +9,10 @@
 #      opening included;
 #      beside it the library's own nearest-10 on the same segment boxes (`loci bench`: a
 #      packed R-tree in memory, random points in the layer's extent) and the ratio.
+#   3. per feature: one window over Funen on the coastline as a shapefile indexed per feature
+#      (converted once with ogr2ogr), which `loci` answers reading the candidates' records
+#      itself, against the same query run by loci-full: median wall time of 7 runs each, and
+#      the ratio.
 # Usage: layer_queries.sh [LOCI_EXE] [N]; LOCI_BENCH_DIR is the working directory. Needs
 # datasets/fetch.sh to have filled the cache.
 set -euo pipefail
@@ -32,11 +36,11 @@ cp "$root/datasets/samples/coastline-denmark.geojson" "$work/sample.geojson"
 
 median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 seconds() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.4f", (b - a) / 1e9 }'; }
-one_query() {  # LAYER WINDOW: median seconds and resident KB of 7 runs
-  local t=() m=() t0 t1
+one_query() {  # LAYER WINDOW [EXE]: median seconds and resident KB of 7 runs
+  local t=() m=() t0 t1 exe=${3:-$loci}
   for _ in 1 2 3 4 5 6 7; do
     t0=$(date +%s%N)
-    /usr/bin/time -f "%M" -o "$work/time.txt" "$loci" query "$1" --bbox "$2" -f ids > /dev/null
+    /usr/bin/time -f "%M" -o "$work/time.txt" "$exe" query "$1" --bbox "$2" -f ids > /dev/null
     t1=$(date +%s%N)
     read -r k < "$work/time.txt"; t+=("$(seconds "$t0" "$t1")"); m+=("$k")
   done
@@ -76,3 +80,16 @@ lib_ms=$("$loci" bench "$work/coast.geojson" --per segment --queries "$n" -k 10 
   awk '/^nearest-n queries/ { print $3 }')
 echo "library nearest-10 on the same boxes: $(awk -v ms="$lib_ms" -v n="$n" 'BEGIN { printf "%.0f queries/s", n / (ms / 1000) }');" \
   "the command's batch takes $(awk -v ms="$lib_ms" -v s="$batch_s" 'BEGIN { printf "%.1f", s / (ms / 1000) }')x its time (aim: within 5x)"
+
+# Per feature, on a shapefile: the front against loci-full (beside it, or where it installs it).
+full=$(dirname "$loci")/loci-full
+[ -x "$full" ] || full=$(dirname "$loci")/../libexec/loci/loci-full
+if [ -x "$full" ]; then
+  [ "$work/coast.shp" -nt "$src" ] ||
+    ogr2ogr -f "ESRI Shapefile" "$work/coast.shp" "$src" > /dev/null
+  "$loci" index -q --per feature "$work/coast.shp"
+  read -r front_s _ <<< "$(one_query "$work/coast.shp" "$window")"
+  read -r full_s _ <<< "$(one_query "$work/coast.shp" "$window" "$full")"
+  echo "one window per feature on the coastline shapefile: loci ${front_s}s, loci-full ${full_s}s" \
+    "($(awk -v a="$full_s" -v b="$front_s" 'BEGIN { printf "%.1f", a / b }')x)"
+fi
