@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <string_view>
 #include <thread>
 
 #include "gdal_seam.hpp"
@@ -38,12 +40,43 @@ std::string quoted(const std::string& text) {
   return "'" + printable(text.substr(0, 60)) + (text.size() > 60 ? "...'" : "'");
 }
 
+// Whether a decimal number that std::from_chars found out of a double's range is too large
+// (rather than too small): its first significant digit stands at a positive power of ten.
+bool beyond_doubles(std::string_view s) {
+  long long lead = 0;  // the power of ten of the first significant digit, plus one
+  bool point = false, significant = false;
+  std::size_t i = s.empty() || s[0] != '-' ? 0 : 1;
+  for (; i < s.size() && (std::isdigit(static_cast<unsigned char>(s[i])) || s[i] == '.'); ++i) {
+    if (s[i] == '.') {
+      point = true;
+    } else if (!significant && s[i] == '0') {
+      lead -= point;
+    } else {
+      significant = true;
+      lead += !point;
+    }
+  }
+  if (!significant) return false;
+  long long exponent = 0;
+  if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+    const std::size_t from = i + 1 + (i + 1 < s.size() && s[i + 1] == '+');
+    const auto r = std::from_chars(s.data() + from, s.data() + s.size(), exponent);
+    // An exponent beyond long long: its sign decides.
+    if (r.ec == std::errc::result_out_of_range) return s[from] != '-';
+  }
+  return lead + exponent > 0;
+}
+
 // "A,B,..." as n finite numbers; spaces around each are allowed. std::from_chars reads the
 // C locale's format whatever the process locale (a user's decimal comma does not change it).
 std::vector<double> parse_numbers(const std::string& text, std::size_t n, const char* what,
                                   const char* form) {
   auto bad = [&] {
     return InvalidArgument(std::string("bad ") + what + " " + quoted(text) + ": expected " + form);
+  };
+  auto too_large = [&] {
+    return InvalidArgument(std::string("bad ") + what + " " + quoted(text) +
+                           ": values beyond +-1e150 are too large for exact distances");
   };
   std::vector<double> v;
   std::size_t at = 0;
@@ -56,10 +89,11 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t n, const 
     if (text[first] == '+') ++first;  // from_chars takes no leading plus
     double d = 0;
     const auto r = std::from_chars(text.data() + first, text.data() + last, d);
+    if (r.ec == std::errc::result_out_of_range && r.ptr == text.data() + last &&
+        beyond_doubles(std::string_view(text).substr(first, last - first)))
+      throw too_large();
     if (r.ec != std::errc() || r.ptr != text.data() + last || !std::isfinite(d)) throw bad();
-    if (std::abs(d) > kMaxCoordinate)
-      throw InvalidArgument(std::string("bad ") + what + " " + quoted(text) +
-                            ": values beyond +-1e150 are too large for exact distances");
+    if (std::abs(d) > kMaxCoordinate) throw too_large();
     v.push_back(d);
     at = comma + 1;
   }

@@ -600,10 +600,24 @@ TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {
     EXPECT_FALSE(fs::exists(l + ".loci"));
   }
   const std::string ok = lines_layer();
-  for (const char* q : {"--bbox 0,0,1e301,1", "--nearest 1e200,0 -k 1", "--within 0,0,1e160"}) {
+  // Beyond doubles too (std::from_chars finds them out of range), however written; a number
+  // too small for a double is not said too large.
+  const std::string huge_integer = "1" + std::string(400, '0');
+  for (const std::string& q : std::vector<std::string>{
+           "--bbox 0,0,1e301,1", "--nearest 1e200,0 -k 1", "--within 0,0,1e160",
+           "--nearest 1e400,0 -k 1", "--point 0,-1E+400",
+           "--bbox 0,0,1,0.00001e99999999999999999999", "--nearest " + huge_integer + ",0",
+           "--within 0,0,1" + huge_integer + ".5"}) {
     const CliRun r = run_loci("query " + shell_quote(ok) + " " + q);
     expect_one_line_error(r);
     EXPECT_NE(r.err.find("1e150"), std::string::npos) << q << ": " << r.err;
+  }
+  for (const std::string& q : std::vector<std::string>{
+           "--nearest 1e-400,0 -k 1", "--point 0.000" + std::string(400, '0') + "1,0",
+           "--point 0,1e-99999999999999999999"}) {
+    const CliRun r = run_loci("query " + shell_quote(ok) + " " + q);
+    expect_one_line_error(r);
+    EXPECT_EQ(r.err.find("1e150"), std::string::npos) << q << ": " << r.err;
   }
   // Large but carryable coordinates still answer exactly.
   const std::string big = write("big.geojson", R"({"type":"FeatureCollection","features":[
