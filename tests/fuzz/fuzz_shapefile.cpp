@@ -5,7 +5,8 @@
 // those files' bytes, then the .shp's.
 //
 // What the direct reader takes it must read as GDAL does (the boxes of the features GDAL
-// gives, the polygons GDAL builds, byte for byte); what it cannot read as GDAL does it must
+// gives, the polygons GDAL builds, byte for byte, the features the front reads flattened as
+// GDAL's are); what it cannot read as GDAL does it must
 // hand back (nullopt) or refuse with a loci::Error. A difference aborts: a finding.
 #include <cpl_error.h>
 #include <gdal_priv.h>
@@ -20,10 +21,12 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
+#include "gdal_layer.hpp"
 #include "loci/geom/box.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/io/shapefile_boxes.hpp"
 #include "shapefile_polygons.hpp"
+#include "shapefile_records.hpp"
 
 namespace {
 
@@ -147,6 +150,36 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const OGRGeometry* g = f ? f->GetGeometryRef() : nullptr;
         check(g != nullptr, "built a polygon GDAL does not give");
         check(wkb_of(*ours) == wkb_of(*g), "polygon differs from GDAL's");
+      }
+    }
+    // The features the `loci` front reads without GDAL: each one it takes, flattened as GDAL's
+    // geometry of it is flattened.
+    if (layer && (flags & 8)) {
+      loci::io::detail::shp::ShapefileFeatures direct(shp);
+      GDALDatasetUniquePtr again(GDALDataset::Open(shp.c_str(), GDAL_OF_VECTOR, shapefile_only));
+      OGRLayer* reference = again ? again->GetLayer(0) : nullptr;
+      const GIntBig count = reference ? std::min<GIntBig>(reference->GetFeatureCount(), 64) : 0;
+      for (GIntBig fid = -1; direct.active() && fid <= count; ++fid) {
+        const auto ours = direct.read(fid);
+        if (!ours) continue;
+        CPLErrorReset();
+        OGRFeatureUniquePtr f(reference ? reference->GetFeature(fid) : nullptr);
+        check(f != nullptr && CPLGetLastErrorType() < CE_Failure,
+              "read a feature GDAL does not give");
+        loci::io::FlatGeometry g;
+        try {
+          g = loci::io::detail::flatten(f->GetGeometryRef(), "feature");
+        } catch (const loci::Error&) {
+          check(false, "read a feature GDAL refuses");
+        }
+        check(ours->points == g.points && ours->polygons == g.polygons &&
+                  ours->parts.size() == g.parts.size(),
+              "feature's points differ from GDAL's");
+        for (std::size_t i = 0; i < g.parts.size(); ++i)
+          check(ours->parts[i].begin == g.parts[i].begin && ours->parts[i].end == g.parts[i].end &&
+                    ours->parts[i].kind == g.parts[i].kind &&
+                    ours->parts[i].polygon == g.parts[i].polygon,
+                "feature's parts differ from GDAL's");
       }
     }
   } catch (const loci::Error&) {
