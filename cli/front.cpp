@@ -26,7 +26,9 @@ namespace {
 using namespace loci::cli;
 
 // The sidecar this process answers from (answers_without_gdal's), loaded once: the query
-// file is read after it was chosen, and nothing can be handed over from then on.
+// file is read after it was chosen, and nothing can be handed over from then on, except per
+// feature (features_here), where the queries came from the command line or a regular file
+// that loci-full reads again.
 std::optional<loci::io::LoadedIndex> g_loaded;
 
 // Whether this process answers: a `loci query` its sidecar answers without GDAL (g_loaded set).
@@ -39,11 +41,16 @@ bool answered_here(int argc, char** argv) {
   try {
     const Args a = parse(query_command(), 2, argc, argv);
     // The queries can be read again by loci-full when none comes from a file other than a
-    // regular one (a pipe, a terminal, a FIFO is read once).
+    // regular one (a pipe, a terminal, a FIFO is read once), named otherwise than as one of
+    // this process's descriptors (/dev/stdin, /dev/fd/N, /proc/self/fd/N: outside Linux,
+    // opening those shares the offset this process's read left at the end).
     bool rereadable = true;
     for (const char* file : {"--bbox-file", "--nearest-file", "--point-file"}) {
+      if (!a.has(file)) continue;
+      const std::string name = a.get(file);
       struct stat st {};
-      if (a.has(file)) rereadable &= ::stat(a.get(file).c_str(), &st) == 0 && S_ISREG(st.st_mode);
+      rereadable &= ::stat(name.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+                    name.rfind("/dev/", 0) != 0 && name.rfind("/proc/", 0) != 0;
     }
     g_loaded = loci::io::answers_without_gdal(query_options(a, false), rereadable);
     return g_loaded.has_value();

@@ -410,7 +410,11 @@ std::optional<Organized> organize(const PolygonRings& r, const std::vector<std::
 
 bool ring_polygons(const unsigned char* c, std::vector<std::uint32_t>& polygon) {
   const PolygonRings r(c);
-  const std::vector<std::int8_t> cw = orientations(r);
+  return ring_polygons(r, orientations(r), polygon);
+}
+
+bool ring_polygons(const PolygonRings& r, const std::vector<std::int8_t>& cw,
+                   std::vector<std::uint32_t>& polygon) {
   polygon.assign(r.parts, 0);
   if (std::all_of(cw.begin(), cw.end(), [](std::int8_t o) { return o == 1; })) {
     for (std::uint32_t k = 0; k < r.parts; ++k)
@@ -552,10 +556,10 @@ std::optional<FlatGeometry> ShapefileFeatures::read(std::int64_t fid) {
     return g;
   }
   // Rings GDAL builds otherwise (closing them, or sorting them some other way) are left to it.
-  std::vector<std::int8_t> cw = orientations(r);
+  const std::vector<std::int8_t> cw = orientations(r);
   if (std::any_of(cw.begin(), cw.end(), [](std::int8_t o) { return o < 0; })) return std::nullopt;
   std::vector<std::uint32_t> polygon(r.parts, 0);
-  if (r.parts > 1 && !ring_polygons(c, polygon)) return std::nullopt;
+  if (r.parts > 1 && !ring_polygons(r, cw, polygon)) return std::nullopt;
   // GDAL's order: the polygons as numbered, each its outer ring (its clockwise ring, or its
   // only ring) first, then its holes in the record's order.
   g.polygons = r.parts == 0 ? 0 : *std::max_element(polygon.begin(), polygon.end()) + 1;

@@ -320,6 +320,9 @@ std::optional<Organized> organize(const PolygonRings& r, const std::vector<std::
 // their own where none does. False, for GDAL to read the record, when organize() leaves the
 // sorting to GDAL, unless every ring runs clockwise.
 bool ring_polygons(const unsigned char* c, std::vector<std::uint32_t>& polygon);
+// The same for rings whose orientations() are `cw`.
+bool ring_polygons(const PolygonRings& r, const std::vector<std::int8_t>& cw,
+                   std::vector<std::uint32_t>& polygon);
 
 // A shapefile's features read by FID without GDAL, each flattened as the GDAL path flattens
 // the geometry GDAL's shapefile driver (that of GDAL 3.6, which loci-full loads) makes of it:

@@ -2308,7 +2308,16 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
                        batch_args + "/dev/stdin")
                   .out,
               expected.out);
-    for (const char* ext : {".shp", ".shx", ".dbf", ".shp.loci", "-windows.txt", ".txt"})
+    // Named as a descriptor (/dev/stdin), even a regular file goes to loci-full at once: outside
+    // Linux, opening it again shares the offset the front's read left at its end.
+    const std::string far_file = path("front-odd-far.txt");
+    std::ofstream(far_file) << "199,-1,201,1\n";
+    EXPECT_EQ(run_with(LOCI_EXE, batch_args + far_file).out, "1 0\n");
+    const CliRun named = run_with(front, batch_args + "/dev/stdin < " + shell_quote(far_file));
+    EXPECT_EQ(named.status, 1);
+    EXPECT_NE(named.out.find("loci is not installed whole"), std::string::npos) << named.out;
+    for (const char* ext :
+         {".shp", ".shx", ".dbf", ".shp.loci", "-windows.txt", ".txt", "-far.txt"})
       fs::remove(path(std::string("front-odd") + ext));
   }
   // A loci-full that cannot run is named as the file that failed.

@@ -113,8 +113,9 @@ struct LoadedIndex {
   bool features_here = false;
 };
 
-// Thrown by io/'s GDAL-free build (the `loci` front's) where the work needs GDAL, which that
-// process has not loaded; never by loci::io.
+// Thrown where the work needs GDAL by io/'s build without it (the library loci_io_lean, which
+// the `loci` front links), whose process has not loaded GDAL; never by the library built with
+// GDAL (the loci::io target).
 class NeedsGdal : public Error {
  public:
   NeedsGdal() : Error("this needs GDAL, which this process does not load") {}
