@@ -255,40 +255,15 @@ namespace detail {
 
 using namespace shp;
 
-struct ShapefilePolygons::Files {
-  Files(const std::string& shp_path, const std::string& shx_path, const std::string& dbf_path)
-      : path(shp_path),
-        shx(shx_path, nullptr, 4096),
-        shp(shp_path, nullptr, 64u << 10),
-        dbf(dbf_path, nullptr, 512) {}
-  std::string path;
-  ChunkReader shx, shp, dbf;
-  std::uint64_t count = 0;
-  DbfLayout dbf_layout{};
-};
-
 ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) : layer_(&layer) {
-  if constexpr (std::endian::native != std::endian::little) return;
   // The rules followed are those of GDAL 3.6 (Debian 12's), checked against it by the tests;
   // other versions, and the options that change how GDAL sorts rings, leave it to GDAL.
   if (std::atoi(GDALVersionInfo("VERSION_NUM")) / 10000 != 306) return;
   if (CPLGetConfigOption("OGR_ORGANIZE_POLYGONS", nullptr) ||
-      CPLTestBool(CPLGetConfigOption("OGR_DEBUG_ORGANIZE_POLYGONS", "NO")) || !is_shp_path(path))
+      CPLTestBool(CPLGetConfigOption("OGR_DEBUG_ORGANIZE_POLYGONS", "NO")))
     return;
-  const std::string shx_path = sibling(path, ".shx", ".SHX");
-  const std::string dbf_path = sibling(path, ".dbf", ".DBF");
-  if (shx_path.empty() || dbf_path.empty()) return;
-  auto f = std::make_unique<Files>(path, shx_path, dbf_path);
-  if (!f->shx.is_open() || !f->shp.is_open() || !f->dbf.is_open()) return;
-  const auto headers = shapefile_headers(f->shp, f->shx);
-  if (!headers || headers->file_type != 5) return;
-  f->count = headers->count;
-  if (layer.GetFeatureCount(FALSE) != GIntBig(f->count)) return;
-  // The .dbf's header only: opening costs the same however big the files (each read checks
-  // its record's deletion flag).
-  const auto layout = dbf_layout(f->dbf, f->count);
-  if (!layout) return;
-  f->dbf_layout = *layout;
+  auto f = RecordFiles::open(path);
+  if (!f || f->file_type() != 5 || layer.GetFeatureCount(FALSE) != GIntBig(f->count())) return;
   srs_ = layer.GetSpatialRef();
   files_ = std::move(f);
 }
@@ -296,25 +271,20 @@ ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) :
 ShapefilePolygons::~ShapefilePolygons() = default;
 
 std::unique_ptr<OGRGeometry> ShapefilePolygons::read(std::int64_t fid) {
-  if (!files_ || fid < 0 || std::uint64_t(fid) >= files_->count) return nullptr;
-  const unsigned char* deleted = files_->dbf_layout.deletion_flag(files_->dbf, std::uint64_t(fid));
-  if (!deleted || *deleted == '*') return nullptr;  // GDAL has no such feature
-  const unsigned char* e = files_->shx.get(100 + 8 * std::uint64_t(fid), 8);
-  if (!e) return nullptr;
-  const std::uint64_t offset = 2 * std::uint64_t(be32(e)), length = 2 * std::uint64_t(be32(e + 4));
-  if (offset < 100 || length < 44) return nullptr;
+  if (!files_) return nullptr;
+  const auto e = files_->entry(fid);  // none for a deleted record: GDAL has no such feature
+  if (!e || e->length < 44) return nullptr;
   // Only the record's header first: most records are not several rings.
-  const unsigned char* head = files_->shp.get(offset, 8 + 44);
-  if (!head || be32(head + 4) != be32(e + 4) || le32(head + 8) != 5 || le32(head + 8 + 36) < 2)
-    return nullptr;
-  const unsigned char* record = files_->shp.get(offset, 8 + length);
-  if (!record) return nullptr;
+  const unsigned char* head = files_->content(*e, 44);
+  if (!head || le32(head) != 5 || le32(head + 36) < 2) return nullptr;
+  const unsigned char* c = files_->content(*e, e->length);
+  if (!c) return nullptr;
   try {
-    if (!read_record(record + 8, length, 5, files_->path, fid).ok) return nullptr;
+    if (!read_record(c, e->length, 5, files_->path(), fid).ok) return nullptr;
   } catch (const Error&) {
     return nullptr;  // a bad coordinate: GDAL's geometry, as before
   }
-  auto g = build_polygons(record + 8);
+  auto g = build_polygons(c);
   if (g && srs_) g->assignSpatialReference(srs_);
   return g;
 }

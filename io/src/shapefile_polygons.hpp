@@ -16,6 +16,8 @@
 #include <memory>
 #include <string>
 
+#include "shapefile_records.hpp"
+
 namespace loci::io::detail {
 
 class ShapefilePolygons {
@@ -42,8 +44,7 @@ class ShapefilePolygons {
   OGRFeatureUniquePtr fetch(std::int64_t fid);
 
  private:
-  struct Files;
-  std::unique_ptr<Files> files_;
+  std::unique_ptr<shp::RecordFiles> files_;
   OGRLayer* layer_;
   OGRSpatialReference* srs_ = nullptr;
   bool geometry_ignored_ = false;

@@ -465,39 +465,53 @@ Location gdal_ring_location(const PolygonRings& r, std::uint32_t k, const Point2
   return crossings % 2 ? Location::inside : Location::outside;
 }
 
-struct ShapefileFeatures::Files {
-  Files(const std::string& shp_path, const std::string& shx_path, const std::string& dbf_path)
-      : path(shp_path),
-        shx(shx_path, nullptr, 4096),
-        shp(shp_path, nullptr, 64u << 10),
-        dbf(dbf_path, nullptr, 512) {}
-  std::string path;
-  ChunkReader shx, shp, dbf;
-  std::uint32_t file_type = 0;
-  std::uint64_t count = 0;
-  DbfLayout dbf_layout{};
-};
+RecordFiles::RecordFiles(const std::string& shp, const std::string& shx, const std::string& dbf)
+    : path_(shp),
+      shx_(shx, nullptr, 4096),
+      shp_(shp, nullptr, 64u << 10),
+      dbf_(dbf, nullptr, 512) {}
+
+std::unique_ptr<RecordFiles> RecordFiles::open(const std::string& path) {
+  if constexpr (std::endian::native != std::endian::little) return nullptr;
+  if (!is_shp_path(path)) return nullptr;
+  const std::string shx = sibling(path, ".shx", ".SHX"), dbf = sibling(path, ".dbf", ".DBF");
+  if (shx.empty() || dbf.empty()) return nullptr;
+  std::unique_ptr<RecordFiles> f(new RecordFiles(path, shx, dbf));
+  if (!f->shx_.is_open() || !f->shp_.is_open() || !f->dbf_.is_open()) return nullptr;
+  const auto headers = shapefile_headers(f->shp_, f->shx_);
+  if (!headers || kind_of(headers->file_type) == Kind::other) return nullptr;
+  f->file_type_ = headers->file_type;
+  f->count_ = headers->count;
+  // The .dbf's header only: opening costs the same however big the files (each read checks
+  // its record's deletion flag).
+  const auto layout = dbf_layout(f->dbf_, f->count_);
+  if (!layout) return nullptr;
+  f->dbf_layout_ = *layout;
+  return f;
+}
+
+std::optional<RecordFiles::Entry> RecordFiles::entry(std::int64_t fid) {
+  if (fid < 0 || std::uint64_t(fid) >= count_) return std::nullopt;
+  const unsigned char* deleted = dbf_layout_.deletion_flag(dbf_, std::uint64_t(fid));
+  if (!deleted || *deleted == '*') return std::nullopt;
+  const unsigned char* e = shx_.get(100 + 8 * std::uint64_t(fid), 8);
+  if (!e) return std::nullopt;
+  const Entry out{2 * std::uint64_t(be32(e)), 2 * std::uint64_t(be32(e + 4))};
+  if (out.offset < 100) return std::nullopt;
+  return out;
+}
+
+const unsigned char* RecordFiles::content(const Entry& e, std::uint64_t bytes) {
+  const unsigned char* record = shp_.get(e.offset, 8 + std::min(bytes, e.length));
+  if (!record || 2 * std::uint64_t(be32(record + 4)) != e.length) return nullptr;
+  return record + 8;
+}
 
 ShapefileFeatures::ShapefileFeatures(const std::string& path) {
 #if defined(LOCI_GDAL_SHAPEFILE_RULES)
-  if constexpr (std::endian::native != std::endian::little) return;
   // The options that change how GDAL sorts rings, whatever their value: then GDAL reads.
-  if (std::getenv("OGR_ORGANIZE_POLYGONS") || std::getenv("OGR_DEBUG_ORGANIZE_POLYGONS") ||
-      !is_shp_path(path))
-    return;
-  const std::string shx_path = sibling(path, ".shx", ".SHX");
-  const std::string dbf_path = sibling(path, ".dbf", ".DBF");
-  if (shx_path.empty() || dbf_path.empty()) return;
-  auto f = std::make_unique<Files>(path, shx_path, dbf_path);
-  if (!f->shx.is_open() || !f->shp.is_open() || !f->dbf.is_open()) return;
-  const auto headers = shapefile_headers(f->shp, f->shx);
-  if (!headers || kind_of(headers->file_type) == Kind::other) return;
-  f->file_type = headers->file_type;
-  f->count = headers->count;
-  const auto layout = dbf_layout(f->dbf, f->count);
-  if (!layout) return;
-  f->dbf_layout = *layout;
-  files_ = std::move(f);
+  if (std::getenv("OGR_ORGANIZE_POLYGONS") || std::getenv("OGR_DEBUG_ORGANIZE_POLYGONS")) return;
+  files_ = RecordFiles::open(path);
 #else
   (void)path;  // built with a GDAL whose rules this reader does not follow
 #endif
@@ -506,20 +520,16 @@ ShapefileFeatures::ShapefileFeatures(const std::string& path) {
 ShapefileFeatures::~ShapefileFeatures() = default;
 
 std::optional<FlatGeometry> ShapefileFeatures::read(std::int64_t fid) {
-  if (!files_ || fid < 0 || std::uint64_t(fid) >= files_->count) return std::nullopt;
-  Files& f = *files_;
-  const unsigned char* deleted = f.dbf_layout.deletion_flag(f.dbf, std::uint64_t(fid));
-  if (!deleted || *deleted == '*') return std::nullopt;
-  const unsigned char* e = f.shx.get(100 + 8 * std::uint64_t(fid), 8);
+  if (!files_) return std::nullopt;
+  RecordFiles& f = *files_;
+  const auto e = f.entry(fid);
   if (!e) return std::nullopt;
-  const std::uint64_t offset = 2 * std::uint64_t(be32(e)), length = 2 * std::uint64_t(be32(e + 4));
-  if (offset < 100) return std::nullopt;
-  const unsigned char* record = f.shp.get(offset, 8 + length);
-  if (!record || be32(record + 4) != be32(e + 4)) return std::nullopt;
-  const unsigned char* c = record + 8;
+  const std::uint64_t length = e->length;
+  const unsigned char* c = f.content(*e, length);
+  if (!c) return std::nullopt;
   RecordRead read;
   try {
-    read = read_record(c, length, f.file_type, f.path, fid);
+    read = read_record(c, length, f.file_type(), f.path(), fid);
   } catch (const Error&) {
     return std::nullopt;  // a bad coordinate: GDAL's path says so
   }
@@ -536,7 +546,7 @@ std::optional<FlatGeometry> ShapefileFeatures::read(std::int64_t fid) {
       g.points.push_back(point(xy + 16 * std::uint64_t(i)));
     g.parts.push_back({at, std::uint32_t(g.points.size()), kind, polygon});
   };
-  switch (kind_of(f.file_type)) {
+  switch (kind_of(f.file_type())) {
     case Kind::point:
       add_part(0, 1, PartKind::point, 0, c + 4);
       return g;
@@ -550,7 +560,7 @@ std::optional<FlatGeometry> ShapefileFeatures::read(std::int64_t fid) {
       return std::nullopt;
   }
   const PolygonRings r(c);
-  if (!is_polygon_type(f.file_type)) {
+  if (!is_polygon_type(f.file_type())) {
     for (std::uint32_t k = 0; k < r.parts; ++k)
       add_part(r.range(k).first, r.range(k).second, PartKind::line, 0, r.xy);
     return g;

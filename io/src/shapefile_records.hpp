@@ -324,6 +324,40 @@ bool ring_polygons(const unsigned char* c, std::vector<std::uint32_t>& polygon);
 bool ring_polygons(const PolygonRings& r, const std::vector<std::int8_t>& cw,
                    std::vector<std::uint32_t>& polygon);
 
+// A shapefile's files opened to read its records by FID, in any order: the .shp, .shx and .dbf
+// (found beside the .shp in either case) checked against each other when opened, each record
+// found through the .shx and checked against its own header when read; a record the .dbf
+// marks deleted is none (GDAL gives no feature for it).
+class RecordFiles {
+ public:
+  // Nullptr when `path` is not a .shp of a shape type the readers take, with its .shx and
+  // .dbf, all three agreeing on the count of records. Reads the headers only.
+  static std::unique_ptr<RecordFiles> open(const std::string& path);
+
+  const std::string& path() const { return path_; }
+  std::uint32_t file_type() const { return file_type_; }
+  std::uint64_t count() const { return count_; }
+
+  // Where record `fid`'s content lies in the .shp, and its length; nullopt for a FID out of
+  // range, a deleted record or an entry out of place.
+  struct Entry {
+    std::uint64_t offset, length;
+  };
+  std::optional<Entry> entry(std::int64_t fid);
+  // The first `bytes` (at most the length) of the record's content, valid until the next
+  // read; nullptr when the .shp does not hold them or the record's header disagrees with
+  // the .shx.
+  const unsigned char* content(const Entry& e, std::uint64_t bytes);
+
+ private:
+  RecordFiles(const std::string& shp, const std::string& shx, const std::string& dbf);
+  std::string path_;
+  ChunkReader shx_, shp_, dbf_;
+  std::uint32_t file_type_ = 0;
+  std::uint64_t count_ = 0;
+  DbfLayout dbf_layout_{};
+};
+
 // A shapefile's features read by FID without GDAL, each flattened as the GDAL path flattens
 // the geometry GDAL's shapefile driver (that of GDAL 3.6, which loci-full loads) makes of it:
 // a point or multipoint shape its points, a line shape its parts as lines, a polygon shape its
@@ -346,8 +380,7 @@ class ShapefileFeatures {
   std::optional<FlatGeometry> read(std::int64_t fid);
 
  private:
-  struct Files;
-  std::unique_ptr<Files> files_;
+  std::unique_ptr<RecordFiles> files_;
 };
 
 }  // namespace loci::io::detail::shp
