@@ -5,10 +5,14 @@
 // queries, the ids output, atomic files) calls GDAL only through the functions declared here
 // and those of the public headers listed below. The full library (loci::io) defines them with
 // GDAL; the `loci` front (cli/front.cpp), which does not link GDAL, is linked with
-// without_gdal.cpp instead, where each throws NeedsGdal, and hands any command that meets one
-// to `loci-full` before it has read its input or written anything. What changes while it
-// reads its queries (the layer, an output file appearing) is met as loci-full meets it where
-// that needs no GDAL, or refused (query_layer, refuse_replacing_layers in without_gdal.cpp).
+// without_gdal.cpp instead, where each throws NeedsGdal, except that a shapefile's features
+// are read there directly (shapefile_records.hpp) where they can be; the front hands any
+// command that meets NeedsGdal to `loci-full` before it has read its input or written
+// anything, or, per feature of a shapefile, before it has written anything, its queries
+// having come from the command line or a regular file that loci-full reads again. What
+// changes while it reads its queries (the layer, an output file appearing) is met as
+// loci-full meets it where that needs no GDAL, or refused (query_layer,
+// refuse_replacing_layers in without_gdal.cpp).
 //
 // Also on the seam, declared where their callers find them: read_items (layer_reader.hpp) and
 // refuse_replacing_layers (atomic_file.hpp). A core file that calls any other GDAL function
@@ -36,8 +40,9 @@ using loci::io::NeedsGdal;
 // without regard to case comes back as the layer spells it. Throws loci::Error as open_layer.
 std::string layer_name_in(const std::string& path, const std::string& name);
 
-// A layer's features by FID, each flattened for the exact tests; a shapefile's polygons of many
-// rings are built without GDAL's sorting of rings.
+// A layer's features by FID, each flattened for the exact tests; a shapefile's records are read
+// directly where the direct reader takes them, and its polygons of many rings built without
+// GDAL's sorting of rings.
 class FeatureReader {
  public:
   virtual ~FeatureReader() = default;

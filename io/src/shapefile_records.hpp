@@ -364,7 +364,7 @@ class RecordFiles {
 // rings, numbered by the polygon each bounds as the driver sorts them (ring_polygons), in the
 // order of its polygons, each outer ring before its holes. What this reader cannot tell as GDAL
 // would it leaves to GDAL (nullopt): a file it does not take, a deleted or out-of-range
-// record, an unusual or corrupt one, a bad coordinate, a ring fewer than 4 points, unclosed or
+// record, an unusual or corrupt one, a bad coordinate, a ring of fewer than 4 points, unclosed or
 // of zero area, a polygon record whose rings only GDAL sorts, and every record when
 // OGR_ORGANIZE_POLYGONS or OGR_DEBUG_ORGANIZE_POLYGONS is set or loci was built with another
 // GDAL. Reads the files' headers when made, then each record it is asked for.
