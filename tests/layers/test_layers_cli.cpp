@@ -2260,6 +2260,10 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
     ASSERT_EQ(from_file.status, 0) << from_file.err;
     EXPECT_EQ(piped.status, 0) << piped.out;
     EXPECT_EQ(piped.out, from_file.out) << layer;
+    // The front alone answers it, per feature too (copying the queries in memory first).
+    const CliRun alone_piped = run_with("cat " + shell_quote(points) + " | " + front, args);
+    EXPECT_EQ(alone_piped.status, 0) << alone_piped.out;
+    EXPECT_EQ(alone_piped.out, from_file.out) << layer;
   }
   // A shapefile record the direct reader leaves to GDAL (a hole starting on its outer ring)
   // hands a query per feature over when the query meets it, before anything is written;
@@ -2308,14 +2312,39 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
                        batch_args + "/dev/stdin")
                   .out,
               expected.out);
-    // Named as a descriptor (/dev/stdin), even a regular file goes to loci-full at once: outside
-    // Linux, opening it again shares the offset the front's read left at its end.
+    // Queries read once (a pipe, a file named as a descriptor) are copied in memory first: the
+    // front alone answers those that meet no such record, and hands over those that do (the
+    // whole program answered them above, from the copy).
     const std::string far_file = path("front-odd-far.txt");
     std::ofstream(far_file) << "199,-1,201,1\n";
     EXPECT_EQ(run_with(LOCI_EXE, batch_args + far_file).out, "1 0\n");
-    const CliRun named = run_with(front, batch_args + "/dev/stdin < " + shell_quote(far_file));
-    EXPECT_EQ(named.status, 1);
-    EXPECT_NE(named.out.find("loci is not installed whole"), std::string::npos) << named.out;
+    for (const std::string& from : {"/dev/stdin < " + shell_quote(far_file),
+                                    "--bbox-file=/dev/stdin < " + shell_quote(far_file)}) {
+      const std::string args = from[0] == '-' ? "query " + odd + " " + from : batch_args + from;
+      const CliRun named = run_with(front, args);
+      EXPECT_EQ(named.status, 0) << from << ": " << named.out;
+      EXPECT_EQ(named.out, "1 0\n") << from;
+    }
+    const CliRun piped_far =
+        run_with("cat " + shell_quote(far_file) + " | " + front, batch_args + "/dev/stdin");
+    EXPECT_EQ(piped_far.status, 0) << piped_far.out;
+    EXPECT_EQ(piped_far.out, "1 0\n");
+    const CliRun piped_met =
+        run_with("cat " + shell_quote(windows_file) + " | " + front, batch_args + "/dev/stdin");
+    EXPECT_EQ(piped_met.status, 1);
+    EXPECT_EQ(lines(piped_met.out).size(), 1u) << piped_met.out;
+    EXPECT_NE(piped_met.out.find("loci is not installed whole"), std::string::npos)
+        << piped_met.out;
+    // A bad line is named in the file as given, not in its copy.
+    const CliRun bad =
+        run_with("printf '199,-1,201,1\\nnot a window\\n' | " + front, batch_args + "/dev/stdin");
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_EQ(lines(bad.out).size(), 1u) << bad.out;
+    EXPECT_NE(bad.out.find("loci: error: /dev/stdin: line 2: "), std::string::npos) << bad.out;
+    // Nor is what cannot be read copied: loci-full says what it is.
+    const CliRun dir = run_with(front, batch_args + "/dev/");
+    EXPECT_EQ(dir.status, 1);
+    EXPECT_NE(dir.out.find("loci is not installed whole"), std::string::npos) << dir.out;
     for (const char* ext :
          {".shp", ".shx", ".dbf", ".shp.loci", "-windows.txt", ".txt", "-far.txt"})
       fs::remove(path(std::string("front-odd") + ext));
