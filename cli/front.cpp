@@ -52,9 +52,9 @@ struct CopyFailed : loci::Error {
 
 // A copy of the file `name` in memory, named so that a program this process becomes (exec)
 // opens it afresh: /proc/self/fd/N, the descriptor left open across exec. nullopt where
-// that cannot be made before anything was read (no memory files; `name` cannot be opened or
-// is a directory: loci-full says so). Throws loci::Error when reading fails midway (what was
-// read is gone), as CopyFailed.
+// that cannot be made before anything was read (no memory files or no /proc; `name` cannot be
+// opened or is a directory: loci-full says so). Throws loci::Error when reading fails midway (what
+// was read is gone), as CopyFailed.
 std::optional<std::string> copy_in_memory(const std::string& name) {
 #if defined(__linux__)
   const int in = ::open(name.c_str(), O_RDONLY | O_CLOEXEC);
@@ -63,7 +63,9 @@ std::optional<std::string> copy_in_memory(const std::string& name) {
   const int copy = ::fstat(in, &st) == 0 && !S_ISDIR(st.st_mode)
                        ? ::memfd_create("loci-queries", 0)  // not MFD_CLOEXEC: loci-full opens it
                        : -1;
-  if (copy < 0) {
+  const std::string copy_name = "/proc/self/fd/" + std::to_string(copy);
+  if (copy < 0 || ::access(copy_name.c_str(), R_OK) != 0) {  // no /proc: loci-full reads it
+    if (copy >= 0) ::close(copy);
     ::close(in);
     return std::nullopt;
   }
@@ -87,7 +89,7 @@ std::optional<std::string> copy_in_memory(const std::string& name) {
     }
   }
   ::close(in);
-  return "/proc/self/fd/" + std::to_string(copy);
+  return copy_name;
 #else
   (void)name;
   return std::nullopt;
