@@ -35,7 +35,8 @@ void fleet_window(sqlite3* db, const Registry& registry, std::span<sqlite3_value
     throw SqlError{SQLITE_MISMATCH, format_sql("%s: the window is inverted (%s > %s)", f,
                                                box.min[0] > box.max[0] ? "xmin" : "ymin",
                                                box.min[0] > box.max[0] ? "xmax" : "ymax")};
-  FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f);
+  const ReadHold hold(db);
+  FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f, hold);
   FleetState& state = fleet.current();
   const auto window = MovingWindow<2>::at(box, t);
   std::vector<FleetReport> hits;
@@ -63,7 +64,8 @@ void fleet_nearest(sqlite3* db, const Registry& registry, std::span<sqlite3_valu
   const char* f = "loci_fleet_nearest";
   const Point2 q{{coordinate_argument(args[1], f, "x"), coordinate_argument(args[2], f, "y")}};
   const std::size_t k = count_argument(args[3], f);
-  FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f);
+  const ReadHold hold(db);
+  FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f, hold);
   FleetState& state = fleet.current();
   const double t = args.size() > 4 ? number_argument(args[4], f, "t") : state.latest();
   if (state.size() == 0 || k == 0) return;
@@ -107,7 +109,8 @@ void conflicts(sqlite3* db, const Registry& registry, std::span<sqlite3_value* c
   const double horizon = number_argument(args[2], f, "H");
   if (within < 0) throw SqlError{SQLITE_MISMATCH, format_sql("%s: D must be >= 0", f)};
   if (horizon < 0) throw SqlError{SQLITE_MISMATCH, format_sql("%s: H must be >= 0", f)};
-  FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f);
+  const ReadHold hold(db);
+  FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f, hold);
   FleetState& state = fleet.current();
   const double now = args.size() > 3 ? number_argument(args[3], f, "now") : state.latest();
   if (state.size() == 0) return;

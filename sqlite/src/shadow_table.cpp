@@ -232,6 +232,33 @@ ShadowTable* Registry::find(std::string_view schema, std::string_view name) cons
   return nullptr;
 }
 
+ReadHold::ReadHold(sqlite3* db) {
+  for (int i = 0; const char* schema = sqlite3_db_name(db, i); ++i) {
+    if (i == 1 || sqlite3_txn_state(db, schema) != SQLITE_TXN_NONE) continue;
+    sqlite3_stmt* s = nullptr;
+    const std::string sql = format_sql("SELECT 1 FROM \"%w\".sqlite_schema", schema);
+    int rc = sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr);
+    if (rc == SQLITE_OK) rc = sqlite3_step(s);
+    if (rc == SQLITE_ROW) {
+      held_.push_back(s);
+      continue;
+    }
+    sqlite3_finalize(s);
+    if (rc != SQLITE_DONE) {  // SQLITE_DONE: an empty database, no table to read
+      const std::string what = format_sql("%s: %s", schema, sqlite3_errmsg(db));
+      for (sqlite3_stmt* h : held_)  // no destructor runs for a constructor that throws
+        sqlite3_finalize(h);
+      throw SqlError{rc, what};
+    }
+  }
+}
+
+ReadHold::~ReadHold() {
+  for (sqlite3_stmt* s : held_)
+    sqlite3_finalize(s);
+  held_.clear();
+}
+
 ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* name,
                              const char* function) {
   if (!name) throw SqlError{SQLITE_ERROR, format_sql("%s: the table name is NULL", function)};

@@ -98,6 +98,25 @@ struct Registry {
   ShadowTable* find(std::string_view schema, std::string_view name) const;
 };
 
+// Read transactions begun on a connection's databases that had none (temp aside, which no
+// other connection changes), by a statement stepped on each and kept so while this lives. A
+// function naming a table holds one while it reads it, as the statement calling it holds the
+// databases that statement reads: beginning one makes SQLite check its copy of the schema
+// against the file (another connection may have changed it; SQLite then reads it again and
+// disconnects the tables of the old one, before they are looked up, not while they are used)
+// and brings SQLITE_FCNTL_DATA_VERSION up to date (a commit by another connection is seen);
+// holding it keeps what is read consistent. Throws SqlError when a database cannot be read.
+class ReadHold {
+ public:
+  explicit ReadHold(sqlite3* db);
+  ~ReadHold();
+  ReadHold(const ReadHold&) = delete;
+  ReadHold& operator=(const ReadHold&) = delete;
+
+ private:
+  std::vector<sqlite3_stmt*> held_;
+};
+
 // The table `name`, connecting it if this connection has not yet; null when it exists but is
 // not a loci table. `name` is found as SQL finds a table name in FROM (temp, then main, then
 // the attached databases in the order attached), or "schema.table" in that schema. Throws
@@ -106,10 +125,12 @@ struct Registry {
 ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* name,
                              const char* function);
 
-// The table `name` of module T (RTreeTable, FleetTable, or ShadowTable for any); throws
-// SqlError naming `function` when there is none.
+// The table `name` of module T (RTreeTable, FleetTable, or ShadowTable for any), to be used
+// while `hold` (made before) lives; throws SqlError naming `function` when there is none.
 template <class T>
-T& table_named(sqlite3* db, const Registry& registry, const char* name, const char* function) {
+T& table_named(sqlite3* db, const Registry& registry, const char* name, const char* function,
+               const ReadHold& hold) {
+  (void)hold;
   if (auto* typed = dynamic_cast<T*>(connected_table(db, registry, name, function))) return *typed;
   throw SqlError{SQLITE_ERROR, format_sql("%s: %s is not a %s table", function, name, T::kModule)};
 }

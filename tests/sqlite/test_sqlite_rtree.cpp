@@ -605,6 +605,64 @@ TEST(SqliteRtreeSql, FunctionsFollowATableReplacedByAnotherConnection) {
   EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
 }
 
+// Another connection changing the schema (any table) or the rows of an attached database:
+// loci_check and the table functions read the schema and rows as they are now, never a table
+// object SQLite frees when it reads the schema again (loci_check, whose statement reads no
+// table, once crashed there), nor an attached table's index from before the commit.
+TEST(SqliteRtreeSql, FunctionsSeeOtherConnectionsSchemaChangesAndAttachedCommits) {
+  TempDir dir;
+  Db db(dir.file("s.db"));
+  db.exec(
+      "CREATE VIRTUAL TABLE t USING loci_rtree(id, minx, maxx, miny, maxy);"
+      "CREATE VIRTUAL TABLE f USING loci_fleet(id, t, x, y, vx, vy);"
+      "INSERT INTO t VALUES (1, 0, 0, 0, 0); INSERT INTO f VALUES (1, 0, 0, 0, 1, 0)");
+  const auto other = [&](const std::string& file, const std::string& sql) {
+    Db o(dir.file(file));
+    o.exec(sql);
+  };
+  for (const char* change : {"CREATE TABLE unrelated(a)", "DROP TABLE unrelated", "VACUUM"}) {
+    EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+    EXPECT_EQ(db.value("SELECT loci_check('f')"), "ok");
+    other("s.db", change);
+    EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok") << change;
+    other("s.db", std::string(change) == "VACUUM" ? "CREATE TABLE again(a)" : "VACUUM");
+    EXPECT_EQ(db.value("SELECT loci_check('f')"), "ok") << change;
+    EXPECT_EQ(db.value("SELECT id FROM loci_nearest('t', 5, 5, 1)"), "1") << change;
+    db.exec("DROP TABLE IF EXISTS again");
+  }
+  other("s.db", "DROP TABLE t");
+  EXPECT_NE(db.error_of("SELECT loci_check('t')").find("loci_check: no such table: t"),
+            std::string::npos)
+      << db.error_of("SELECT loci_check('t')");
+  // In an attached database, rows another connection commits are seen by the functions, and
+  // its schema changes too.
+  db.exec("ATTACH '" + dir.file("a.db") +
+          "' AS a; CREATE VIRTUAL TABLE a.u USING loci_rtree(id, minx, maxx, miny, maxy);"
+          "CREATE VIRTUAL TABLE a.g USING loci_fleet(id, t, x, y, vx, vy);"
+          "INSERT INTO a.u VALUES (1, 0, 0, 0, 0); INSERT INTO a.g VALUES (1, 0, 0, 0, 0, 0)");
+  EXPECT_EQ(db.rows("SELECT id, distance FROM loci_nearest('a.u', 0, 0, 10)"),
+            (std::vector<Row>{{"1", "0"}}));
+  EXPECT_EQ(db.rows("SELECT id FROM loci_fleet_window('a.g', -1, -1, 1, 1, 0)"),
+            (std::vector<Row>{{"1"}}));
+  other("a.db",
+        "INSERT INTO u VALUES (2, 3, 3, 4, 4); DELETE FROM u WHERE id = 1;"
+        "INSERT INTO g VALUES (2, 0, 0.5, 0.5, 0, 0); DELETE FROM g WHERE id = 1");
+  EXPECT_EQ(db.rows("SELECT id, distance FROM loci_nearest('a.u', 0, 0, 10)"),
+            (std::vector<Row>{{"2", "5"}}));
+  EXPECT_EQ(db.rows("SELECT id FROM loci_fleet_window('a.g', -1, -1, 1, 1, 0)"),
+            (std::vector<Row>{{"2"}}));
+  EXPECT_EQ(db.rows("SELECT id FROM loci_fleet_nearest('a.g', 0, 0, 5)"),
+            (std::vector<Row>{{"2"}}));
+  other("a.db", "CREATE TABLE unrelated(a)");
+  EXPECT_EQ(db.value("SELECT loci_check('a.u')"), "ok");
+  EXPECT_EQ(db.rows("SELECT id FROM loci_nearest('a.u', 0, 0, 10)"), (std::vector<Row>{{"2"}}));
+  other("a.db",
+        "DROP TABLE u; CREATE VIRTUAL TABLE u USING loci_rtree(id, minx, maxx, miny, maxy);"
+        "INSERT INTO u VALUES (7, 1, 1, 1, 1)");
+  EXPECT_EQ(db.rows("SELECT id FROM loci_nearest('a.u', 0, 0, 10)"), (std::vector<Row>{{"7"}}));
+  EXPECT_EQ(db.value("SELECT loci_check('a.u')"), "ok");
+}
+
 // A writer killed with SIGKILL in the middle of its transactions (including the repack at
 // commit) leaves database and index consistent: SQLite's journal puts the shadow tables back.
 TEST(SqliteRtreeSql, AWriterKilledMidTransactionLeavesItConsistent) {
