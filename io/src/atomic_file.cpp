@@ -130,6 +130,24 @@ bool is_special_path(const std::string& path) {
   return path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
 }
 
+// The descriptor of this process a path names (/dev/stdout, /dev/stderr, /dev/fd/N,
+// /proc/self/fd/N), -1 for any other path.
+int named_descriptor(const std::string& path) {
+  if (path == "/dev/stdout") return 1;
+  if (path == "/dev/stderr") return 2;
+  for (const char* prefix : {"/dev/fd/", "/proc/self/fd/"}) {
+    const std::size_t n = std::strlen(prefix);
+    if (path.size() <= n || path.compare(0, n, prefix) != 0 || path.size() - n > 9) continue;
+    int fd = 0;
+    for (std::size_t i = n; i < path.size(); ++i) {
+      if (path[i] < '0' || path[i] > '9') return -1;
+      fd = fd * 10 + (path[i] - '0');
+    }
+    return fd;
+  }
+  return -1;
+}
+
 // A file whose first bytes are those of an SQLite database (a GeoPackage) or a TIFF: one that
 // may hold several layers or raster data, which an output written over it would lose. Other
 // files are replaced without asking GDAL (a sidecar index being rewritten, a text output).
@@ -170,6 +188,14 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   const bool in_place = fs::is_character_file(st) || fs::is_fifo(st) || fs::is_socket(st) ||
                         (is_special_path(path) && fs::exists(st));
   if (in_place) {
+    // Written through the descriptor it names, where it names one of this process's: opened
+    // again, the file behind it (`> out.txt`) would be truncated and written from its start,
+    // over what others wrote into it before.
+    if (const int named = named_descriptor(path); named >= 0 && ::fcntl(named, F_GETFD) >= 0) {
+      fd_ = ::fcntl(named, F_DUPFD_CLOEXEC, 0);
+      if (fd_ < 0) throw cannot_write(path, errno);
+      return;
+    }
     fd_ = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
     if (fd_ < 0) throw cannot_write(path, errno);
     return;

@@ -588,6 +588,28 @@ TEST_F(BadInput, IndexWithOutputReplacesOnlyAnIndex) {
   fs::remove(beside);
 }
 
+// -o naming one of the process's descriptors (/dev/stdout, /dev/fd/N, /proc/self/fd/N) writes
+// through it: opened again, the file behind it was truncated and written from its start, over
+// what the shell had written there before (and leaving NUL bytes before what came after).
+TEST_F(BadInput, OutputNamedAsADescriptorWritesThroughIt) {
+  const std::string l = lines_layer();
+  const std::string fleet = write("one.csv", "id,t,x,y,vx,vy\n1,0,0,0,1,0\n");
+  const std::string out = path("through.txt");
+  const CliRun expected = run_loci("query " + shell_quote(l) + " --bbox -1000,-1000,1000,1000");
+  ASSERT_EQ(expected.status, 0) << expected.err;
+  for (const std::string& name : {"/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"}) {
+    for (const std::string& command :
+         {"query " + shell_quote(l) + " --bbox -1000,-1000,1000,1000 -o " + name,
+          "fleet query " + shell_quote(fleet) + " --bbox 0,0,1,1 -q -o " + name}) {
+      const std::string shell = "( echo before; " + std::string(LOCI_EXE) + " " + command +
+                                "; echo after ) > " + shell_quote(out);
+      ASSERT_EQ(std::system(shell.c_str()), 0) << command;
+      const std::string answer = command.rfind("fleet", 0) == 0 ? "1\n" : expected.out;
+      EXPECT_EQ(read_text(out), "before\n" + answer + "after\n") << command;
+    }
+  }
+}
+
 TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {
   const std::string l = write("huge.geojson", R"({"type":"FeatureCollection","features":[
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}},
