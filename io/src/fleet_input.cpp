@@ -129,7 +129,10 @@ std::string_view trimmed(std::string_view s) {
 // are numbers here: the caller decides what they mean.
 std::optional<double> number(std::string_view s) {
   s = trimmed(s);
-  if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+  if (!s.empty() && s[0] == '+') {
+    s.remove_prefix(1);  // from_chars takes no leading plus, nor a second sign after it
+    if (!s.empty() && (s[0] == '-' || s[0] == '+')) return std::nullopt;
+  }
   double d = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), d);
   if (s.empty() || r.ptr != s.data() + s.size()) return std::nullopt;
@@ -137,6 +140,12 @@ std::optional<double> number(std::string_view s) {
     return std::strtod(std::string(s).c_str(), nullptr);
   if (r.ec != std::errc()) return std::nullopt;
   return d;
+}
+
+// Whether a field read as an infinite number spells an infinity ("inf", "-Infinity"), rather
+// than a number beyond the range of doubles ("1e400").
+bool spells_infinity(std::string_view s) {
+  return s.find_first_of("iI") != std::string_view::npos;
 }
 
 std::optional<Id> whole_number(std::string_view s) {
@@ -534,6 +543,8 @@ FleetData read_fleet_csv(std::string_view text, const std::string& source) {
     auto num = [&](int col, const char* name) {
       const auto d = number(f[col]);
       if (!d) csv.fail(std::string(name) + " " + quoted(f[col]) + " is not a number");
+      if (std::isinf(*d) && !spells_infinity(f[col]))
+        csv.fail(std::string(name) + " " + quoted(f[col]) + " is beyond the range of doubles");
       if (!std::isfinite(*d)) csv.fail(std::string(name) + " is NaN or infinite");
       return *d;
     };
@@ -614,7 +625,9 @@ FleetData read_ais_csv(std::string_view text, const std::string& source) {
       }
       const auto d = number(f[col]);
       if (!d) csv.fail(std::string(name) + " " + quoted(f[col]) + " is not a number");
-      if (!std::isfinite(*d) && !skip) skip = SkipReason::not_a_number;
+      // A number beyond doubles is out of its field's range, below; NaN and "inf" are none.
+      if (!std::isfinite(*d) && !skip && (std::isnan(*d) || spells_infinity(f[col])))
+        skip = SkipReason::not_a_number;
       return *d;
     };
     const double lat = num(clat, "LAT"), lon = num(clon, "LON"), sog = num(csog, "SOG");
@@ -724,13 +737,16 @@ FleetData read_fleet(std::string_view text, const std::string& source) {
   CsvRecords csv(text, source);
   std::vector<std::string_view> f;
   if (!csv.next(f)) throw Error(source + ": empty file, expected a header line");
-  bool mmsi = false, date = false;
+  bool mmsi = false, date = false, id = false;
   for (auto name : f) {
-    const std::string n = lowered(name);
+    const std::string n = lowered(trimmed(name));
     mmsi |= n == "mmsi";
     date |= n == "basedatetime";
+    id |= n == "id";
   }
-  return mmsi && date ? read_ais_csv(text, source) : read_fleet_csv(text, source);
+  // AIS by its MMSI column, unless the file has the planar id column and no AIS date (then the
+  // AIS reader says which of its columns is missing, rather than the planar one).
+  return mmsi && (date || !id) ? read_ais_csv(text, source) : read_fleet_csv(text, source);
 }
 
 FleetData read_fleet_file(const std::string& path) {

@@ -86,7 +86,10 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t n, const 
     while (last > at && (text[last - 1] == ' ' || text[last - 1] == '\t' || text[last - 1] == '\r'))
       --last;
     if (first == std::string::npos || first >= last) throw bad();
-    if (text[first] == '+') ++first;  // from_chars takes no leading plus
+    if (text[first] == '+') {  // from_chars takes no leading plus, nor a sign after one
+      ++first;
+      if (first < last && (text[first] == '-' || text[first] == '+')) throw bad();
+    }
     double d = 0;
     const auto r = std::from_chars(text.data() + first, text.data() + last, d);
     if (r.ec == std::errc::result_out_of_range && r.ptr == text.data() + last &&

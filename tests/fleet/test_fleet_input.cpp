@@ -101,7 +101,10 @@ TEST(FleetCsv, MalformedInputIsOneLineErrorNamingFileAndLine) {
       {"id,t,x,y\n-1,0,0,0\n", "line 2: id '-1' is not a whole number"},
       {"id,t,x,y\n1,NaN,0,0\n", "line 2: t is NaN or infinite"},
       {"id,t,x,y\n1,0,inf,0\n", "line 2: x is NaN or infinite"},
-      {"id,t,x,y,vx,vy\n1,0,0,0,1e400,0\n", "line 2: vx is NaN or infinite"},
+      {"id,t,x,y,vx,vy\n1,0,0,0,1e400,0\n", "line 2: vx '1e400' is beyond the range of doubles"},
+      {"id,t,x,y,vx,vy\n1,0,0,0,-Infinity,0\n", "line 2: vx is NaN or infinite"},
+      {"id,t,x,y\n1,0,+-5,0\n", "line 2: x '+-5' is not a number"},
+      {"id,t,x,y\n1,++5,0,0\n", "line 2: t '++5' is not a number"},
       {"id,t,x,y\n1,0,2e150,0\n", "line 2: report has a position or velocity beyond 1e150"},
       {"id,t,x,y\n1,1e200,0,0\n", "line 2: report has a time beyond 1e150"},
       {"id,t,x,y\n1,0,1e150,0\n1,1e-300,-1e150,0\n", "line 2: the velocity derived"},
@@ -225,6 +228,21 @@ TEST(FleetAis, MalformedRowsAreErrorsNamingTheLine) {
   EXPECT_NE(error_of(h + "1,2023-01-01T00:00:00,55,10\n").find("line 2: 4 fields"),
             std::string::npos);
   EXPECT_NE(error_of("MMSI,BaseDateTime,LAT,LON,SOG\n").find("no column 'cog'"), std::string::npos);
+  EXPECT_NE(error_of(h + "1,2023-01-01T00:00:00,+-55,10,1,1\n").find("line 2: LAT '+-55' is not"),
+            std::string::npos);
+  // An AIS file whose date column is named otherwise is said to lack BaseDateTime (it was read
+  // as a planar file lacking `id`).
+  EXPECT_NE(error_of("MMSI,DateTime,LAT,LON,SOG,COG\n").find("no column 'basedatetime'"),
+            std::string::npos)
+      << error_of("MMSI,DateTime,LAT,LON,SOG,COG\n");
+  // A number beyond doubles is out of its field's range; NaN and infinities are not numbers.
+  const FleetData beyond = read_fleet(h + "1,2023-01-01T00:00:00,1e400,10,1,1\n" +
+                                          "2,2023-01-01T00:00:00,55,10,1e999,1\n" +
+                                          "3,2023-01-01T00:00:00,55,-inf,1,1\n",
+                                      "beyond");
+  EXPECT_EQ(beyond.skipped[SkipReason::lat_out_of_range], 1u);
+  EXPECT_EQ(beyond.skipped[SkipReason::sog_out_of_range], 1u);
+  EXPECT_EQ(beyond.skipped[SkipReason::not_a_number], 1u);
   EXPECT_NE(error_of("MMSI,BaseDateTime,LAT,LON,SOG,COG,Lat\n").find("column 'lat' twice"),
             std::string::npos);
   // Header only: no vessels, no frame.

@@ -636,7 +636,7 @@ TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {
   }
   for (const std::string& q : std::vector<std::string>{
            "--nearest 1e-400,0 -k 1", "--point 0.000" + std::string(400, '0') + "1,0",
-           "--point 0,1e-99999999999999999999"}) {
+           "--point 0,1e-99999999999999999999", "--bbox +-1,0,1,1", "--nearest 0,++1"}) {
     const CliRun r = run_loci("query " + shell_quote(ok) + " " + q);
     expect_one_line_error(r);
     EXPECT_EQ(r.err.find("1e150"), std::string::npos) << q << ": " << r.err;
