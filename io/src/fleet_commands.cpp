@@ -951,6 +951,16 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
     world.expand(at[i]);
     world.expand(to[i]);
   }
+  // The pairs' positions at their closest approach are drawn too (they may lie beyond the
+  // arrows: a turn reported later, a closest approach beyond the arrows' time).
+  std::vector<std::pair<Point2, Point2>> closest(found.size());
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    const FoundConflict& fc = found[i];
+    closest[i] = {shown(l, position(fc.ma, fc.c.approach.tcpa)),
+                  shown(l, position(fc.mb, fc.c.approach.tcpa))};
+    world.expand(closest[i].first);
+    world.expand(closest[i].second);
+  }
   const detail::Frame f = detail::frame_of(detail::drawn_world(world), o.width);
   std::vector<bool> conflicting(ids.size(), false);
   auto index_of = [&](Id id) {
@@ -964,10 +974,29 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
   for (const FoundConflict& fc : found)
     mark(fc.c.a), mark(fc.c.b);
 
+  // The layer under the fleet is read (and refused, when it is) before anything is written.
+  std::string linework;
+  if (!o.over.empty()) {
+    char* text = nullptr;
+    std::size_t size = 0;
+    std::FILE* mem = ::open_memstream(&text, &size);
+    if (!mem) throw std::bad_alloc();
+    try {
+      detail::write_linework(mem, f, o.over, o.over_layer, l.ais());
+    } catch (...) {
+      std::fclose(mem);
+      std::free(text);
+      throw;
+    }
+    const bool written = std::fclose(mem) == 0;
+    if (written) linework.assign(text, size);
+    std::free(text);
+    if (!written) throw std::bad_alloc();
+  }
   OutputFile out(o.out_path, fallback);
   std::FILE* svg = out.stream();
   detail::write_svg_head(svg, f);
-  if (!o.over.empty()) detail::write_linework(svg, f, o.over, o.over_layer, l.ais());
+  std::fwrite(linework.data(), 1, linework.size(), svg);
   std::fprintf(svg, "<g stroke=\"#2b6cb0\" stroke-width=\"0.8\" fill=\"none\">\n");
   for (std::size_t i = 0; i < at.size(); ++i)
     std::fprintf(svg, "<path d=\"M%.1f %.1fL%.1f %.1f\"/>\n", f.x(at[i][0]), f.y(at[i][1]),
@@ -982,17 +1011,19 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
             f.x(at[i][0]), f.y(at[i][1]), red ? 2.5 : 1.8, static_cast<unsigned long long>(ids[i]));
     std::fprintf(svg, "</g>\n");
   }
-  std::fprintf(svg, "<g stroke=\"#d62728\" stroke-width=\"1.2\">\n");
-  for (const FoundConflict& fc : found) {
-    const Conflict& c = fc.c;
-    const Point2 a = shown(l, position(fc.ma, c.approach.tcpa));
-    const Point2 b = shown(l, position(fc.mb, c.approach.tcpa));
+  std::fprintf(svg, "<g stroke=\"#d62728\" stroke-width=\"1.2\" stroke-linecap=\"round\">\n");
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    const Conflict& c = found[i].c;
+    const auto& [a, b] = closest[i];
+    const double x1 = f.x(a[0]), y1 = f.y(a[1]), x2 = f.x(b[0]), y2 = f.y(b[1]);
+    const std::string title = std::to_string(c.a) + " " + std::to_string(c.b) + ": dcpa " +
+                              num(c.approach.dcpa) + " at " + num(c.approach.tcpa);
+    // Closer than a pixel: a dot (a line that short, drawn round-capped and wide).
     std::fprintf(svg,
-                 "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"><title>%llu %llu: "
-                 "dcpa %s at %s</title></line>\n",
-                 f.x(a[0]), f.y(a[1]), f.x(b[0]), f.y(b[1]), static_cast<unsigned long long>(c.a),
-                 static_cast<unsigned long long>(c.b), num(c.approach.dcpa).c_str(),
-                 num(c.approach.tcpa).c_str());
+                 "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"%s><title>%s</title>"
+                 "</line>\n",
+                 x1, y1, x2, y2, std::hypot(x2 - x1, y2 - y1) < 1 ? " stroke-width=\"5\"" : "",
+                 title.c_str());
   }
   std::fprintf(svg, "</g>\n</svg>\n");
   out.commit();

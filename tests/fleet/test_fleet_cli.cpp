@@ -939,6 +939,33 @@ TEST_F(FleetCli, DrawShowsEveryObjectInForceAndEveryConflict) {
     EXPECT_EQ(lines(b.err).size(), 1u) << bad << ": " << b.err;
     EXPECT_FALSE(fs::exists(none)) << bad;
   }
+  // Drawn to stdout, a layer that cannot be read leaves stdout empty (the picture's head was
+  // written before the layer was opened).
+  const CliRun to_stdout = run_loci("fleet draw " + shell_quote(f) + " --over /no/such/layer.shp");
+  EXPECT_EQ(to_stdout.status, 1);
+  EXPECT_EQ(to_stdout.out, "");
+  // A pair's closest approach lies in the picture, also beyond the arrows' reach or after a
+  // turn reported later; one at a single point is a dot (round-capped), not an invisible line.
+  for (const auto& [fleet, flags] :
+       {std::pair{std::string("id,t,x,y,vx,vy\n1,0,0,0,1,1\n2,0,10,0,-1,1\n"),
+                  std::string(" --within 1 --horizon 10 --arrows 0")},
+        std::pair{std::string("id,t,x,y,vx,vy\n1,0,0,0,1,0\n1,5,5,0,0,-10\n2,0,100,100,0,0\n"
+                              "2,5,5,-100,0,10\n"),
+                  std::string(" --within 1 --horizon 10 --at 0")}}) {
+    const std::string file = write("cpa.csv", fleet);
+    const CliRun d = run_loci("fleet draw " + shell_quote(file) + flags + " -q");
+    ASSERT_EQ(d.status, 0) << d.err;
+    double width = 0, height = 0, x = 0, y = 0;
+    ASSERT_EQ(std::sscanf(d.out.c_str() + d.out.find("viewBox=\"0 0 "), "viewBox=\"0 0 %lf %lf",
+                          &width, &height),
+              2)
+        << d.out;
+    const std::size_t line = d.out.find("<line x1=\"");
+    ASSERT_NE(line, std::string::npos) << d.out;
+    ASSERT_EQ(std::sscanf(d.out.c_str() + line, "<line x1=\"%lf\" y1=\"%lf\"", &x, &y), 2);
+    EXPECT_TRUE(x >= 0 && x <= width && y >= 0 && y <= height) << flags << ": " << d.out;
+    EXPECT_NE(d.out.find("stroke-width=\"5\"><title>1 2: dcpa 0 at"), std::string::npos) << d.out;
+  }
   // Before any report: nothing to draw.
   const CliRun early =
       run_loci("fleet draw " + shell_quote(f) + " --at -5 -o " + shell_quote(none));
