@@ -336,10 +336,15 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
       const LinearSpan s = meets(m, MovingWindow<2>::during(box, pc.lo, pc.hi));
       if (s.empty()) return true;
       double t = s.lo;
-      if (const auto ll = reported_lonlat(l, pc.id, m, pc.lo); ll && m.v == Point2{}) {
-        // At rest over the piece: where it was reported, all along.
-        if (intersects(o.box, Box2::of_point(*ll))) hits.push_back({pc.id, pc.lo, m.p, 0, ll});
-        return true;
+      if (const auto ll = reported_lonlat(l, pc.id, m, pc.lo)) {
+        // At the piece's start where its report put it (at the report's time, or at rest all
+        // along): in the window by its reported lon/lat, as --at tests it (a window's edge
+        // through it holds it); at rest and outside, never in.
+        if (intersects(o.box, Box2::of_point(*ll))) {
+          hits.push_back({pc.id, pc.lo, position(m, pc.lo), 0, ll});
+          return true;
+        }
+        if (m.v == Point2{}) return true;
       }
       if (poly && !inverted) {
         const Segment2 path{position(m, pc.lo), position(m, pc.hi)};

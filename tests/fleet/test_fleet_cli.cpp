@@ -397,7 +397,11 @@ TEST_F(FleetCli, AisWindowEdgesHoldVesselsOnThem) {
       b[edge] = edge % 2 ? lat : lon;
       const std::string bbox = num(b[0]) + "," + num(b[1]) + "," + num(b[2]) + "," + num(b[3]);
       SCOPED_TRACE(id + " on the window " + bbox);
-      for (const char* during : {"", " --during 1672530000,1672531200"}) {
+      // Over intervals ending at the reports' time, reduced to it, and starting at it (the
+      // vessels moving away from the edge after).
+      for (const char* during :
+           {"", " --during 1672530000,1672531200", " --during 1672531200,1672531200",
+            " --during 1672531200,1672531800"}) {
         const CliRun r =
             run_loci("fleet query " + shell_quote(f) + " --bbox " + bbox + during + " -f csv -q");
         ASSERT_EQ(r.status, 0) << r.err;
@@ -413,6 +417,21 @@ TEST_F(FleetCli, AisWindowEdgesHoldVesselsOnThem) {
         EXPECT_TRUE(found) << during << "\n" << r.out;
       }
     }
+  // On the edge of a window a degree wide (whose edges in the local frame are curves, not the
+  // chords between its corners) at the time of its report, a vessel heading out of the window
+  // and one heading in are both in it over an interval starting then, as at that time.
+  const std::string wide = write("wide.csv",
+                                 "MMSI,BaseDateTime,LAT,LON,SOG,COG\n"
+                                 "211111111,2023-01-01T00:00:00,55.005,10,10,90\n"
+                                 "211111112,2023-01-01T00:00:00,57,14,0,0\n"
+                                 "211111113,2023-01-01T00:00:00,55.005,10,10,270\n");
+  for (const char* when :
+       {" --at 1672531200", " --during 1672531200,1672531200", " --during 1672531200,1672531800"}) {
+    const CliRun w =
+        run_loci("fleet query " + shell_quote(wide) + " --bbox 10,55,11,56" + when + " -q");
+    ASSERT_EQ(w.status, 0) << w.err;
+    EXPECT_EQ(w.out, "211111111\n211111113\n") << when;
+  }
   // Nearest-n shows them as reported too.
   const CliRun r = run_loci("fleet query " + shell_quote(f) + " --nearest 10,56 -k 4 -f csv -q");
   ASSERT_EQ(r.status, 0) << r.err;
