@@ -13,6 +13,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/index/moving/conflicts.hpp"
 #include "loci/index/moving/moving_scan.hpp"
+#include "loci/index/packed_rtree.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/exact.hpp"
 #include "svg.hpp"
@@ -112,24 +113,76 @@ FlatGeometry lonlat_window(const LocalFrame& frame, const Box2& b) {
   return g;
 }
 
-// The first time in [lo, hi] at which the straight path of m is inside the polygon g (a hit
-// known to meet it): lo when it starts inside, else where it first crosses an edge.
-double first_time_in(const FlatGeometry& g, const Motion2& m, double lo, double hi) {
-  const Point2 a = position(m, lo), b = position(m, hi);
-  if (meets(g, Box2::of_point(a)) || lo == hi) return lo;
-  double best = 1;
-  const double dx = b[0] - a[0], dy = b[1] - a[1];
-  for (std::size_t i = 0; i + 1 < g.points.size(); ++i) {
-    const Point2 p = g.points[i], q = g.points[i + 1];
-    const double ex = q[0] - p[0], ey = q[1] - p[1];
-    const double den = dx * ey - dy * ex;
-    if (den == 0) continue;
-    const double s = ((p[0] - a[0]) * ey - (p[1] - a[1]) * ex) / den;
-    const double u = ((p[0] - a[0]) * dy - (p[1] - a[1]) * dx) / den;
-    if (s >= 0 && s <= 1 && u >= 0 && u <= 1) best = std::min(best, s);
+// A window's polygon in the local frame (lonlat_window: one ring of up to 144,000 points),
+// its edges in a packed R-tree: a path is tested against the few edges near it, not all.
+class IndexedWindow {
+ public:
+  explicit IndexedWindow(const FlatGeometry& g) : g_(g), prepared_(g) {
+    std::vector<Box2> boxes;
+    for (std::size_t i = 0; i + 1 < g.points.size(); ++i) {
+      Box2 b = Box2::of_point(g.points[i]);
+      b.expand(g.points[i + 1]);
+      boxes.push_back(b);
+    }
+    edges_ = PackedRTree<2>::build(boxes);
   }
-  return lo + (hi - lo) * best;
-}
+  // Whether the segment s meets the polygon: meets(g, s).
+  bool meets(const Segment2& s) const {
+    if (prepared_.meets(s.a)) return true;  // inside, or on the boundary
+    bool met = false;
+    each_edge(s.box(), [&](const Segment2& e) { return !(met = intersects(e, s)); });
+    return met;
+  }
+  // The first parameter along s at which s meets the ring's edges, taken as lines (first_meet
+  // of the ring as a line layer); nullopt when none does.
+  std::optional<double> first_meet_of_edges(const Segment2& s) const {
+    std::optional<double> best;
+    each_edge(s.box(), [&](const Segment2& e) {
+      if (const auto m = first_meeting(e, s); m && (!best || m->t < *best)) best = m->t;
+      return true;
+    });
+    return best;
+  }
+  // The first time in [lo, hi] at which the straight path of m is inside the polygon (a hit
+  // known to meet it): lo when it starts inside, else where it first crosses an edge.
+  double first_time_in(const Motion2& m, double lo, double hi) const {
+    const Point2 a = position(m, lo), b = position(m, hi);
+    if (prepared_.meets(a) || lo == hi) return lo;
+    double best = 1;
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    // Edges whose boxes miss the path's by a hair could still pass the rounded test below.
+    Box2 reach = Box2::of_point(a);
+    reach.expand(b);
+    const double hair = 1e-9 * (std::abs(reach.min[0]) + std::abs(reach.max[0]) +
+                                std::abs(reach.min[1]) + std::abs(reach.max[1])) +
+                        1e-300;
+    reach = {{reach.min[0] - hair, reach.min[1] - hair},
+             {reach.max[0] + hair, reach.max[1] + hair}};
+    each_edge(reach, [&](const Segment2& e) {
+      const Point2 p = e.a, q = e.b;
+      const double ex = q[0] - p[0], ey = q[1] - p[1];
+      const double den = dx * ey - dy * ex;
+      if (den == 0) return true;
+      const double s = ((p[0] - a[0]) * ey - (p[1] - a[1]) * ex) / den;
+      const double u = ((p[0] - a[0]) * dy - (p[1] - a[1]) * dx) / den;
+      if (s >= 0 && s <= 1 && u >= 0 && u <= 1) best = std::min(best, s);
+      return true;
+    });
+    return lo + (hi - lo) * best;
+  }
+
+ private:
+  // f(edge) for each edge whose box meets `box`, until f returns false.
+  template <class F>
+  void each_edge(const Box2& box, F&& f) const {
+    edges_.query(box, [&](Id i, const Box2&) {
+      return f(Segment2{g_.points[std::size_t(i)], g_.points[std::size_t(i) + 1]});
+    });
+  }
+  const FlatGeometry& g_;
+  PreparedGeometry prepared_;
+  PackedRTree<2> edges_;
+};
 
 // A piece of an object's trajectory: the report in force over [lo, hi].
 struct Piece {
@@ -283,7 +336,7 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
   // frame; a window holding the antipode of the frame's centre holds the frame's edge, where
   // the azimuthal projection is singular: there the polygon's edges bound what lies outside
   // the window (`inverted`), and every object is a candidate.
-  std::optional<FlatGeometry> poly, ring;
+  std::optional<FlatGeometry> poly;
   bool inverted = false;
   Box2 box = o.box;
   if (l.ais()) {
@@ -295,9 +348,6 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
     inverted = intersects(o.box, Box2::of_point(antipode));
     if (inverted) {
       box = {{-kMaxCoordinate, -kMaxCoordinate}, {kMaxCoordinate, kMaxCoordinate}};
-      ring = poly;
-      ring->parts[0].kind = PartKind::line;
-      ring->polygons = 0;
     } else {
       // The edges are chords of the window's curved edges, which bulge out of them by far less
       // than this margin: the candidates hold every position the lon/lat test may take.
@@ -327,6 +377,8 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
     });
   } else {
     const auto [t1, t2] = *o.during;
+    std::optional<IndexedWindow> indexed;
+    if (poly) indexed.emplace(*poly);
     const std::vector<Piece> pieces = pieces_during(l.data.reports, t1, t2);
     FleetIndex ix;
     for (std::size_t i = 0; i < pieces.size(); ++i)
@@ -348,14 +400,14 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
       }
       if (poly && !inverted) {
         const Segment2 path{position(m, pc.lo), position(m, pc.hi)};
-        if (!meets(*poly, path)) return true;
-        t = first_time_in(*poly, m, pc.lo, pc.hi);
+        if (!indexed->meets(path)) return true;
+        t = indexed->first_time_in(m, pc.lo, pc.hi);
       } else if (poly) {
         // In the window unless strictly inside the polygon of what lies outside it.
         const Segment2 path{position(m, pc.lo), position(m, pc.hi)};
         if (in_window(path.a)) {
           t = pc.lo;
-        } else if (const auto at = first_meet(*ring, path)) {
+        } else if (const auto at = indexed->first_meet_of_edges(path)) {
           t = pc.lo + (pc.hi - pc.lo) * *at;
         } else {
           return true;
