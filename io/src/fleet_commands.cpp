@@ -330,6 +330,13 @@ std::optional<Point2> reported_lonlat(const Loaded& l, Id id, const Motion2& m, 
   return l.data.lonlat[std::size_t(it - r.begin())];
 }
 
+// Whether the lon/lat box holds the point, where longitudes -180 and 180 are one meridian.
+bool holds_lonlat(const Box2& box, const Point2& p) {
+  if (intersects(box, Box2::of_point(p))) return true;
+  const bool on_antimeridian = std::abs(p[0]) == 180;
+  return on_antimeridian && intersects(box, Box2::of_point(Point2{-p[0], p[1]}));
+}
+
 std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
   // AIS windows are lon/lat boxes; objects move in the local frame. A position is in the
   // window when its lon/lat is. Over an interval the window is the polygon of its edges in the
@@ -345,7 +352,7 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
     poly = lonlat_window(frame, o.box);
     const Point2 antipode{frame.lon0() > 0 ? frame.lon0() - 180 : frame.lon0() + 180,
                           -frame.lat0()};
-    inverted = intersects(o.box, Box2::of_point(antipode));
+    inverted = holds_lonlat(o.box, antipode);
     if (inverted) {
       box = {{-kMaxCoordinate, -kMaxCoordinate}, {kMaxCoordinate, kMaxCoordinate}};
     } else {
@@ -359,7 +366,7 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
   auto in_window = [&](const Point2& p) {
     if (!poly) return true;  // planar: the index query was exact
     try {
-      return intersects(o.box, Box2::of_point(l.data.frame->to_lonlat(p)));
+      return holds_lonlat(o.box, l.data.frame->to_lonlat(p));
     } catch (const Error&) {
       return false;  // beyond the frame's edge: no lon/lat
     }
@@ -371,8 +378,7 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
     ix.query(MovingWindow<2>::at(box, l.now), [&](Id id, const Motion2& m) {
       const Point2 p = position(m, l.now);
       const auto ll = reported_lonlat(l, id, m, l.now);
-      if (ll ? intersects(o.box, Box2::of_point(*ll)) : in_window(p))
-        hits.push_back({id, l.now, p, 0, ll});
+      if (ll ? holds_lonlat(o.box, *ll) : in_window(p)) hits.push_back({id, l.now, p, 0, ll});
       return true;
     });
   } else {
@@ -392,7 +398,7 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
         // At the piece's start where its report put it (at the report's time, or at rest all
         // along): in the window by its reported lon/lat, as --at tests it (a window's edge
         // through it holds it); at rest and outside, never in.
-        if (intersects(o.box, Box2::of_point(*ll))) {
+        if (holds_lonlat(o.box, *ll)) {
           hits.push_back({pc.id, pc.lo, position(m, pc.lo), 0, ll});
           return true;
         }

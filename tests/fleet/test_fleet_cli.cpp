@@ -432,6 +432,19 @@ TEST_F(FleetCli, AisWindowEdgesHoldVesselsOnThem) {
     ASSERT_EQ(w.status, 0) << w.err;
     EXPECT_EQ(w.out, "211111111\n211111113\n") << when;
   }
+  // Longitudes -180 and 180 are one meridian: a window reaching it from either side holds a
+  // vessel reported there under either spelling.
+  const std::string antimeridian = write("am.csv",
+                                         "MMSI,BaseDateTime,LAT,LON,SOG,COG\n"
+                                         "211111111,2023-01-01T00:00:00,10,-180,0,0\n"
+                                         "211111112,2023-01-01T00:00:00,10,180,0,0\n");
+  for (const char* bbox : {"179,9,180,11", "-180,9,-179,11"})
+    for (const char* when : {" --at 1672531200", " --during 1672531000,1672531300"}) {
+      const CliRun w =
+          run_loci("fleet query " + shell_quote(antimeridian) + " --bbox " + bbox + when + " -q");
+      ASSERT_EQ(w.status, 0) << w.err;
+      EXPECT_EQ(w.out, "211111111\n211111112\n") << bbox << when;
+    }
   // Nearest-n shows them as reported too.
   const CliRun r = run_loci("fleet query " + shell_quote(f) + " --nearest 10,56 -k 4 -f csv -q");
   ASSERT_EQ(r.status, 0) << r.err;
