@@ -113,6 +113,11 @@ void conflicts(sqlite3* db, const Registry& registry, std::span<sqlite3_value* c
   FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f, hold);
   FleetState& state = fleet.current();
   const double now = args.size() > 3 ? number_argument(args[3], f, "now") : state.latest();
+  try {
+    check_conflict_query(within, now, horizon);
+  } catch (const InvalidArgument& e) {
+    throw SqlError{SQLITE_MISMATCH, format_sql("%s: %s", f, e.what())};
+  }
   if (state.size() == 0) return;
   const std::vector<FleetReport> reports = fleet.in_force_at(now);
   std::vector<Id> ids;

@@ -471,6 +471,12 @@ TEST(SqliteFleetSql, BadInputIsAnSqlErrorWithAClearMessage) {
                   "too far for its distance"));
   EXPECT_EQ(db.value("SELECT id FROM loci_fleet_nearest('f', 0, 0, 1, 1e11)"), "1");
   EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_conflicts('f', 1, 1e160)"), "beyond 1e150"));
+  // A horizon or a time whose sum would overflow is refused as such (it was said to be a box
+  // of NaN, or an object standing still to move beyond 1e150).
+  EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_conflicts('f', 1, 9e307)"),
+                  "loci_conflicts: conflict horizon must be at most 1e300"));
+  EXPECT_TRUE(has(db.error_of("SELECT * FROM loci_conflicts('f', 1, 1e300, 1.7976931348623e308)"),
+                  "loci_conflicts: conflict time plus horizon is beyond the range of doubles"));
   // Refusals from the library name the function asked, as the functions' own errors do.
   for (const char* sql : {"SELECT * FROM loci_fleet_nearest('f', 0, 0, 2, 1e160)",
                           "SELECT * FROM loci_conflicts('f', 1, 1e160)"}) {

@@ -163,7 +163,11 @@ inline void check_conflict_query(double within, double now, double horizon) {
     throw InvalidArgument("conflict distance must be a finite number >= 0");
   if (!std::isfinite(horizon) || horizon < 0)
     throw InvalidArgument("conflict horizon must be a finite number >= 0");
+  // Beyond, the search's sums of times would overflow (a horizon of 9e307 did).
+  if (horizon > 1e300) throw InvalidArgument("conflict horizon must be at most 1e300");
   if (!std::isfinite(now)) throw InvalidArgument("conflict time is NaN or infinite");
+  if (!std::isfinite(now + horizon))
+    throw InvalidArgument("conflict time plus horizon is beyond the range of doubles");
 }
 
 namespace detail {
