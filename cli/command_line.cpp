@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <optional>
 #include <set>
 #include <string_view>
@@ -161,6 +162,10 @@ int run_command(const Command& c, int first, int argc, char** argv,
       throw loci::Error(std::string("cannot write output (") + std::strerror(errno ? errno : EIO) +
                         ")");
     return status;
+  } catch (const std::bad_alloc&) {  // its what() names no cause a user knows
+    std::fflush(stdout);
+    std::fprintf(stderr, "loci: error: out of memory\n");
+    return 1;
   } catch (const std::exception& e) {
     std::fflush(stdout);
     std::fprintf(stderr, "loci: error: %s\n", printable(e.what()).c_str());
