@@ -51,41 +51,41 @@ struct CopyFailed : loci::Error {
 };
 
 // A copy of the file `name` in memory, named so that a program this process becomes (exec)
-// opens it afresh: /proc/self/fd/N, the descriptor left open across exec. nullopt where
-// that cannot be made before anything was read (no memory files or no /proc; `name` cannot be
-// opened or is a directory: loci-full says so). Throws loci::Error when reading fails midway (what
-// was read is gone), as CopyFailed.
+// opens it afresh: /proc/self/fd/N, the descriptor left open across exec. nullopt where that
+// cannot be made, decided before `name` is opened (opening a FIFO takes its writer's lines):
+// no memory files or no /proc; `name` missing or a directory (loci-full says so). Throws
+// CopyFailed when reading or copying fails midway (what was read is gone).
 std::optional<std::string> copy_in_memory(const std::string& name) {
 #if defined(__linux__)
-  const int in = ::open(name.c_str(), O_RDONLY | O_CLOEXEC);
-  if (in < 0) return std::nullopt;
   struct stat st {};
-  const int copy = ::fstat(in, &st) == 0 && !S_ISDIR(st.st_mode)
-                       ? ::memfd_create("loci-queries", 0)  // not MFD_CLOEXEC: loci-full opens it
-                       : -1;
+  if (::stat(name.c_str(), &st) != 0 || S_ISDIR(st.st_mode)) return std::nullopt;
+  const int copy = ::memfd_create("loci-queries", 0);  // not MFD_CLOEXEC: loci-full opens it
+  if (copy < 0) return std::nullopt;
   const std::string copy_name = "/proc/self/fd/" + std::to_string(copy);
-  if (copy < 0 || ::access(copy_name.c_str(), R_OK) != 0) {  // no /proc: loci-full reads it
-    if (copy >= 0) ::close(copy);
-    ::close(in);
+  const int in =
+      ::access(copy_name.c_str(), R_OK) == 0 ? ::open(name.c_str(), O_RDONLY | O_CLOEXEC) : -1;
+  if (in < 0) {  // no /proc, or `name` gone meanwhile: nothing was read
+    ::close(copy);
     return std::nullopt;
   }
+  const auto fail = [&](const char* what, int error) {
+    ::close(in);
+    ::close(copy);
+    throw CopyFailed(name + ": " + what + " (" + std::strerror(error) + ")");
+  };
   char buf[1 << 16];
   for (;;) {
     const ssize_t n = ::read(in, buf, sizeof buf);
     if (n == 0) break;
-    if (n < 0 && errno == EINTR) continue;
-    bool written = n > 0;
-    for (ssize_t at = 0; written && at < n;) {
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail("cannot read the query file", errno);
+    }
+    for (ssize_t at = 0; at < n;) {
       const ssize_t w = ::write(copy, buf + at, std::size_t(n - at));
       if (w < 0 && errno == EINTR) continue;
-      written = w > 0;
-      at += w > 0 ? w : 0;
-    }
-    if (!written) {
-      const int error = errno;
-      ::close(in);
-      ::close(copy);
-      throw CopyFailed(name + ": cannot read the query file (" + std::strerror(error) + ")");
+      if (w <= 0) fail("cannot copy the query file into memory", w < 0 ? errno : EIO);
+      at += w;
     }
   }
   ::close(in);
@@ -152,7 +152,7 @@ bool answered_here() {
           name.rfind("/proc/", 0) == 0)
         once.push_back(file);
     }
-    g_loaded = loci::io::answers_without_gdal(query_options(a, false), true);
+    g_loaded = loci::io::answers_without_gdal(query_options(a, false));
     // Per feature, those are copied first, for loci-full to read again (or it is handed over
     // before any is read, where they cannot be).
     if (g_loaded && g_loaded->features_here && !once.empty() && !copy_query_files(c, once))

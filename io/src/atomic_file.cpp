@@ -167,6 +167,15 @@ bool may_hold_layers(const std::string& path) {
 }  // namespace
 
 AtomicFile::AtomicFile(const std::string& path) : path_(path) {
+  // Written through the descriptor it names, where it names one of this process's: opened
+  // again, the file behind it (`> out.txt`) would be truncated and written from its start,
+  // over what others wrote into it before; closed, there is nothing to write to (and no file
+  // is made in its place).
+  if (const int named = named_descriptor(path); named >= 0) {
+    fd_ = ::fcntl(named, F_DUPFD_CLOEXEC, 0);
+    if (fd_ < 0) throw cannot_write(path, errno == EINVAL ? EBADF : errno);
+    return;
+  }
   std::error_code ec;
   fs::path target = path;
   if (fs::is_symlink(fs::symlink_status(target, ec)) && !is_special_path(path)) {
@@ -188,14 +197,6 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   const bool in_place = fs::is_character_file(st) || fs::is_fifo(st) || fs::is_socket(st) ||
                         (is_special_path(path) && fs::exists(st));
   if (in_place) {
-    // Written through the descriptor it names, where it names one of this process's: opened
-    // again, the file behind it (`> out.txt`) would be truncated and written from its start,
-    // over what others wrote into it before.
-    if (const int named = named_descriptor(path); named >= 0 && ::fcntl(named, F_GETFD) >= 0) {
-      fd_ = ::fcntl(named, F_DUPFD_CLOEXEC, 0);
-      if (fd_ < 0) throw cannot_write(path, errno);
-      return;
-    }
     fd_ = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
     if (fd_ < 0) throw cannot_write(path, errno);
     return;

@@ -397,7 +397,9 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
       if (const auto ll = reported_lonlat(l, pc.id, m, pc.lo)) {
         // At the piece's start where its report put it (at the report's time, or at rest all
         // along): in the window by its reported lon/lat, as --at tests it (a window's edge
-        // through it holds it); at rest and outside, never in.
+        // through it holds it); at rest and outside, never in. Moving and outside, the path is
+        // tested against the window's chords below, which a position a hair outside a curved
+        // edge may meet at the start too.
         if (holds_lonlat(o.box, *ll)) {
           hits.push_back({pc.id, pc.lo, position(m, pc.lo), 0, ll});
           return true;

@@ -9,7 +9,8 @@
 // are read there directly (shapefile_records.hpp) where they can be; the front hands any
 // command that meets NeedsGdal to `loci-full` before it has read its input or written
 // anything, or, per feature of a shapefile, before it has written anything, its queries
-// having come from the command line or a regular file that loci-full reads again. What
+// coming from the command line, a regular file, or a copy in memory of a pipe's, which
+// loci-full reads again. What
 // changes while it reads its queries (the layer, an output file appearing) is met as
 // loci-full meets it where that needs no GDAL, or refused (query_layer,
 // refuse_replacing_layers in without_gdal.cpp).

@@ -348,7 +348,7 @@ LayerIndex load_index(const LoadOptions& o, std::string* origin, LayerGeometries
   return LayerIndex::build(std::move(items), o.structure.value_or(Structure::packed_hilbert));
 }
 
-std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options, bool rereadable) {
+std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options) {
   // An output file is written here only where nothing is yet (not even a dangling link): one
   // that is there may be a dataset of several layers, which GDAL tells (refuse_replacing_layers).
   std::error_code ec;
@@ -362,7 +362,7 @@ std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options, boo
     // records the direct reader takes (said from the headers, before the layer is hashed to
     // tell it fresh, which loci-full would do again).
     const Per per = Sidecar::open(path).info().per;
-    const bool features_here = !options.candidates && per != Per::segment && rereadable &&
+    const bool features_here = !options.candidates && per != Per::segment &&
                                detail::shp::ShapefileFeatures(options.load.layer_path).active();
     if (!options.candidates && per != Per::segment && !features_here) return std::nullopt;
     if (options.load.per && *options.load.per != per) return std::nullopt;

@@ -23,7 +23,7 @@ void check_function(sqlite3_context* ctx, int, sqlite3_value** argv) {
     auto& registry = *registry_of(sqlite3_user_data(ctx));
     const char* name = reinterpret_cast<const char*>(sqlite3_value_text(argv[0]));
     sqlite3* db = sqlite3_context_db_handle(ctx);
-    const ReadHold hold(db);
+    ReadHold hold;
     ShadowTable& t = table_named<ShadowTable>(db, registry, name, "loci_check", hold);
     const std::string verdict = t.check();
     sqlite3_result_text(ctx, verdict.c_str(), int(verdict.size()), SQLITE_TRANSIENT);

@@ -35,7 +35,7 @@ void fleet_window(sqlite3* db, const Registry& registry, std::span<sqlite3_value
     throw SqlError{SQLITE_MISMATCH, format_sql("%s: the window is inverted (%s > %s)", f,
                                                box.min[0] > box.max[0] ? "xmin" : "ymin",
                                                box.min[0] > box.max[0] ? "xmax" : "ymax")};
-  const ReadHold hold(db);
+  ReadHold hold;
   FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f, hold);
   FleetState& state = fleet.current();
   const auto window = MovingWindow<2>::at(box, t);
@@ -64,7 +64,7 @@ void fleet_nearest(sqlite3* db, const Registry& registry, std::span<sqlite3_valu
   const char* f = "loci_fleet_nearest";
   const Point2 q{{coordinate_argument(args[1], f, "x"), coordinate_argument(args[2], f, "y")}};
   const std::size_t k = count_argument(args[3], f);
-  const ReadHold hold(db);
+  ReadHold hold;
   FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f, hold);
   FleetState& state = fleet.current();
   const double t = args.size() > 4 ? number_argument(args[4], f, "t") : state.latest();
@@ -109,16 +109,16 @@ void conflicts(sqlite3* db, const Registry& registry, std::span<sqlite3_value* c
   const double horizon = number_argument(args[2], f, "H");
   if (within < 0) throw SqlError{SQLITE_MISMATCH, format_sql("%s: D must be >= 0", f)};
   if (horizon < 0) throw SqlError{SQLITE_MISMATCH, format_sql("%s: H must be >= 0", f)};
-  const ReadHold hold(db);
+  ReadHold hold;
   FleetTable& fleet = table_named<FleetTable>(db, registry, table_argument(args[0]), f, hold);
   FleetState& state = fleet.current();
   const double now = args.size() > 3 ? number_argument(args[3], f, "now") : state.latest();
+  if (state.size() == 0) return;  // no report: no latest time (and no pair)
   try {
     check_conflict_query(within, now, horizon);
   } catch (const InvalidArgument& e) {
     throw SqlError{SQLITE_MISMATCH, format_sql("%s: %s", f, e.what())};
   }
-  if (state.size() == 0) return;
   const std::vector<FleetReport> reports = fleet.in_force_at(now);
   std::vector<Id> ids;
   std::vector<Motion2> motions;

@@ -13,7 +13,7 @@ void nearest(sqlite3* db, const Registry& registry, std::span<sqlite3_value* con
   const char* name = reinterpret_cast<const char*>(sqlite3_value_text(args[0]));
   const Point2 p{{coordinate_argument(args[1], f, "x"), coordinate_argument(args[2], f, "y")}};
   const std::size_t k = count_argument(args[3], f);
-  const ReadHold hold(db);
+  ReadHold hold;
   RTreeTable& t = table_named<RTreeTable>(db, registry, name, f, hold);
   std::vector<Near> found;
   t.current().nearest(p, k, found);

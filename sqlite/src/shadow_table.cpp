@@ -232,36 +232,25 @@ ShadowTable* Registry::find(std::string_view schema, std::string_view name) cons
   return nullptr;
 }
 
-ReadHold::ReadHold(sqlite3* db) {
-  for (int i = 0; const char* schema = sqlite3_db_name(db, i); ++i) {
-    if (i == 1 || sqlite3_txn_state(db, schema) != SQLITE_TXN_NONE) continue;
-    sqlite3_stmt* s = nullptr;
-    const std::string sql = format_sql("SELECT 1 FROM \"%w\".sqlite_schema", schema);
-    int rc = sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr);
-    if (rc == SQLITE_OK) rc = sqlite3_step(s);
-    if (rc == SQLITE_ROW) {
-      held_.push_back(s);
-      continue;
-    }
-    sqlite3_finalize(s);
-    if (rc != SQLITE_DONE) {  // SQLITE_DONE: an empty database, no table to read
-      const std::string what = format_sql("%s: %s", schema, sqlite3_errmsg(db));
-      for (sqlite3_stmt* h : held_)  // no destructor runs for a constructor that throws
-        sqlite3_finalize(h);
-      throw SqlError{rc, what};
-    }
-  }
+void ReadHold::begin(sqlite3* db, const std::string& schema) {
+  if (held_ || sqlite3_stricmp(schema.c_str(), "temp") == 0 ||
+      sqlite3_txn_state(db, schema.c_str()) != SQLITE_TXN_NONE)
+    return;
+  const std::string sql = format_sql("SELECT 1 FROM \"%w\".sqlite_schema", schema.c_str());
+  int rc = sqlite3_prepare_v2(db, sql.c_str(), -1, &held_, nullptr);
+  if (rc == SQLITE_OK) rc = sqlite3_step(held_);
+  if (rc == SQLITE_ROW) return;
+  sqlite3_finalize(held_);
+  held_ = nullptr;
+  if (rc != SQLITE_DONE)  // SQLITE_DONE: no table there (the lookup says so)
+    throw SqlError{rc, format_sql("%s: %s", schema.c_str(), sqlite3_errmsg(db))};
 }
 
-ReadHold::~ReadHold() {
-  for (sqlite3_stmt* s : held_)
-    sqlite3_finalize(s);
-  held_.clear();
-}
+namespace {
 
-ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* name,
-                             const char* function) {
-  if (!name) throw SqlError{SQLITE_ERROR, format_sql("%s: the table name is NULL", function)};
+// The schema and table `name` names (see connected_table); throws SqlError naming `function`
+// when there is no such table.
+std::pair<std::string, std::string> resolved(sqlite3* db, const char* name, const char* function) {
   // "schema.table" where that schema exists and holds that table; otherwise the whole name is
   // a table's, looked up as SQL looks up an unqualified name.
   const std::string whole = name;
@@ -285,6 +274,25 @@ ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* 
     if (schema.empty())
       throw SqlError{SQLITE_ERROR, format_sql("%s: no such table: %s", function, name)};
   }
+  return {schema, table};
+}
+
+}  // namespace
+
+ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* name,
+                             const char* function, ReadHold& hold) {
+  if (!name) throw SqlError{SQLITE_ERROR, format_sql("%s: the table name is NULL", function)};
+  // Its database held first (main when the name is found nowhere: another connection may
+  // have made it there), then the name looked up again: holding it may have had SQLite read a
+  // schema another connection changed (the table dropped, or made again).
+  std::string first = "main";
+  try {
+    first = resolved(db, name, function).first;
+  } catch (const SqlError&) {
+  }
+  hold.begin(db, first);
+  const auto [schema, table] = resolved(db, name, function);
+  hold.begin(db, schema);  // when `first` was temp, which needs no hold, and is no longer
   if (ShadowTable* t = registry.find(schema, table)) return t;
   // Not connected on this connection yet: naming it in a statement connects it (or says what
   // is wrong with it, a missing shadow table for instance).

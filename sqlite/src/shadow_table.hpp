@@ -98,40 +98,44 @@ struct Registry {
   ShadowTable* find(std::string_view schema, std::string_view name) const;
 };
 
-// Read transactions begun on a connection's databases that had none (temp aside, which no
-// other connection changes), by a statement stepped on each and kept so while this lives. A
-// function naming a table holds one while it reads it, as the statement calling it holds the
-// databases that statement reads: beginning one makes SQLite check its copy of the schema
-// against the file (another connection may have changed it; SQLite then reads it again and
-// disconnects the tables of the old one, before they are looked up, not while they are used)
-// and brings SQLITE_FCNTL_DATA_VERSION up to date (a commit by another connection is seen);
-// holding it keeps what is read consistent. Throws SqlError when a database cannot be read.
+// A read transaction begun on the database of the table a function reads, when that database
+// had none, by a statement stepped on it and kept so while this lives. A function naming a
+// table holds one while it reads it, as a statement reading the table would: beginning it
+// makes SQLite check its copy of that schema against the file (another connection may have
+// changed it; SQLite then reads it again and disconnects the tables of the old one, before
+// they are looked up, not while they are used) and brings SQLITE_FCNTL_DATA_VERSION up to date
+// (a commit by another connection is seen); holding it keeps what is read consistent. Other
+// databases are left alone (one locked by another connection does not matter).
 class ReadHold {
  public:
-  explicit ReadHold(sqlite3* db);
-  ~ReadHold();
+  ReadHold() = default;
+  ~ReadHold() { sqlite3_finalize(held_); }
   ReadHold(const ReadHold&) = delete;
   ReadHold& operator=(const ReadHold&) = delete;
+  // Begins it on `schema` of db (temp aside: no other connection changes it); throws SqlError
+  // when that database cannot be read.
+  void begin(sqlite3* db, const std::string& schema);
 
  private:
-  std::vector<sqlite3_stmt*> held_;
+  sqlite3_stmt* held_ = nullptr;
 };
 
-// The table `name`, connecting it if this connection has not yet; null when it exists but is
-// not a loci table. `name` is found as SQL finds a table name in FROM (temp, then main, then
-// the attached databases in the order attached), or "schema.table" in that schema. Throws
-// SqlError naming `function` when there is no such table, or with SQLite's reason when the
-// table cannot be opened (a shadow table missing, say).
+// The table `name`, connecting it if this connection has not yet, its database held by `hold`
+// first; null when it exists but is not a loci table. `name` is found as SQL finds a table name in
+// FROM (temp, then main, then the attached databases in the order attached), or "schema.table" in
+// that schema. Throws SqlError naming `function` when there is no such table, or with SQLite's
+// reason when the table cannot be opened (a shadow table missing, say).
 ShadowTable* connected_table(sqlite3* db, const Registry& registry, const char* name,
-                             const char* function);
+                             const char* function, ReadHold& hold);
 
-// The table `name` of module T (RTreeTable, FleetTable, or ShadowTable for any), to be used
-// while `hold` (made before) lives; throws SqlError naming `function` when there is none.
+// The table `name` of module T (RTreeTable, FleetTable, or ShadowTable for any), its database
+// held by `hold` (begun there), to be used while `hold` lives; throws SqlError naming
+// `function` when there is none.
 template <class T>
 T& table_named(sqlite3* db, const Registry& registry, const char* name, const char* function,
-               const ReadHold& hold) {
-  (void)hold;
-  if (auto* typed = dynamic_cast<T*>(connected_table(db, registry, name, function))) return *typed;
+               ReadHold& hold) {
+  if (auto* typed = dynamic_cast<T*>(connected_table(db, registry, name, function, hold)))
+    return *typed;
   throw SqlError{SQLITE_ERROR, format_sql("%s: %s is not a %s table", function, name, T::kModule)};
 }
 

@@ -608,6 +608,11 @@ TEST_F(BadInput, OutputNamedAsADescriptorWritesThroughIt) {
       EXPECT_EQ(read_text(out), "before\n" + answer + "after\n") << command;
     }
   }
+  // Closed, the descriptor is no output: one line, exit 1 (no file is made in its place).
+  const CliRun closed = run_loci("query " + shell_quote(l) + " --bbox 0,0,1,1 -o /dev/fd/1 1>&-");
+  expect_one_line_error(closed);
+  EXPECT_NE(closed.err.find("cannot write /dev/fd/1 (Bad file descriptor)"), std::string::npos)
+      << closed.err;
 }
 
 TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {

@@ -408,6 +408,8 @@ TEST(SqliteFleetSql, BadInputIsAnSqlErrorWithAClearMessage) {
   EXPECT_TRUE(has(db.try_exec("CREATE VIRTUAL TABLE a USING loci_fleet(id, t, x, y, vy, vx)"),
                   "expected the columns"));
   db.exec("CREATE VIRTUAL TABLE f USING loci_fleet(ID, T, X, Y, VX, VY)");  // any case
+  // Empty: no latest time, and no pair (not an error about that time).
+  EXPECT_EQ(db.rows("SELECT * FROM loci_conflicts('f', 1, 10)").size(), 0u);
   EXPECT_TRUE(has(db.try_exec("INSERT INTO f VALUES (NULL, 0, 0, 0, 0, 0)"), "id is NULL"));
   EXPECT_TRUE(
       has(db.try_exec("INSERT INTO f VALUES ('a', 0, 0, 0, 0, 0)"), "id must be an integer"));

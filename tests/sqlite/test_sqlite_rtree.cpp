@@ -661,6 +661,18 @@ TEST(SqliteRtreeSql, FunctionsSeeOtherConnectionsSchemaChangesAndAttachedCommits
         "INSERT INTO u VALUES (7, 1, 1, 1, 1)");
   EXPECT_EQ(db.rows("SELECT id FROM loci_nearest('a.u', 0, 0, 10)"), (std::vector<Row>{{"7"}}));
   EXPECT_EQ(db.value("SELECT loci_check('a.u')"), "ok");
+  // Only the table's own database is read: another one, attached and locked by another
+  // connection, does not stand in the way.
+  db.exec("ATTACH '" + dir.file("b.db") + "' AS b; CREATE TABLE b.x(v)");
+  {
+    Db locker(dir.file("b.db"));
+    locker.exec("BEGIN EXCLUSIVE; INSERT INTO x VALUES (1)");
+    EXPECT_EQ(db.rows("SELECT id FROM loci_fleet_window('f', -1, -1, 1, 1, 0)"),
+              (std::vector<Row>{{"1"}}));
+    EXPECT_EQ(db.rows("SELECT id FROM loci_nearest('a.u', 0, 0, 10)"), (std::vector<Row>{{"7"}}));
+    EXPECT_EQ(db.value("SELECT loci_check('f')"), "ok");
+    locker.exec("COMMIT");
+  }
 }
 
 // A writer killed with SIGKILL in the middle of its transactions (including the repack at

@@ -144,8 +144,8 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 
 // The index query_layer answers `options` from without reading the layer through GDAL: a
 // fresh sidecar per segment (or for --candidates), or per feature of a shapefile whose
-// records the direct reader takes when `rereadable` (the queries can be read again, by the
-// command run in full, should a record need GDAL: see LoadedIndex::features_here), when ids
+// records the direct reader takes (the caller can then have the command run in full, reading
+// its queries again, should a record need GDAL: see LoadedIndex::features_here), when ids
 // go to stdout or to a file not there yet (one that is may be a dataset of several layers,
 // which GDAL tells); nullopt otherwise, and on any failure (the command run in full says what
 // is wrong). Reads no query file and writes nothing. For the `loci` front, which runs such queries
@@ -154,8 +154,7 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback);
 // queries were read) but checks again that the layer has not changed: changed, its index is
 // loaded again as loci-full loads it, and where that needs GDAL the query is refused as stale
 // (loci-full would name another layer when GDAL names the layer otherwise).
-std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options,
-                                                bool rereadable = false);
+std::optional<LoadedIndex> answers_without_gdal(const QueryOptions& options);
 
 struct ClipOptions {
   LoadOptions load;
