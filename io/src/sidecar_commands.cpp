@@ -224,9 +224,15 @@ std::string check_sidecar(const std::string& arg) {
                   " does not exist; run 'loci index " + arg + "'");
     path = beside;
     layer = arg;
-  } else if (path.size() > 5 && path.ends_with(".loci") &&
-             file_exists(path.substr(0, path.size() - 5))) {
-    layer = path.substr(0, path.size() - 5);
+  }
+  // A sidecar named after a layer (LAYER.loci) that is not there is checked alone, and says so.
+  std::string unchecked;
+  if (layer.empty() && path.size() > 5 && path.ends_with(".loci")) {
+    const std::string named = path.substr(0, path.size() - 5);
+    if (file_exists(named))
+      layer = named;
+    else
+      unchecked = ", not checked against " + named + " (not found)";
   }
   Sidecar sc = Sidecar::open(path);
   const SidecarInfo info = sc.info();
@@ -248,15 +254,19 @@ std::string check_sidecar(const std::string& arg) {
     if (what.rfind(path, 0) == 0) throw;
     throw Error(path + ": corrupt index file (" + what + "); run 'loci index' to rebuild it");
   }
+  // Queries trust an unchanged size, modification time and inode; check reads the layer's
+  // contents too (an edit of the same size with the time set back).
   Fingerprint now;
-  if (!layer.empty() && !still_fresh(layer, info.source, &now))
+  if (!layer.empty() &&
+      (!still_fresh(layer, info.source, &now) ||
+       (now = fingerprint_of(layer)).size != info.source.size || now.hash != info.source.hash))
     throw Error(path + ": intact but stale, " + layer + " changed since it was indexed (" +
                 stale_reason(info.source, now) + "); run 'loci index " + layer + "'");
   const auto& i = info;
   return path + ": ok, " + (i.packing == Packing::str ? "packed-str" : "packed-hilbert") + " per " +
          to_string(i.per) + ", layer " + i.layer_name + ", " + std::to_string(i.items) +
          " entries, " + std::to_string(chunks) + " chunks verified, " +
-         std::to_string(i.file_size) + " bytes";
+         std::to_string(i.file_size) + " bytes" + unchecked;
 }
 
 std::string default_layer_name(const std::string& path) {

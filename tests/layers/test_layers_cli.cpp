@@ -1916,6 +1916,20 @@ TEST_F(LayersCli, CheckSaysWhenTheLayerChangedSinceItWasIndexed) {
                                      " changed since it was indexed (contents changed); run "
                                      "'loci index " +
                                      layer + "'");
+  // An edit of the same size with the modification time set back, which queries do not see
+  // (they trust size, time and inode), is found by check, which reads the contents.
+  ASSERT_EQ(run_loci("index -q " + layer).status, 0);
+  const auto indexed_at = fs::last_write_time(layer);
+  text[at + 3] = text[at + 3] == '5' ? '6' : '5';
+  {
+    std::fstream same(layer, std::ios::in | std::ios::out | std::ios::binary);
+    same.seekp(std::streamoff(at + 3));
+    same.put(text[at + 3]);
+  }
+  fs::last_write_time(layer, indexed_at);
+  for (const std::string& arg : {layer, sidecar})
+    expect_error("check " + arg, sidecar + ": intact but stale, " + layer +
+                                     " changed since it was indexed (contents changed)");
   // A sidecar written elsewhere names no layer: its own checks only.
   const std::string elsewhere = path("checked-copy.idx");
   ASSERT_EQ(run_loci("index -q " + layer + " -o " + elsewhere).status, 0);
@@ -1923,6 +1937,13 @@ TEST_F(LayersCli, CheckSaysWhenTheLayerChangedSinceItWasIndexed) {
   const CliRun r = run_loci("check " + elsewhere);
   EXPECT_EQ(r.status, 0) << r.err;
   fs::remove(elsewhere);
+  // One named after a layer that is gone says it was checked alone.
+  ASSERT_EQ(run_loci("index -q " + layer).status, 0);
+  fs::remove(layer);
+  const CliRun alone = run_loci("check " + sidecar);
+  EXPECT_EQ(alone.status, 0) << alone.err;
+  EXPECT_NE(alone.out.find(", not checked against " + layer + " (not found)\n"), std::string::npos)
+      << alone.out;
   fs::remove(sidecar);
 }
 
