@@ -255,11 +255,16 @@ std::string check_sidecar(const std::string& arg) {
     throw Error(path + ": corrupt index file (" + what + "); run 'loci index' to rebuild it");
   }
   // Queries trust an unchanged size, modification time and inode; check reads the layer's
-  // contents too (an edit of the same size with the time set back).
+  // contents then too (an edit of the same size with the time set back). still_fresh read
+  // them already where those differ.
   Fingerprint now;
-  if (!layer.empty() &&
-      (!still_fresh(layer, info.source, &now) ||
-       (now = fingerprint_of(layer)).size != info.source.size || now.hash != info.source.hash))
+  bool fresh = layer.empty() || still_fresh(layer, info.source, &now);
+  if (!layer.empty() && fresh && now.mtime_ns == info.source.mtime_ns &&
+      now.inode == info.source.inode) {
+    now = fingerprint_of(layer);
+    fresh = now.size == info.source.size && now.hash == info.source.hash;
+  }
+  if (!fresh)
     throw Error(path + ": intact but stale, " + layer + " changed since it was indexed (" +
                 stale_reason(info.source, now) + "); run 'loci index " + layer + "'");
   const auto& i = info;
