@@ -3,6 +3,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
@@ -62,6 +64,77 @@ LoadOptions load_options(const Args& a, const std::string& layer) {
   if (a.has("--per")) o.per = parse_flag("--per", a.get("--per"), parse_per);
   o.progress = progress_bar(a, "indexing");
   return o;
+}
+
+std::string format_named_by(const std::string& out) {
+  const std::size_t slash = out.rfind('/');
+  const std::size_t dot = out.rfind('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = out.substr(dot + 1);
+  for (char& c : ext)
+    c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == "csv") return "csv";
+  if (ext == "geojson" || ext == "json") return "geojson";
+  if (ext == "svg") return "svg";
+  if (ext == "loci") return "loci";
+  static const char* const kOthers[] = {
+      "shp",      "shx",      "dbf",      "prj",     "cpg",   "qix",  "gpkg", "fgb",
+      "kml",      "kmz",      "gml",      "gpx",     "tab",   "mif",  "gdb",  "sqlite",
+      "topojson", "geojsonl", "geojsons", "parquet", "arrow", "xlsx", "ods",  "tif",
+      "tiff",     "png",      "jpg",      "jpeg",    "gif",   "webp", "pdf"};
+  for (const char* other : kOthers)
+    if (ext == other) return "." + ext;
+  return "";
+}
+
+namespace {
+
+std::string described(const std::string& format) {
+  if (format == "ids") return "feature ids";
+  if (format == "csv") return "CSV";
+  if (format == "geojson") return "GeoJSON";
+  if (format == "svg") return "an SVG drawing";
+  if (format == "loci") return "a sidecar index";
+  return "a " + format + " file";
+}
+
+const char* format_name(Format f) {
+  return f == Format::ids ? "ids" : f == Format::csv ? "csv" : "geojson";
+}
+
+[[noreturn]] void refuse_named_other(const std::string& out, const std::string& named,
+                                     const std::string& written, bool choice) {
+  throw UsageError("-o " + out + ": its name says " + described(named) + " but the output is " +
+                   described(written) +
+                   (choice ? " (name the file for what it holds, or choose -f)"
+                           : " (name the file for what it holds)"));
+}
+
+}  // namespace
+
+Format output_format(const Args& a, std::initializer_list<Format> choices, Format fallback) {
+  const std::string out = a.get("--output");
+  const std::string named = out.empty() ? "" : format_named_by(out);
+  bool offered = false;  // -f could choose what the name says
+  for (const Format f : choices)
+    offered = offered || named == format_name(f);
+  if (!a.has("--format")) {
+    for (const Format f : choices)
+      if (named == format_name(f)) return f;
+    if (!named.empty()) refuse_named_other(out, named, format_name(fallback), offered);
+    return fallback;
+  }
+  const Format f = parse_flag("--format", a.get("--format"), parse_format);
+  if (!named.empty() && named != format_name(f) && !(f == Format::ids && named == "csv"))
+    refuse_named_other(out, named, format_name(f), offered);
+  return f;
+}
+
+void check_output_name(const Args& a, const char* format) {
+  const std::string out = a.get("--output");
+  if (out.empty()) return;
+  const std::string named = format_named_by(out);
+  if (!named.empty() && named != format) refuse_named_other(out, named, format, false);
 }
 
 const Flag kLayer{"--layer", nullptr, "NAME",

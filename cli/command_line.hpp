@@ -7,12 +7,14 @@
 #pragma once
 
 #include <cstddef>
+#include <initializer_list>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
+#include "loci/io/output.hpp"
 
 namespace loci::cli {
 
@@ -76,6 +78,22 @@ auto parse_flag(const char* flag, const std::string& text, Parse parse) {
 }
 
 io::LoadOptions load_options(const Args& a, const std::string& layer);
+
+// What the name of an output file says it holds, by its extension: "csv" (.csv), "geojson"
+// (.geojson, .json), "svg" (.svg), "loci" (a sidecar), the extension itself (".shp") for a
+// dataset or image format the command line writes only through `loci clip`, or "" where it
+// says nothing (.txt, no extension, a device).
+std::string format_named_by(const std::string& out);
+
+// The answer format of a text output: -f where given, else the one -o's name says when
+// `choices` holds it (`loci query -o near.geojson` writes GeoJSON), else `fallback`. A name
+// saying another format than the one chosen is refused (an ids answer may go to a .csv), so
+// that no file says it is what it is not (`-o pairs.shp` holding CSV).
+io::Format output_format(const Args& a, std::initializer_list<io::Format> choices,
+                         io::Format fallback);
+
+// For an output of one format ("svg", "csv", "loci"): refused when -o's name says another.
+void check_output_name(const Args& a, const char* format);
 
 void print_command_help(const Command& c);
 

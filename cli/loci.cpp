@@ -61,6 +61,7 @@ int run_index(const Args& a) {
   o.layer_path = layer_arg(a, "index");
   o.layer_name = a.get("--layer");
   o.out_path = a.get("--output");
+  check_output_name(a, "loci");
   if (a.has("--structure"))
     o.structure = parse_flag("--structure", a.get("--structure"), parse_structure);
   const LoadOptions lo = load_options(a, o.layer_path);
@@ -128,7 +129,7 @@ int run_intersections(const Args& a) {
   else if (a.has("--layer2"))
     o.other_path = o.layer_path;
   o.other_name = a.get("--layer2");
-  o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
+  o.format = output_format(a, {Format::csv, Format::geojson}, Format::csv);
   o.pairs_only = a.has("--pairs-only");
   o.out_path = a.get("--output");
   if (a.has("--jobs"))
@@ -161,7 +162,7 @@ int run_join(const Args& a) {
       parse_join_predicate(t, o);
       return 0;
     });
-  o.format = parse_flag("--format", a.get("--format", "csv"), parse_format);
+  o.format = output_format(a, {Format::csv, Format::ids}, Format::csv);
   o.out_path = a.get("--output");
   o.progress = progress_bar(a, "joining");
   const std::size_t n = write_join(o, stdout);
@@ -177,6 +178,7 @@ int run_draw(const Args& a) {
   o.layer_name = a.get("--layer");
   o.index_path = a.get("--index");
   o.out_path = a.get("--output");  // empty: stdout
+  check_output_name(a, "svg");
   if (a.has("--levels") && a.has("--cells"))
     throw UsageError(
         "loci draw takes --levels (index nodes) or --cells (quadtree cells), not both");
@@ -260,7 +262,7 @@ int run_fleet_query(const Args& a) {
   if (a.has("--during"))
     o.during = parse_flag("--during", a.get("--during"),
                           [](const std::string& t) { return parse_range(t, "interval"); });
-  o.format = parse_flag("--format", a.get("--format", "ids"), parse_format);
+  o.format = output_format(a, {Format::ids, Format::csv, Format::geojson}, Format::ids);
   o.out_path = a.get("--output");
   print_fleet_run(a, fleet_query(o, stdout));
   return 0;
@@ -277,7 +279,7 @@ int run_fleet_conflicts(const Args& a) {
   const std::string format = a.get("--format", "csv");
   if (format != "csv" && format != "geojson")
     throw UsageError("--format: '" + format + "' for conflicts (choose csv or geojson)");
-  o.format = parse_format(format);
+  o.format = output_format(a, {Format::csv, Format::geojson}, Format::csv);
   o.out_path = a.get("--output");
   const FleetRun r = fleet_conflicts(o, stdout);
   print_fleet_run(a, r);
@@ -305,6 +307,7 @@ int run_fleet_generate(const Args& a) {
   if (a.has("--reports")) o.reports = parse_count("--reports", a.get("--reports"), 1, 100000);
   if (a.has("--interval")) o.interval = parse_nonnegative("--interval", a.get("--interval"));
   o.out_path = a.get("--output");
+  check_output_name(a, "csv");  // AIS files are CSV too
   o.progress = progress_bar(a, "generating");
   const std::size_t n = fleet_generate(o, stdout);
   if (!a.has("--quiet"))
@@ -326,6 +329,7 @@ int run_fleet_draw(const Args& a) {
   if (a.has("--arrows")) o.arrows = parse_nonnegative("--arrows", a.get("--arrows"));
   if (a.has("--width")) o.width = int(parse_count("--width", a.get("--width"), 16, 20000));
   o.out_path = a.get("--output");
+  check_output_name(a, "svg");
   const FleetDrawReport r = fleet_draw(o, stdout);
   print_fleet_run(a, r.run);
   if (!a.has("--quiet"))
@@ -349,6 +353,7 @@ int run_fleet_simulate(const Args& a) {
   if (a.has("--slack")) o.slack = parse_nonnegative("--slack", a.get("--slack"));
   o.from_scratch = a.has("--from-scratch");
   o.out_path = a.get("--output");
+  check_output_name(a, "csv");
   o.progress = progress_bar(a, "simulating");
   const FleetSimulateReport r = fleet_simulate(o, stdout);
   print_fleet_run(a, r.run);
@@ -403,7 +408,8 @@ const std::vector<Command>& commands() {
        "loci intersections LAYER [LAYER2] [-f csv|geojson] [--pairs-only] [-o OUT]",
        "where the layer's linework meets itself, or LAYER2's: feature pairs and points",
        {{"--format", "-f", "csv|geojson",
-         "CSV `fid_a,fid_b,x,y` (default) or GeoJSON points with both FIDs"},
+         "CSV `fid_a,fid_b,x,y` (default) or GeoJSON points with both FIDs (default: as -o's "
+         "name says, .csv or .geojson)"},
         {"--pairs-only", nullptr, nullptr, "only the feature pairs (`fid_a,fid_b`)"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         {"--jobs", "-j", "N", "threads (default: one per core; the rows do not depend on it)"},
@@ -429,7 +435,7 @@ const std::vector<Command>& commands() {
          "RIGHT are the same layer), with the distance"},
         {"--format", "-f", "csv|ids",
          "CSV `fid_left,fid_right` (plus `distance` for dwithin and --closest; default) or "
-         "`LEFT RIGHT` lines"},
+         "`LEFT RIGHT` lines (-o's name must not say another format)"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         kLayer,
         {"--layer2", nullptr, "NAME", "layer of RIGHT (default: its first)"},
@@ -472,7 +478,8 @@ const std::vector<Command>& commands() {
         {"--during", nullptr, "T1,T2", "objects in the window at some time of [T1, T2]"},
         {"--format", "-f", "ids|csv|geojson",
          "ids (default), CSV id,[distance,]t,x,y (AIS: id,[distance,distance_nm,]t,time_utc,"
-         "lon,lat, distance in metres), GeoJSON points"},
+         "lon,lat, distance in metres), GeoJSON points (default: as -o's name says, .csv or "
+         ".geojson)"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         kQuiet},
        "  loci fleet query fleet.csv --bbox 0,0,100,100 --at 30\n"
@@ -489,7 +496,7 @@ const std::vector<Command>& commands() {
          "followed)"},
         {"--format", "-f", "csv|geojson",
          "CSV id_a,id_b,tcpa,dcpa,t_enter,t_exit,... (default) or GeoJSON lines between the "
-         "two positions at tcpa"},
+         "two positions at tcpa (default: as -o's name says)"},
         {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
         kQuiet},
        "  loci fleet conflicts fleet.csv --within 5 --horizon 60\n"

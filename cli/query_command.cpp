@@ -67,7 +67,7 @@ QueryOptions query_options(const Args& a, bool read_queries) {
     o.queries.emplace_back(1, q);
   }
   o.candidates = a.has("--candidates");
-  o.format = parse_flag("--format", a.get("--format", "ids"), parse_format);
+  o.format = output_format(a, {Format::ids, Format::csv, Format::geojson}, Format::ids);
   o.out_path = a.get("--output");
   o.progress = progress_bar(a, "querying");
   if (a.has("--jobs"))
@@ -108,7 +108,8 @@ const Command& query_command() {
        {"--candidates", nullptr, nullptr,
         "the index's answer before the exact test (it holds the exact answer)"},
        {"--format", "-f", "ids|csv|geojson",
-        "output: FIDs (default), CSV with attributes, GeoJSON"},
+        "output: FIDs (default), CSV with attributes, GeoJSON (default: as -o's name says, "
+        ".csv or .geojson)"},
        {"--output", "-o", "OUT", "write to OUT (whole or not at all) instead of stdout", true},
        {"--jobs", "-j", "N", "threads for a batch file (default: one per core)"},
        kIndex,

@@ -21,6 +21,7 @@
 
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
+#include "loci/geom/predicates.hpp"
 #include "loci/io/commands.hpp"
 #include "shapefile_polygons.hpp"
 
@@ -71,6 +72,46 @@ std::unique_ptr<OGRGeometry> united_polygons(const OGRGeometry& g) {
   return std::unique_ptr<OGRGeometry>(all.UnionCascaded());
 }
 
+// A ring of a window the user wrote that is no ring: not closed, under four points, or
+// without area (its points on one line), said as such (GEOS calls each merely invalid).
+void refuse_malformed_rings(const OGRGeometry& window) {
+  std::vector<const OGRPolygon*> polygons;
+  if (wkbFlatten(window.getGeometryType()) == wkbPolygon)
+    polygons.push_back(window.toPolygon());
+  else
+    for (const OGRGeometry* part : *window.toGeometryCollection())
+      if (wkbFlatten(part->getGeometryType()) == wkbPolygon) polygons.push_back(part->toPolygon());
+  for (std::size_t p = 0; p < polygons.size(); ++p) {
+    int r = 0;
+    for (const OGRLinearRing* ring : *polygons[p]) {
+      const std::string which = "ring " + std::to_string(r + 1) + " of polygon " +
+                                std::to_string(p + 1) + " (" + (r == 0 ? "its shell" : "a hole") +
+                                ")";
+      ++r;
+      const int n = ring->getNumPoints();
+      if (n == 0) continue;
+      if (!ring->get_IsClosed())
+        throw InvalidGeometry("--wkt: " + which +
+                              " is not closed: a ring ends at the point it starts from");
+      if (n < 4)
+        throw InvalidGeometry("--wkt: " + which + " has " + std::to_string(n) +
+                              " points; a ring needs at least 4, the last repeating the first");
+      // On one line, decided exactly: the first point apart from the start and every point
+      // collinear with both (a ring that crosses itself can have an area of 0 too).
+      const Point2 a{ring->getX(0), ring->getY(0)};
+      int k = 1;
+      while (k < n && Point2{ring->getX(k), ring->getY(k)} == a)
+        ++k;
+      bool line = true;
+      for (int i = k + 1; line && i < n; ++i)
+        line = orientation(a, {ring->getX(k), ring->getY(k)}, {ring->getX(i), ring->getY(i)}) ==
+               Orientation::collinear;
+      if (line)
+        throw InvalidGeometry("--wkt: " + which + " has no area: its points lie on one line");
+    }
+  }
+}
+
 // The window as one valid polygonal geometry: the rectangle, the WKT, or the union of the
 // window layer's polygons; a rectangle of no width or height is a line or a point.
 std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o, std::string& system) {
@@ -85,6 +126,7 @@ std::unique_ptr<OGRGeometry> window_of(const ClipOptions& o, std::string& system
     // A window the user wrote is taken as written or refused: repairing it would choose an
     // answer (a hole reaching out of its shell, polygons that overlap: --window-layer unites
     // them).
+    if (!w->IsEmpty()) refuse_malformed_rings(*w);
     if (!w->IsEmpty() && !w->IsValid())
       throw InvalidGeometry(
           "--wkt: the window is not a valid polygon (rings that cross, a hole not inside its "

@@ -345,13 +345,15 @@ TEST_F(BadInput, TheInputLayerIsNeverOverwritten) {
   const std::string sidecar = read_text(l + ".loci"), other = read_text(path("other.loci"));
   for (const std::string& command : {"query " + shell_quote(l) + " --bbox 0,0,9,9",
                                      "clip " + shell_quote(l) + " --bbox 0,0,9,9"}) {
+    // (a text answer is refused sooner, by the name: a .loci file is no text)
+    const std::string why = command.rfind("clip", 0) == 0 ? "it is the index" : "says a sidecar";
     const CliRun own = run_loci(command + " -o " + shell_quote(l + ".loci"));
     expect_one_line_error(own);
-    EXPECT_NE(own.err.find("it is the index"), std::string::npos) << own.err;
+    EXPECT_NE(own.err.find(why), std::string::npos) << own.err;
     const CliRun given = run_loci(command + " --index " + shell_quote(path("other.loci")) + " -o " +
                                   shell_quote(path("other.loci")));
     expect_one_line_error(given);
-    EXPECT_NE(given.err.find("it is the index"), std::string::npos) << given.err;
+    EXPECT_NE(given.err.find(why), std::string::npos) << given.err;
   }
   EXPECT_EQ(read_text(l + ".loci"), sidecar);
   EXPECT_EQ(read_text(path("other.loci")), other);
@@ -563,13 +565,19 @@ namespace {
 // failing on it as not a regular file. The default LAYER.loci is replaced whatever it holds.
 TEST_F(BadInput, IndexWithOutputReplacesOnlyAnIndex) {
   const std::string l = lines_layer();
+  // (a layer named as one is refused by its name; named otherwise, by what it holds)
   const std::string other = write("other.geojson", R"({"type":"FeatureCollection","features":[
 {"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1,2]}}]})");
   const std::string before = read_text(other);
   CliRun r = run_loci("index " + shell_quote(l) + " -o " + shell_quote(other));
   expect_one_line_error(r);
-  EXPECT_NE(r.err.find("is not a loci index file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("its name says GeoJSON"), std::string::npos) << r.err;
   EXPECT_EQ(read_text(other), before);
+  const std::string unnamed = write("other-points", before);
+  r = run_loci("index " + shell_quote(l) + " -o " + shell_quote(unnamed));
+  expect_one_line_error(r);
+  EXPECT_NE(r.err.find("is not a loci index file"), std::string::npos) << r.err;
+  EXPECT_EQ(read_text(unnamed), before);
   const std::string fifo = path("index.fifo");
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   for (const std::string& device : {fifo, std::string("/dev/null")}) {
@@ -613,6 +621,56 @@ TEST_F(BadInput, OutputNamedAsADescriptorWritesThroughIt) {
   expect_one_line_error(closed);
   EXPECT_NE(closed.err.find("cannot write /dev/fd/1 (Bad file descriptor)"), std::string::npos)
       << closed.err;
+}
+
+// An output's name says what it holds: without -f the answer takes the format its name says
+// (.csv, .geojson, .json, in any case), and a name saying another format than the output's is
+// refused before anything is written (`join ... -o pairs.shp` wrote CSV named .shp, `draw -o
+// map.png` an SVG named .png).
+TEST_F(BadInput, OutputNamesSayWhatTheyHold) {
+  const std::string l = lines_layer();
+  const std::string fleet = write("two.csv", "id,t,x,y,vx,vy\n1,0,0,0,1,0\n2,0,1,0,-1,0\n");
+  const std::string q = "query " + shell_quote(l) + " --bbox -10,-10,10,10 -q";
+  ASSERT_EQ(run_loci(q + " -o " + shell_quote(path("a.csv"))).status, 0);
+  EXPECT_EQ(read_text(path("a.csv")), "fid,n\n0,1\n1,2\n");
+  ASSERT_EQ(run_loci(q + " -o " + shell_quote(path("a.GeoJSON"))).status, 0);
+  EXPECT_NE(read_text(path("a.GeoJSON")).find("\"FeatureCollection\""), std::string::npos);
+  ASSERT_EQ(run_loci(q + " -o " + shell_quote(path("a.txt"))).status, 0);
+  EXPECT_EQ(read_text(path("a.txt")), "0\n1\n");
+  ASSERT_EQ(run_loci(q + " -f ids -o " + shell_quote(path("ids.csv"))).status, 0);
+  EXPECT_EQ(read_text(path("ids.csv")), "0\n1\n");
+  ASSERT_EQ(run_loci("fleet query " + shell_quote(fleet) + " --bbox -1,-1,2,1 -q -o " +
+                     shell_quote(path("f.json")))
+                .status,
+            0);
+  EXPECT_NE(read_text(path("f.json")).find("\"FeatureCollection\""), std::string::npos);
+  struct Refused {
+    std::string command, out, says;
+  };
+  const std::string conflicts =
+      "fleet conflicts " + shell_quote(fleet) + " --within 1 --horizon 10 -q";
+  const std::vector<Refused> refused = {
+      {q, "x.shp", "its name says a .shp file but the output is feature ids"},
+      {q + " -f csv", "x.geojson", "its name says GeoJSON but the output is CSV"},
+      {q + " -f geojson", "x.csv", "its name says CSV but the output is GeoJSON"},
+      {q, "x.svg", "its name says an SVG drawing but the output is feature ids"},
+      {q, "x.loci", "its name says a sidecar index but the output is feature ids"},
+      {"join " + shell_quote(l) + " " + shell_quote(l) + " -p intersects -q", "pairs.geojson",
+       "its name says GeoJSON but the output is CSV"},
+      {"intersections " + shell_quote(l) + " -q", "x.gpkg", "its name says a .gpkg file"},
+      {"draw " + shell_quote(l) + " -q", "map.png", "but the output is an SVG drawing"},
+      {"index " + shell_quote(l) + " -q", "x.geojson", "but the output is a sidecar index"},
+      {conflicts, "c.svg", "its name says an SVG drawing but the output is CSV"},
+      {"fleet draw " + shell_quote(fleet) + " -q", "f.pdf", "its name says a .pdf file"},
+      {"fleet generate --count 3 -q", "g.geojson", "its name says GeoJSON but the output is CSV"},
+  };
+  for (const Refused& r : refused) {
+    const CliRun run = run_loci(r.command + " -o " + shell_quote(path(r.out)));
+    expect_one_line_error(run);
+    EXPECT_NE(run.err.find(r.says), std::string::npos) << r.command << "\n" << run.err;
+    EXPECT_FALSE(fs::exists(path(r.out))) << r.command;
+  }
+  EXPECT_TRUE(temporaries().empty());
 }
 
 TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {

@@ -1210,8 +1210,19 @@ TEST_F(LayersCli, OutputsRefuseToReplaceAFileHoldingOtherLayers) {
   for (const std::string& command :
        {"query " + u + " --bbox 1,1,2,2", "index " + u + " -q", "draw " + u + " -q",
         "join " + u + " " + u + " -p intersects -q", "intersections " + u + " -q"}) {
-    expect_error(command + " -o " + two,
-                 "holds 2 layers (alpha, beta), which writing the whole file would lose");
+    // (an index is refused sooner, by the name: a .gpkg is no sidecar; named otherwise, as
+    // the others)
+    if (command.rfind("index", 0) == 0) {
+      expect_error(command + " -o " + two, "its name says a .gpkg file");
+      const std::string unnamed = path("keep-data");
+      fs::copy_file(two, unnamed, fs::copy_options::overwrite_existing);
+      expect_error(command + " -o " + unnamed,
+                   "holds 2 layers (alpha, beta), which writing the whole file would lose");
+      EXPECT_EQ(fs::file_size(unnamed), size) << command;
+    } else {
+      expect_error(command + " -o " + two,
+                   "holds 2 layers (alpha, beta), which writing the whole file would lose");
+    }
     EXPECT_EQ(fs::file_size(two), size) << command;
   }
   EXPECT_EQ(read_with_ogr(two).geoms.size(), 1u);  // alpha, untouched
@@ -1240,10 +1251,17 @@ TEST_F(LayersCli, OutputsRefuseToReplaceAFileHoldingOtherLayers) {
   EXPECT_EQ(fs::file_size(shp), shp_size);
   EXPECT_EQ(fs::file_size(one), one_size);
   EXPECT_EQ(read_with_ogr(shp).geoms.size(), 1u);
-  // A dBase table is told by its header, not its name: an answer named .dbf is replaced.
+  // Under a name that says nothing, what a file holds decides.
+  const std::string unnamed = path("one-data");
+  fs::copy_file(one, unnamed);
+  expect_error("query " + u + " --bbox 1,1,2,2 -o " + unnamed,
+               "which this text output would replace");
+  EXPECT_EQ(fs::file_size(unnamed), one_size);
+  // A new file named as a dataset does not get a text answer either (an answer.dbf of CSV).
   const std::string named = path("answer.dbf");
-  for (int run = 0; run < 2; ++run)
-    EXPECT_EQ(run_loci("query " + u + " --bbox 1,1,2,2 -f csv -o " + named).status, 0) << run;
+  expect_error("query " + u + " --bbox 1,1,2,2 -f csv -o " + named,
+               "its name says a .dbf file but the output is CSV");
+  EXPECT_FALSE(fs::exists(named));
   const std::string text = path("answer.geojson");
   for (int run = 0; run < 2; ++run)
     ASSERT_EQ(run_loci("query " + u + " --bbox 1,1,2,2 -f geojson -o " + text).status, 0);
@@ -1301,11 +1319,20 @@ TEST_F(LayersCli, DrawOfASidecarRefusesItsLayerAsTheOutput) {
   EXPECT_EQ(fs::file_size(layer), layer_size);
   EXPECT_EQ(read_with_ogr(layer).geoms.size(), 1u);
   const auto sidecar_size = fs::file_size(layer + ".loci");
-  expect_error("draw " + layer + ".loci -q -o " + layer + ".loci", "refusing to write");
+  // A .loci name is refused for a drawing by its name; under a name that says nothing, the
+  // sidecar read is refused as such.
+  expect_error("draw " + layer + ".loci -q -o " + layer + ".loci", "its name says a sidecar");
   EXPECT_EQ(fs::file_size(layer + ".loci"), sidecar_size);
+  const std::string plain = path("drawn-index");
+  ASSERT_EQ(run_loci("index -q " + layer + " -o " + plain).status, 0);
+  const auto plain_size = fs::file_size(plain);
+  expect_error("draw " + plain + " -q -o " + plain, "refusing to write");
+  EXPECT_EQ(fs::file_size(plain), plain_size);
   // Drawing the layer reads its default sidecar: that is refused as the output too.
-  expect_error("draw " + layer + " -q -o " + layer + ".loci", "refusing to write");
+  expect_error("draw " + layer + " -q -o " + layer + ".loci", "its name says a sidecar");
   EXPECT_EQ(fs::file_size(layer + ".loci"), sidecar_size);
+  expect_error("draw " + layer + " --index " + plain + " -q -o " + plain, "refusing to write");
+  EXPECT_EQ(fs::file_size(plain), plain_size);
 }
 
 // A GeoPackage of the WKT geometries of a CSV (column WKT), as ogr2ogr converts it.
@@ -1607,6 +1634,19 @@ TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
   expect_error("clip " + u + " --wkt " + shell_quote("POLYGON((0 0,4 4,4 0,0 4,0 0))") + " -o " +
                    path("w.geojson"),
                "--wkt: the window is not a valid polygon");
+  // Rings that are no rings are said as such (not as rings that cross, or holes outside).
+  const std::pair<const char*, const char*> malformed[] = {
+      {"POLYGON((0 0,4 0,4 4,0 4))", "ring 1 of polygon 1 (its shell) is not closed"},
+      {"POLYGON((0 0,4 0,0 0))", "ring 1 of polygon 1 (its shell) has 3 points"},
+      {"POLYGON((0 0,4 0,2 0,0 0))", "ring 1 of polygon 1 (its shell) has no area"},
+      {"POLYGON((0 0,0 0,1 1,3 3,0 0))", "ring 1 of polygon 1 (its shell) has no area"},
+      {"POLYGON((0 0,9 0,9 9,0 9,0 0),(1 1,2 1,2 2,1 2))",
+       "ring 2 of polygon 1 (a hole) is not closed"},
+      {"MULTIPOLYGON(((0 0,1 0,1 1,0 0)),((5 5,6 5,7 5,5 5)))",
+       "ring 1 of polygon 2 (its shell) has no area"}};
+  for (const auto& [wkt, says] : malformed)
+    expect_error("clip " + u + " --wkt " + shell_quote(wkt) + " -o " + path("w.geojson"),
+                 std::string("--wkt: ") + says);
   EXPECT_FALSE(fs::exists(path("w.geojson")));
 }
 
