@@ -17,6 +17,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/fleet.hpp"
+#include "number_text.hpp"
 
 namespace loci::io {
 namespace {
@@ -129,10 +130,7 @@ std::string_view trimmed(std::string_view s) {
 // are numbers here: the caller decides what they mean.
 std::optional<double> number(std::string_view s) {
   s = trimmed(s);
-  if (!s.empty() && s[0] == '+') {
-    s.remove_prefix(1);  // from_chars takes no leading plus, nor a second sign after it
-    if (!s.empty() && (s[0] == '-' || s[0] == '+')) return std::nullopt;
-  }
+  if (!detail::drop_plus(s)) return std::nullopt;
   double d = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), d);
   if (s.empty() || r.ptr != s.data() + s.size()) return std::nullopt;

@@ -22,6 +22,7 @@
 #include "loci/io/atomic_file.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/sidecar.hpp"
+#include "number_text.hpp"
 #include "shapefile_records.hpp"
 
 namespace loci::io {
@@ -86,10 +87,9 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t n, const 
     while (last > at && (text[last - 1] == ' ' || text[last - 1] == '\t' || text[last - 1] == '\r'))
       --last;
     if (first == std::string::npos || first >= last) throw bad();
-    if (text[first] == '+') {  // from_chars takes no leading plus, nor a sign after one
-      ++first;
-      if (first < last && (text[first] == '-' || text[first] == '+')) throw bad();
-    }
+    std::string_view field(text.data() + first, last - first);
+    if (!detail::drop_plus(field)) throw bad();
+    first = std::size_t(field.data() - text.data());
     double d = 0;
     const auto r = std::from_chars(text.data() + first, text.data() + last, d);
     if (r.ec == std::errc::result_out_of_range && r.ptr == text.data() + last &&
