@@ -289,15 +289,22 @@ int run_fleet_conflicts(const Args& a) {
 }
 
 int run_fleet_generate(const Args& a) {
-  if (!a.positional.empty()) throw UsageError("loci fleet generate takes no FILE, only -o OUT");
+  if (!a.positional.empty())
+    throw UsageError("loci fleet generate takes no FILE (it writes -o OUT, or stdout)");
   FleetGenerateOptions o;
   if (!a.has("--count")) throw UsageError("loci fleet generate needs --count N");
-  if (!a.has("--output")) throw UsageError("loci fleet generate needs -o OUT");
   o.count = parse_count("--count", a.get("--count"), 1, 100000000);
   if (a.has("--seed")) o.seed = parse_count("--seed", a.get("--seed"), 0, std::size_t(-1) / 2);
+  o.along = a.get("--along");
+  // --along lays lanes: alone it asks for them, and with another distribution it would be
+  // unused.
   if (a.has("--distribution"))
     o.distribution = parse_flag("--distribution", a.get("--distribution"), parse_distribution);
-  o.along = a.get("--along");
+  else if (a.has("--along"))
+    o.distribution = FleetGenerateOptions::Distribution::lanes;
+  if (a.has("--along") && o.distribution != FleetGenerateOptions::Distribution::lanes)
+    throw UsageError("--along lays lanes: it goes with --distribution lanes, not " +
+                     a.get("--distribution"));
   if (a.has("--format")) o.format = parse_flag("--format", a.get("--format"), parse_fleet_format);
   if (a.has("--bbox")) o.bbox = parse_flag("--bbox", a.get("--bbox"), parse_bbox);
   if (a.has("--speed"))
@@ -311,8 +318,9 @@ int run_fleet_generate(const Args& a) {
   o.progress = progress_bar(a, "generating");
   const std::size_t n = fleet_generate(o, stdout);
   if (!a.has("--quiet"))
-    std::fprintf(stderr, "loci: %s of %s written into %s\n", counted(n, "report").c_str(),
-                 counted(o.count, "object").c_str(), printable(o.out_path).c_str());
+    std::fprintf(stderr, "loci: %s of %s written%s\n", counted(n, "report").c_str(),
+                 counted(o.count, "object").c_str(),
+                 o.out_path.empty() ? "" : (" into " + printable(o.out_path)).c_str());
   return 0;
 }
 
@@ -504,26 +512,27 @@ const std::vector<Command>& commands() {
        run_fleet_conflicts},
       {"fleet generate",
        "loci fleet generate --count N [--seed S] [--distribution uniform|clustered|lanes "
-       "--along LAYER] [--format csv|ais] [--bbox ...] [--speed MIN,MAX] [--time T0] -o OUT",
+       "--along LAYER] [--format csv|ais] [--bbox ...] [--speed MIN,MAX] [--time T0] [-o OUT]",
        "a synthetic fleet, in the planar CSV or the AIS CSV format",
        {{"--count", nullptr, "N", "objects (vessels) to generate"},
         {"--seed", nullptr, "S", "random seed (default 1)"},
         {"--distribution", nullptr, "uniform|clustered|lanes",
-         "where objects are: uniform (default), in clusters, or in lanes along --along's lines"},
+         "where objects are: uniform (default; lanes with --along), in clusters, or in lanes "
+         "along --along's lines"},
         {"--along", nullptr, "LAYER",
-         "line or polygon layer the lanes follow, off its lines and off its polygons (lon/lat "
-         "for AIS)"},
+         "line or polygon layer the lanes follow, off its lines, each course off its polygons "
+         "(lon/lat for AIS)"},
         {"--format", "-f", "csv|ais", "planar id,t,x,y,vx,vy (default) or MarineCadastre AIS"},
         {"--bbox", "-b", "XMIN,YMIN,XMAX,YMAX",
          "area (default 0,0,10000,10000, or the --along layer's extent; AIS 8,54.5,13,58 in "
          "lon/lat)"},
         {"--speed", nullptr, "MIN,MAX", "speed range (default 1,10 per time unit; AIS 5,20 knots)"},
         {"--time", nullptr, "T0",
-         "each object's last report at T0 or up to half an --interval before it, in whole time "
-         "units (default 0; AIS 2023-01-01T00:00:00)"},
+         "each object's last report at T0 or a whole number of time units before it, up to half "
+         "an --interval (default 0; AIS 2023-01-01T00:00:00)"},
         {"--reports", nullptr, "R", "reports per object (default 3)"},
         {"--interval", nullptr, "S", "time between an object's reports (default 60; AIS: >= 1)"},
-        {"--output", "-o", "OUT", "the fleet file"},
+        {"--output", "-o", "OUT", "the fleet file (whole or not at all) instead of stdout", true},
         kQuiet},
        "  loci fleet generate --count 1000 -o fleet.csv\n"
        "  loci fleet generate --count 300 --format ais --distribution lanes --along "

@@ -57,12 +57,15 @@ QueryOptions query_options(const Args& a, bool read_queries) {
   } else if (a.has("--bbox-file")) {
     o.queries = read_query_file(a.get("--bbox-file"), Query::Kind::bbox, k);
     o.numbered = true;
+    o.batch_kind = Query::Kind::bbox;
   } else if (a.has("--nearest-file")) {
     o.queries = read_query_file(a.get("--nearest-file"), Query::Kind::nearest, k);
     o.numbered = true;
+    o.batch_kind = Query::Kind::nearest;
   } else if (a.has("--point-file")) {
     o.queries = read_query_file(a.get("--point-file"), Query::Kind::point, k);
     o.numbered = true;
+    o.batch_kind = Query::Kind::point;
   } else {
     o.queries.emplace_back(1, q);
   }

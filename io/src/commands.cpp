@@ -74,6 +74,21 @@ std::string shell_word(const std::string& word) {
     q += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return q + "'";
 }
+
+// Whether `path` is an OGR VRT: a file describing layers whose features live in other files
+// or databases, which a fingerprint of the file does not see change.
+bool is_vrt(const std::string& path) {
+  // Only a regular file is read: opening a FIFO would wait for a writer (open_layer refuses
+  // it, with a message, once this says no).
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
+  std::ifstream f(path, std::ios::binary);
+  std::string head(256, '\0');
+  f.read(head.data(), std::streamsize(head.size()));
+  head.resize(std::size_t(f.gcount()));
+  return head.find("<OGRVRTDataSource") != std::string::npos;
+}
+
 }  // namespace
 
 std::string describe_layer(const std::string& layer_path, const std::string& layer_name,
@@ -104,6 +119,11 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   o << '\n';
   const std::string sidecar = default_sidecar_path(layer_path);
   o << "index:     ";
+  if (is_vrt(layer_path)) {
+    o << "none (a VRT is not indexed: its features live in its sources; loci query builds "
+         "an index in memory)\n";
+    return o.str();
+  }
   if (std::error_code ec; !std::filesystem::exists(sidecar, ec)) {
     // Of a dataset's other layers than its first, the command names the layer.
     const bool first = s.layer_names.empty() || s.layer_names.front() == s.layer_name;
@@ -133,24 +153,6 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
   }
   return o.str();
 }
-
-namespace {
-
-// Whether `path` is an OGR VRT: a file describing layers whose features live in other files
-// or databases, which a fingerprint of the file does not see change.
-bool is_vrt(const std::string& path) {
-  // Only a regular file is read: opening a FIFO would wait for a writer (open_layer refuses
-  // it, with a message, once this says no).
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
-  std::ifstream f(path, std::ios::binary);
-  std::string head(256, '\0');
-  f.read(head.data(), std::streamsize(head.size()));
-  head.resize(std::size_t(f.gcount()));
-  return head.find("<OGRVRTDataSource") != std::string::npos;
-}
-
-}  // namespace
 
 IndexReport index_layer(const IndexOptions& options) {
   if (is_vrt(options.layer_path))

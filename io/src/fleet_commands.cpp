@@ -826,28 +826,48 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
   };
   // Placing an object and writing its reports count alike.
   ProgressTicker ticker(o.progress, double(o.count) * double(1 + o.reports));
+  // In lanes, an object's course stays off the layer's polygons: at its reports, along each
+  // report's leg to the next (four points a leg) and from its last report on to t_last; else
+  // it is placed again. (A track runs from the last report back.)
+  auto off_land = [&](const std::vector<Out>& track) {
+    if (!lanes) return true;
+    for (std::size_t r = 0; r < track.size(); ++r) {
+      const Motion2 m{track[r].t, track[r].p, track[r].v};
+      const double until = r == 0 ? t_last : track[r - 1].t;
+      for (int k = 0; k <= (r == 0 ? 4 : 3); ++k)
+        if (lanes->on_land(position(m, m.t + (until - m.t) * k / 4))) return false;
+    }
+    return true;
+  };
+  std::vector<Out> track;
   for (std::size_t n = 0; n < o.count; ++n) {
     ticker.tick(double(n + 1));
-    const auto s = place();
-    if (!s)
-      throw Error("cannot place object " + std::to_string(n + 1) +
-                  " inside --bbox (the lanes or clusters may lie outside it)");
     const double speed = (vmin + (vmax - vmin) * unit(rng)) * (ais ? kKnot : 1.0);
     const Id id = ais ? Id(219000000 + n) : Id(n + 1);
-    // The last report is at (about) t_last at the placed position; earlier ones trace back
-    // along the course, turning a little between reports.
-    double heading = s->heading;
-    Point2 p = s->p;
-    double t = t_last - std::floor(o.interval * unit(rng) * 0.5);
-    for (std::size_t r = 0; r < o.reports; ++r) {
-      const Point2 v{speed * std::cos(heading), speed * std::sin(heading)};
-      check_generated(t, p, v);
-      rows.push_back({t, id, p, v});
-      heading += 0.05 * (unit(rng) - 0.5);
-      const Point2 back{speed * std::cos(heading), speed * std::sin(heading)};
-      p = {p[0] - back[0] * o.interval, p[1] - back[1] * o.interval};
-      t -= o.interval;
+    for (int attempt = 0;; ++attempt) {
+      const auto s = attempt < 1000 ? place() : std::nullopt;
+      if (!s)
+        throw Error("cannot place object " + std::to_string(n + 1) +
+                    (lanes ? " inside --bbox with its course off the --along layer's polygons"
+                           : " inside --bbox (the clusters may lie outside it)"));
+      // The last report is at (about) t_last at the placed position; earlier ones trace back
+      // along the course, turning a little between reports.
+      double heading = s->heading;
+      Point2 p = s->p;
+      double t = t_last - std::floor(o.interval * unit(rng) * 0.5);
+      track.clear();
+      for (std::size_t r = 0; r < o.reports; ++r) {
+        const Point2 v{speed * std::cos(heading), speed * std::sin(heading)};
+        check_generated(t, p, v);
+        track.push_back({t, id, p, v});
+        heading += 0.05 * (unit(rng) - 0.5);
+        const Point2 back{speed * std::cos(heading), speed * std::sin(heading)};
+        p = {p[0] - back[0] * o.interval, p[1] - back[1] * o.interval};
+        t -= o.interval;
+      }
+      if (off_land(track)) break;
     }
+    rows.insert(rows.end(), track.begin(), track.end());
   }
   std::sort(rows.begin(), rows.end(),
             [](const Out& a, const Out& b) { return a.t != b.t ? a.t < b.t : a.id < b.id; });

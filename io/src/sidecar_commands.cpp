@@ -429,7 +429,8 @@ QueryReport query_layer(const QueryOptions& options, std::FILE* fallback) {
         load_index(options.load, &report.index_origin, geometries.get()));
   }
   const LayerIndex& index = *loaded;
-  bool with_distance = false, with_point = false;
+  bool with_distance = options.batch_kind == Query::Kind::nearest;
+  bool with_point = false;
   for (const auto& [number, q] : options.queries) {
     with_distance |= q.kind == Query::Kind::within || q.kind == Query::Kind::nearest || q.first;
     with_point |= q.kind == Query::Kind::segment && !options.candidates;

@@ -673,6 +673,26 @@ TEST_F(BadInput, OutputNamesSayWhatTheyHold) {
   EXPECT_TRUE(temporaries().empty());
 }
 
+// A batch's CSV header is that of its kind of query, rows or none: an empty --nearest-file
+// lost its distance column.
+TEST_F(BadInput, EmptyQueryFilesGiveTheHeaderOfTheirKind) {
+  const std::string l = lines_layer();
+  const std::string empty = write("empty.txt", ""), one = write("one.txt", "0,0\n");
+  const std::string head[] = {"query,fid,distance,n", "query,fid,n", "query,fid,n"};
+  const char* files[] = {"--nearest-file", "--bbox-file", "--point-file"};
+  for (int i = 0; i < 3; ++i) {
+    const CliRun none =
+        run_loci("query " + shell_quote(l) + " -f csv " + files[i] + " " + shell_quote(empty));
+    ASSERT_EQ(none.status, 0) << none.err;
+    EXPECT_EQ(none.out, head[i] + "\n") << files[i];
+    if (i == 1) continue;  // (a point is no window)
+    const CliRun some =
+        run_loci("query " + shell_quote(l) + " -f csv " + files[i] + " " + shell_quote(one));
+    ASSERT_EQ(some.status, 0) << some.err;
+    EXPECT_EQ(lines(some.out).at(0), head[i]) << files[i];
+  }
+}
+
 TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {
   const std::string l = write("huge.geojson", R"({"type":"FeatureCollection","features":[
 {"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1,1]]}},

@@ -2140,6 +2140,11 @@ TEST_F(LayersCli, RefusesToIndexAVrtWhoseSourcesItCannotWatch) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("a VRT's features live in its sources"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(vrt + ".loci"));
+  // loci info does not suggest the command refused.
+  const CliRun info = run_loci("info " + vrt);
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("index:     none (a VRT is not indexed"), std::string::npos) << info.out;
+  EXPECT_EQ(info.out.find("loci index"), std::string::npos) << info.out;
   EXPECT_EQ(run_loci("query " + vrt + " --bbox 0,0,2,2").out, "1\n");
   std::ofstream(src) << "id,WKT\n1,\"POINT (9 9)\"\n2,\"POINT (1 1)\"\n";
   EXPECT_EQ(run_loci("query " + vrt + " --bbox 0,0,2,2").out, "2\n");

@@ -124,7 +124,10 @@ class NeedsGdal : public Error {
 struct QueryOptions {
   LoadOptions load;
   std::vector<std::pair<std::size_t, Query>> queries;  // number, query
-  bool numbered = false;    // batch output: every row starts with the query number
+  bool numbered = false;  // batch output: every row starts with the query number
+  // A batch's kind of query, known even when its file holds none (the CSV header's columns
+  // depend on it, not on whether there are rows).
+  std::optional<Query::Kind> batch_kind;
   bool candidates = false;  // box-level answers only
   Format format = Format::ids;
   std::string out_path;  // empty: `fallback`
