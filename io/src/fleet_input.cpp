@@ -174,6 +174,16 @@ struct Header {
   }
 };
 
+// An AIS column's name as MarineCadastre spells it in either of its headers: `BaseDateTime`,
+// `LAT`, `LON` (to 2023) or `base_date_time`, `latitude`, `longitude` (since 2024), any case.
+std::string ais_name(std::string_view name) {
+  std::string n = lowered(name);
+  std::erase(n, '_');
+  if (n == "latitude") return "lat";
+  if (n == "longitude") return "lon";
+  return n;
+}
+
 Header read_header(CsvRecords& csv, const std::string& source) {
   std::vector<std::string_view> fields;
   if (!csv.next(fields)) throw Error(source + ": empty file, expected a header line");
@@ -578,7 +588,9 @@ FleetData read_fleet_csv(std::string_view text, const std::string& source) {
 FleetData read_ais_csv(std::string_view text, const std::string& source) {
   static const char* kHeader = "MMSI,BaseDateTime,LAT,LON,SOG,COG,...";
   CsvRecords csv(text, source);
-  const Header h = read_header(csv, source);
+  Header h = read_header(csv, source);
+  for (std::string& name : h.names)
+    name = ais_name(name);
   const int cm = require(h, csv, "mmsi", kHeader), cd = require(h, csv, "basedatetime", kHeader),
             clat = require(h, csv, "lat", kHeader), clon = require(h, csv, "lon", kHeader),
             csog = require(h, csv, "sog", kHeader), ccog = require(h, csv, "cog", kHeader);
@@ -737,7 +749,7 @@ FleetData read_fleet(std::string_view text, const std::string& source) {
   if (!csv.next(f)) throw Error(source + ": empty file, expected a header line");
   bool mmsi = false, date = false, id = false;
   for (auto name : f) {
-    const std::string n = lowered(trimmed(name));
+    const std::string n = ais_name(trimmed(name));
     mmsi |= n == "mmsi";
     date |= n == "basedatetime";
     id |= n == "id";

@@ -527,6 +527,39 @@ TEST_F(FleetCli, AisConflictsAndLonLatWindowsMatchBruteForce) {
   }
 }
 
+// MarineCadastre's header since 2024 (`mmsi,base_date_time,longitude,latitude,...`, longitude
+// first, dates with a space) reads as its earlier one: the sample rewritten so answers alike.
+TEST_F(FleetCli, AisHeadersOfBothSpellingsReadAlike) {
+  std::istringstream in(read_text(kSample));
+  std::string out =
+      "mmsi,base_date_time,longitude,latitude,sog,cog,heading,vessel_name,imo,"
+      "call_sign,vessel_type,status,length,width,draft,cargo,transceiver\n";
+  std::string line;
+  std::getline(in, line);  // the earlier header
+  ASSERT_EQ(line.rfind("MMSI,BaseDateTime,LAT,LON,", 0), 0u) << line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string v; std::getline(fields, v, ',');)
+      f.push_back(v);
+    ASSERT_GE(f.size(), 6u);
+    std::swap(f[2], f[3]);
+    f[1][10] = ' ';
+    for (std::size_t i = 0; i < f.size(); ++i)
+      out += (i ? "," : "") + f[i];
+    out += "\n";
+  }
+  const std::string renamed = write("renamed.csv", out);
+  const std::string run = " --within 926 --horizon 1200";
+  const CliRun a = run_loci("fleet conflicts " + shell_quote(kSample) + run);
+  const CliRun b = run_loci("fleet conflicts " + shell_quote(renamed) + run);
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_GT(lines(a.out).size(), 10u);
+  EXPECT_EQ(a.out, b.out);
+  EXPECT_EQ(a.err, b.err);
+}
+
 // Lanes keep each vessel's course off the layer's polygons from its first report to the
 // fleet's last report time, as the sample's README says (the sample itself, made with these
 // flags, had 32 of its 900 reports on islands). Checked through OGR (GEOS), every 10 s.
