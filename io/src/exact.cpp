@@ -910,7 +910,11 @@ double distance(const FlatGeometry& g, const Point2& p) {
   // exactly when p lies on g.
   const double near2 = near_zone_squared(p, g.envelope());
   double best = std::numeric_limits<double>::infinity();
-  auto offer = [&](const Segment2& s) {
+  auto offer = [&](Segment2 s) {
+    // Measured from its lesser end, as a per-segment index recovers it from its box: the two
+    // granularities report the same double (ties between features that share an edge stay
+    // ties, ranked by FID alike).
+    if (s.b[0] < s.a[0] || (s.b[0] == s.a[0] && s.b[1] < s.a[1])) std::swap(s.a, s.b);
     const double d2 = squared_distance(p, s);
     best = std::min(best, d2 > near2 ? d2 : accurate_squared_distance(p, s));
   };

@@ -726,18 +726,27 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
                                              const LayerIndex::Features& features,
                                              std::vector<Answer>& out) {
   const Point2 p = q.point;
-  // The k best (squared distance, feature) as a max-heap: its top is the k-th distance.
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // The k best (distance, FID) as a max-heap: its top is the k-th. Features rank by the
+  // distance reported, the square root of the squared distances compared here, and at equal
+  // distances by FID: a squared distance a little above another can give the same distance,
+  // so the walk follows bounds up to `reach` of a distance (squared), beyond every square
+  // whose root is that distance.
+  auto reach = [](double d) {
+    const double above = std::nextafter(std::nextafter(d, kInf), kInf);
+    return std::max(above * above, std::nextafter(d * d, kInf));  // (0 squares to 0)
+  };
   auto& top = top_;
   top.clear();
-  auto kth = [&] {
-    return top.size() < q.k ? std::numeric_limits<double>::infinity() : top.front().first;
-  };
+  auto kth = [&] { return top.size() < q.k ? kInf : reach(top.front().d); };
   auto keep = [&](double d2, std::uint32_t f) {
+    const Ranked r{std::sqrt(d2), features.fid_of(f), f};
     if (top.size() == q.k) {
+      if (!(r < top.front())) return;
       std::pop_heap(top.begin(), top.end());
       top.pop_back();
     }
-    top.emplace_back(d2, f);
+    top.push_back(r);
     std::push_heap(top.begin(), top.end());
   };
   // Every feature has one root; one met twice is a forged file, refused (its hull would
@@ -747,16 +756,14 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
   std::vector<std::uint32_t> inside;
   for (const std::uint32_t f : containing_features(index_, p, features)) {
     inside.push_back(f);
-    if (top.size() < q.k) keep(0.0, f);
+    keep(0.0, f);
   }
   // First the candidates: the features in increasing distance of their roots' boxes, each
   // with an upper bound on its distance from one dive down its hierarchy, until a root is
   // no nearer than the k-th smallest upper bound (no feature from there on can rank).
   auto& bounds = bounds_;  // the k smallest upper bounds, as a max-heap
   bounds.assign(top.size(), 0.0);
-  auto bound = [&] {
-    return bounds.size() < q.k ? std::numeric_limits<double>::infinity() : bounds.front();
-  };
+  auto bound = [&] { return bounds.size() < q.k ? kInf : reach(std::sqrt(bounds.front())); };
   const FeatureDescent descend{features, *index_.packed(), p, candidates_only};
   auto& candidates = candidates_;
   candidates.clear();
@@ -796,19 +803,20 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     if (!(c.lower < limit)) continue;
     const auto [level, i] = features.root(c.root);
     const std::uint32_t f = features.node(level, i).feature;
-    // Not descended when its hull is no nearer than the k-th distance (a bound that is not
+    // Not descended when its hull is farther than the k-th distance (a bound that is not
     // finite, from a forged hull of coordinates that are not, rules nothing out).
     if (!c.exact && !candidates_only) {
       const double hull_lower = hull_lower_bound(features.hull(f), p);
-      if (!(hull_lower < limit) && hull_lower < std::numeric_limits<double>::infinity()) continue;
+      if (!(hull_lower < limit) && hull_lower < kInf) continue;
     }
+    // The descent takes what is nearer than `best`: below the reach of the k-th distance.
     double best = std::min(c.upper, limit);
     if (!c.exact && (level > 0 || i != c.leaf)) descend(level, i, best, false, c.leaf);
     if (best < limit) keep(best, f);
   }
   std::sort_heap(top.begin(), top.end());
-  for (const auto& [d2, f] : top)
-    out.push_back({number, features.fid_of(f), std::sqrt(d2)});
+  for (const Ranked& r : top)
+    out.push_back({number, r.fid, r.d});
 }
 
 void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
@@ -831,25 +839,26 @@ void LayerQuery::run(const Query& q, std::size_t number, bool candidates_only,
       if (s.stamp != generation_) s = {generation_, false, kInf};
       return s;
     };
-    using Pending = std::pair<double, std::uint32_t>;
-    std::priority_queue<Pending, std::vector<Pending>, std::greater<>> pending;
+    std::priority_queue<Ranked, std::vector<Ranked>, std::greater<>> pending;
     std::size_t found = 0;
     auto offer = [&](std::uint32_t f, double d) {
       FeatureState& s = state(f);
       if (d >= s.best) return;
       s.best = d;
-      pending.push({d, f});
+      pending.push({d, features.fid[f], f});
     };
-    // Everything pending at most `limit` away is final: every entry not yet browsed is at
-    // least `limit` away.
+    // Everything pending nearer than `limit` is final: every entry not yet browsed is at
+    // least `limit` away, to the rounding of box distances (a few units in the last place:
+    // one a hair nearer may tie, and rank first by its FID).
     auto settle = [&](double limit) {
-      while (!pending.empty() && found < q.k && pending.top().first <= limit) {
-        const auto [d, f] = pending.top();
+      const double below = limit * (1 - 0x1p-48);
+      while (!pending.empty() && found < q.k && (pending.top().d < below || limit == kInf)) {
+        const Ranked r = pending.top();
         pending.pop();
-        FeatureState& s = state(f);
-        if (s.done || s.best != d) continue;
+        FeatureState& s = state(r.f);
+        if (s.done || s.best != r.d) continue;
         s.done = true;
-        out.push_back({number, features.fid[f], d});
+        out.push_back({number, r.fid, r.d});
         ++found;
       }
     };

@@ -98,7 +98,10 @@ void check(const LayerIndex& index, const Layer& l, std::uint64_t seed) {
     std::map<std::int64_t, double> of;
     for (const auto& [d, fid] : expected)
       of[fid] = d;
-    for (const std::size_t k : {std::size_t(1), std::size_t(4), std::size_t(17), of.size() + 3}) {
+    // The answers of the largest k first: each smaller k's is its first rows (features at
+    // equal distances rank by FID, duplicated features' among them).
+    std::vector<Answer> all;
+    for (const std::size_t k : {of.size() + 3, std::size_t(1), std::size_t(4), std::size_t(17)}) {
       std::vector<Answer> got;
       Query q;
       q.kind = Query::Kind::nearest;
@@ -106,8 +109,13 @@ void check(const LayerIndex& index, const Layer& l, std::uint64_t seed) {
       q.k = k;
       query.run(q, 1, false, got);
       ASSERT_EQ(got.size(), std::min(k, expected.size())) << "k " << k;
+      if (all.empty()) all = got;
       std::vector<std::int64_t> seen;
       for (std::size_t r = 0; r < got.size(); ++r) {
+        EXPECT_EQ(got[r].fid, all[r].fid) << "point " << p[0] << ',' << p[1] << " k " << k;
+        EXPECT_EQ(got[r].distance, all[r].distance);
+        if (r > 0 && got[r].distance == got[r - 1].distance)
+          EXPECT_LT(got[r - 1].fid, got[r].fid) << "a tie out of FID order";
         // A segment comes back from its box in canonical direction: the last bit may differ.
         const double tol = 1e-13 * (1 + expected[r].first);
         EXPECT_NEAR(got[r].distance, expected[r].first, tol)

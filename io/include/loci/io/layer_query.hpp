@@ -343,7 +343,9 @@ class LayerQuery {
   LayerQuery(const LayerQuery&) = delete;
   LayerQuery& operator=(const LayerQuery&) = delete;
 
-  // Appends the answers of q to out: windows in ascending FID, nearest-n nearest first.
+  // Appends the answers of q to out: windows in ascending FID, nearest-n nearest first and, at
+  // equal distances, in ascending FID (so that the k nearest are the first k rows of any
+  // larger k's answer, per feature and per segment alike).
   // Throws InvalidArgument for k = 0 or a negative radius, InvalidGeometry for a NaN input.
   void run(const Query& q, std::size_t number, bool candidates_only, std::vector<Answer>& out);
 
@@ -365,9 +367,19 @@ class LayerQuery {
   std::uint32_t generation_ = 0;
   // A new query's stamp, state_ sized for `features` (every stamp forgotten when it wraps).
   void next_generation(std::size_t features);
-  // Nearest-n's arrays, kept between queries: the k best (squared distance, feature), the k
-  // smallest upper bounds, and the candidate features (squared bounds, root).
-  std::vector<std::pair<double, std::uint32_t>> top_;
+  // A feature ranked by nearest-n: by distance (squared through the hierarchies), then FID.
+  struct Ranked {
+    double d;
+    std::int64_t fid;
+    std::uint32_t f;
+    friend bool operator<(const Ranked& a, const Ranked& b) {
+      return a.d < b.d || (a.d == b.d && a.fid < b.fid);
+    }
+    friend bool operator>(const Ranked& a, const Ranked& b) { return b < a; }
+  };
+  // Nearest-n's arrays, kept between queries: the k best, the k smallest upper bounds, and
+  // the candidate features (squared bounds, root).
+  std::vector<Ranked> top_;
   std::vector<double> bounds_;
   struct Candidate {
     double upper, lower;
