@@ -809,8 +809,20 @@ TEST(BspTree, RejectsBadInput) {
   EXPECT_THROW(BspTree::build(V{}, bad), InvalidArgument);
   bad.bevel_angle = 4;
   EXPECT_THROW(BspTree::build(V{}, bad), InvalidArgument);
+  // Beyond 1e150: the root cell's margin overflowed (6e307 killed the process in GMP with an
+  // infinity) and areas past 1.3e154 read as NaN ("no area").
+  for (const double big : {6e307, 1e200, 2e150}) {
+    EXPECT_THROW(BspTree::build(V{{{{-big, -big}, {big, -big}, {big, big}, {-big, big}}, {}}}),
+                 InvalidGeometry)
+        << big;
+  }
+  EXPECT_NO_THROW(BspTree::build(V{{{{-1e150, -1e150}, {1e150, -1e150}, {0, 1e150}}, {}}}));
   const BspTree tree = BspTree::build(V{{{{0, 0}, {1, 0}, {1, 1}}, {}}});
   EXPECT_THROW(tree.trace({nan, 0}, {1, 1}, BspPoint{}), InvalidGeometry);
+  // (a move from 1.7e308 to -1.7e308 has no finite length: the contact came out NaN)
+  EXPECT_THROW(tree.trace({1.7e308, 0.5}, {-1.7e308, 0.5}, BspPoint{}), InvalidGeometry);
+  EXPECT_THROW(tree.trace({0.5, 0.5}, {2e150, 0.5}, BspCircle{1}), InvalidGeometry);
+  EXPECT_THROW(tree.overlaps({5, 5}, BspCircle{1e151}), InvalidGeometry);
   // Shapes: a NaN, infinite or negative size, or a polygon without vertices, is refused.
   const double inf = std::numeric_limits<double>::infinity();
   EXPECT_THROW(tree.trace({5, 5}, {6, 6}, BspCircle{nan}), InvalidGeometry);

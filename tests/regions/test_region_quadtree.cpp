@@ -278,6 +278,15 @@ TEST(RegionQuadtree, DegenerateGridsAndBadInput) {
   EXPECT_THROW(RegionQuadtree::build(Box2{{0, 0}, {0, 0}}, 3, any), InvalidGeometry);
   EXPECT_THROW(RegionQuadtree::build(kRegion, 31, any), InvalidArgument);
   EXPECT_THROW(RegionQuadtree::build(kRegion, -1, any), InvalidArgument);
+  // A cell the tree does not have (a level below its finest shifted by a negative count, an
+  // x beyond the grid gave an inverted box).
+  const auto two = RegionQuadtree::build(kRegion, 2, any);
+  EXPECT_THROW(two.cell_box(0, 0, 5), InvalidArgument);
+  EXPECT_THROW(two.cell_box(0, 0, -1), InvalidArgument);
+  EXPECT_THROW(two.cell_box(4, 0, 2), InvalidArgument);
+  EXPECT_THROW(two.cell_box(0, 2, 1), InvalidArgument);
+  EXPECT_THROW(two.cell_box(~0u, 0, 0), InvalidArgument);
+  EXPECT_EQ(two.cell_box(3, 3, 2).max, two.region().max);
   EXPECT_THROW(RegionQuadtree::build(Box2{{1e9, 1e9}, {1e9 + 1e-3, 1e9 + 1e-3}}, 30, any),
                InvalidArgument);
   const std::vector<std::uint8_t> px(100, 1);

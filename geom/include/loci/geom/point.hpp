@@ -45,7 +45,6 @@ std::string to_string(const Point<D>& p) {
   return s + ")";
 }
 
-// Throws InvalidGeometry naming `what` when a coordinate is NaN or infinite.
 // The largest coordinate magnitude read from layers and query arguments. Squared distances
 // between points within it stay finite (8 * 1e300 < 1.8e308), so distances and nearest-n
 // rankings never overflow; larger values are refused with a message rather than misranked.
@@ -58,6 +57,7 @@ constexpr bool within_coordinate_range(const Point<D>& p) {
   return true;
 }
 
+// Throws InvalidGeometry naming `what` when a coordinate is NaN or infinite.
 template <int D>
 void check_point(const Point<D>& p, const char* what = "point") {
   if (!is_finite(p))

@@ -109,7 +109,7 @@ class RegionQuadtree {
   static RegionQuadtree build(const Box2& region, int levels, Classify&& classify) {
     RegionQuadtree t(region, levels);
     auto by_cell = [&](std::uint32_t x, std::uint32_t y, int l) {
-      return Cover(classify(t.cell_box(x, y, l)));
+      return Cover(classify(t.block(x, y, l)));
     };
     t.grow(0, 0, 0, 0, by_cell);
     return t;
@@ -125,10 +125,14 @@ class RegionQuadtree {
 
   int levels() const { return levels_; }
   Box2 region() const { return {origin_, {grid(0, 1u << levels_), grid(1, 1u << levels_)}}; }
-  // The block of cell (x, y) at `level`.
+  // The block of cell (x, y) at `level`, 0 <= level <= levels(), x and y below 2^level;
+  // throws InvalidArgument otherwise.
   Box2 cell_box(std::uint32_t x, std::uint32_t y, int level) const {
-    const int s = levels_ - level;
-    return {{grid(0, x << s), grid(1, y << s)}, {grid(0, (x + 1) << s), grid(1, (y + 1) << s)}};
+    if (level < 0 || level > levels_ || x >> level != 0 || y >> level != 0)
+      throw InvalidArgument("cell_box: no cell (" + std::to_string(x) + ", " + std::to_string(y) +
+                            ") at level " + std::to_string(level) + " of a tree of " +
+                            std::to_string(levels_) + " levels");
+    return block(x, y, level);
   }
   std::size_t node_count() const { return std::max<std::size_t>(nodes_.size(), 1); }
   std::size_t memory_bytes() const { return nodes_.size() * sizeof(std::uint32_t); }
@@ -179,6 +183,11 @@ class RegionQuadtree {
   RegionQuadtree(const Box2& region, int levels);
 
   double grid(int axis, std::uint32_t i) const { return origin_[axis] + double(i) * step_; }
+  // cell_box without its checks, for the tree's own cells.
+  Box2 block(std::uint32_t x, std::uint32_t y, int level) const {
+    const int s = levels_ - level;
+    return {{grid(0, x << s), grid(1, y << s)}, {grid(0, (x + 1) << s), grid(1, (y + 1) << s)}};
+  }
 
   // Fills node n, cell (x, y) at level l, then merges four equal leaves into n;
   // classify(x, y, l) gives the cover of a cell.
@@ -340,7 +349,7 @@ std::size_t RegionQuadtree::walk(Emit&& emit, Descend&& descend) const {
   while (!stack.empty()) {
     const Frame f = stack.back();
     stack.pop_back();
-    const Box2 box = cell_box(f.x, f.y, f.level);
+    const Box2 box = block(f.x, f.y, f.level);
     if (!descend(box)) continue;
     ++visited;
     const std::uint32_t w = word(f.node);

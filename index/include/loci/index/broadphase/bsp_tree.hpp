@@ -190,12 +190,15 @@ class BspTree {
     return *this;
   }
 
-  // The tree of the union of `polygons`. Throws InvalidGeometry on a non-finite coordinate
-  // or a ring with fewer than three distinct vertices or no area, InvalidArgument on bad
-  // parameters.
+  // The tree of the union of `polygons`. Throws InvalidGeometry on a coordinate that is NaN,
+  // infinite or beyond kMaxCoordinate (1e150: the root cell's margin and the exact tests'
+  // areas stay finite), or a ring with fewer than three distinct vertices or no area,
+  // InvalidArgument on bad parameters.
   static BspTree build(std::span<const BspPolygon> polygons, const BspParams& params = {});
 
-  // First impact of `shape` moving from `from` to `to` (straight, at constant speed).
+  // First impact of `shape` moving from `from` to `to` (straight, at constant speed). Throws
+  // InvalidGeometry for an end or a shape's vertex or extent that is NaN, infinite or beyond
+  // kMaxCoordinate (the move's length then stays finite).
   template <BspShape S>
   BspHit trace(const Point2& from, const Point2& to, const S& shape,
                QueryStats* stats = nullptr) const {
@@ -384,11 +387,15 @@ class BspTree {
       const double a = shape.support(n), b = shape.support(Point2{-n[0], -n[1]});
       if (!std::isfinite(a) || !std::isfinite(b) || !(a + b >= 0))
         throw InvalidGeometry("traced shape has a NaN, infinite or negative extent");
+      if (!(std::abs(a) <= kMaxCoordinate && std::abs(b) <= kMaxCoordinate))
+        throw InvalidGeometry("traced shape reaches beyond 1e150");
     }
   }
   static void check_point(const Point2& p, const char* what) {
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]))
       throw InvalidGeometry(std::string(what) + " has a non-finite coordinate");
+    if (!within_coordinate_range(p))
+      throw InvalidGeometry(std::string(what) + " has a coordinate beyond 1e150");
   }
 
   void swap(BspTree& other) noexcept {
@@ -719,6 +726,7 @@ inline std::vector<Point2> bsp_ring(const std::vector<Point2>& in, bool ccw,
   for (const Point2& p : in) {
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]))
       throw InvalidGeometry(what + " has a non-finite coordinate");
+    if (!within_coordinate_range(p)) throw InvalidGeometry(what + " has a coordinate beyond 1e150");
     if (r.empty() || !(r.back() == p)) r.push_back(p);
   }
   while (r.size() > 1 && r.front() == r.back())
