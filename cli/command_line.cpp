@@ -219,12 +219,19 @@ Args parse(const Command& c, int first, int argc, char** argv) {
   return a;
 }
 
+int help_status() {
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return 0;
+  std::fprintf(stderr, "loci: error: cannot write the help (%s)\n",
+               std::strerror(errno ? errno : EIO));
+  return 1;
+}
+
 int run_command(const Command& c, int first, int argc, char** argv,
                 void (*before)(const Command&, const Args&)) {
   for (int i = first; i < argc; ++i)
     if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
       print_command_help(c);
-      return 0;
+      return help_status();
     }
   try {
     const Args args = parse(c, first, argc, argv);

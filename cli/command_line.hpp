@@ -97,6 +97,10 @@ void check_output_name(const Args& a, const char* format);
 
 void print_command_help(const Command& c);
 
+// The exit status after help was printed: 0, or 1 (said in one line) when it did not reach
+// stdout (a full disk, a closed pipe).
+int help_status();
+
 // The arguments argv[first, argc) of command c; throws UsageError naming what is wrong.
 Args parse(const Command& c, int first, int argc, char** argv);
 

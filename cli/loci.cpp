@@ -385,7 +385,8 @@ const std::vector<Command>& commands() {
        "loci index LAYER [-o FILE] [--structure S] [--per feature|segment] [--layer NAME]",
        "writes the sidecar index LAYER.loci (or FILE), read by later queries in place",
        {{"--output", "-o", "FILE", "where to write the index (default: LAYER.loci)"},
-        kStructure,
+        {"--structure", nullptr, "S",
+         "the sidecar's packing: packed-hilbert (default) or packed-str"},
         kPer,
         kLayer,
         kQuiet},
@@ -622,7 +623,7 @@ int main(int argc, char** argv) {
   // Without a command: the help on stdout, and the failure said in one line on stderr.
   if (argc < 2 || is_help(argv[1])) {
     print_help();
-    if (argc >= 2) return 0;
+    if (argc >= 2) return help_status();
     std::fflush(stdout);
     std::fprintf(stderr, "loci: error: no command given (see loci --help)\n");
     return 1;
@@ -633,7 +634,7 @@ int main(int argc, char** argv) {
   if (name == "fleet") {
     if (argc < 3 || is_help(argv[2])) {
       print_fleet_help();
-      if (argc >= 3) return 0;
+      if (argc >= 3) return help_status();
       std::fflush(stdout);
       std::fprintf(stderr, "loci: error: no fleet command given (see loci fleet --help)\n");
       return 1;

@@ -26,6 +26,18 @@ inline void append_nums(std::string& out, std::initializer_list<double> values) 
   }
 }
 
+// The shortest text that reads back as d; two of them joined by a comma.
+inline std::string shortest(double d) {
+  std::string s;
+  append_num(s, d);
+  return s;
+}
+inline std::string shortest_pair(double a, double b) {
+  std::string s;
+  append_nums(s, {a, b});
+  return s;
+}
+
 template <class Int>
 void append_int(std::string& out, Int v) {
   char buf[24];

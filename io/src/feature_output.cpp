@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "block_writer.hpp"
 #include "gdal_layer.hpp"
 #include "gdal_seam.hpp"
 #include "loci/geom/error.hpp"
@@ -29,9 +30,7 @@ std::string csv_quoted(const std::string& s) {
 }
 
 std::string number(double d) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", d);
-  return buf;
+  return detail::shortest(d);
 }
 
 OGRFeatureUniquePtr found(OGRFeatureUniquePtr f, const AnswerSource& src, std::int64_t fid) {

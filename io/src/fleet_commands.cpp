@@ -32,9 +32,7 @@ constexpr double kKnot = kNauticalMile / 3600.0;
 
 // The shortest text that reads back as the same double.
 std::string num(double d) {
-  std::string s;
-  detail::append_num(s, d);
-  return s;
+  return detail::shortest(d);
 }
 
 std::string fixed(double d, int decimals) {

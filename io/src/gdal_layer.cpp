@@ -6,8 +6,10 @@
 
 #include <cpl_conv.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -94,6 +96,9 @@ OpenLayer open_layer(const std::string& path, const std::string& name) {
     if (VSIStatL(path.c_str(), &st) != 0) throw Error(path + ": no such file");
     if (starts_as_sidecar(path))
       throw Error(path + ": a loci index, not a layer (give the layer it indexes)");
+    // A file this process may not read says why (GDAL, which finds no driver, does not).
+    if (S_ISREG(st.st_mode) && ::access(path.c_str(), R_OK) != 0)
+      throw Error(path + ": cannot read the file (" + std::strerror(errno) + ")");
     throw Error(path + ": cannot open as a vector layer" +
                 (gdal_message.empty() ? std::string() : " (" + gdal_message + ")"));
   }

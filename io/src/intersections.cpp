@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <span>
 
+#include "block_writer.hpp"
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/index/detail/large_alloc.hpp"
@@ -145,8 +146,8 @@ std::size_t write_intersections(const IntersectionsOptions& o, std::FILE* fallba
       if (o.pairs_only)
         std::fprintf(f, "%lld,%lld\n", (long long)r.fid_a, (long long)r.fid_b);
       else
-        std::fprintf(f, "%lld,%lld,%.17g,%.17g\n", (long long)r.fid_a, (long long)r.fid_b, r.p[0],
-                     r.p[1]);
+        std::fprintf(f, "%lld,%lld,%s\n", (long long)r.fid_a, (long long)r.fid_b,
+                     detail::shortest_pair(r.p[0], r.p[1]).c_str());
     }
   } else {
     // The points are in the (first) layer's coordinates: a reader must know which.
@@ -159,8 +160,8 @@ std::size_t write_intersections(const IntersectionsOptions& o, std::FILE* fallba
       if (o.pairs_only)
         std::fputs("\"geometry\":null}", f);
       else
-        std::fprintf(f, "\"geometry\":{\"type\":\"Point\",\"coordinates\":[%.17g,%.17g]}}", r.p[0],
-                     r.p[1]);
+        std::fprintf(f, "\"geometry\":{\"type\":\"Point\",\"coordinates\":[%s]}}",
+                     detail::shortest_pair(r.p[0], r.p[1]).c_str());
     }
     std::fputs("\n]}\n", f);
   }

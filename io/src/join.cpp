@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 
+#include "block_writer.hpp"
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/index/packed_rtree.hpp"
@@ -230,7 +231,8 @@ std::size_t write_join(const JoinOptions& o, std::FILE* fallback) {
     if (o.format == Format::ids)
       std::fprintf(f, "%lld %lld\n", (long long)r.left, (long long)r.right);
     else if (dwithin)
-      std::fprintf(f, "%lld,%lld,%.17g\n", (long long)r.left, (long long)r.right, r.distance);
+      std::fprintf(f, "%lld,%lld,%s\n", (long long)r.left, (long long)r.right,
+                   detail::shortest(r.distance).c_str());
     else
       std::fprintf(f, "%lld,%lld\n", (long long)r.left, (long long)r.right);
   }

@@ -313,9 +313,11 @@ TEST_F(BadInput, DevicesFifosAndLinksAreWrittenThroughNeverReplaced) {
   EXPECT_EQ(dash.out, run_loci("query " + shell_quote(l) + " --bbox 0,0,9,9").out);
   EXPECT_FALSE(dash.out.empty());
   for (const std::string& command :
-       {"index " + shell_quote(l) + " -o -", "clip " + shell_quote(l) + " --bbox 0,0,9,9 -o -",
-        std::string("fleet generate --count 3 -o -")})
+       {"index " + shell_quote(l) + " -o -", "clip " + shell_quote(l) + " --bbox 0,0,9,9 -o -"})
     expect_one_line_error(run_loci(command));
+  const CliRun generated = run_loci("fleet generate --count 3 -q -o -");  // text: stdout
+  EXPECT_EQ(generated.status, 0) << generated.err;
+  EXPECT_EQ(lines(generated.out).size(), 10u);
   EXPECT_FALSE(fs::exists(dir_ / "-"));
   fs::current_path(cwd);
 }
@@ -367,6 +369,12 @@ TEST_F(BadInput, FullDiskAndFullStdoutFailAndKeepTheOldFile) {
     expect_one_line_error(r);
   }
   expect_one_line_error(run_loci("info " + shell_quote(l) + " > /dev/full"));
+  // the help too (it said nothing and exited 0)
+  for (const char* help : {"--help", "fleet --help", "query --help", "fleet query -h"}) {
+    const CliRun r = run_loci(std::string(help) + " > /dev/full");
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("cannot write the help"), std::string::npos) << help << ": " << r.err;
+  }
   // a file size limit stands in for a full disk: the old output must stay whole
   write("old.csv", "the old answer\n");
   const std::string cmd = "ulimit -f 0; " + std::string(LOCI_EXE) + " query " + shell_quote(l) +

@@ -332,6 +332,82 @@ double ogr_first_meet(const OGRGeometry& g, double x0, double y0, double x1, dou
 
 // --point-file: point location in batch, every point against GEOS, per feature and per
 // segment (crossing parity over the index's ring segments).
+// Nearest-n ranks features at equal distances by FID, per feature and per segment alike: on a
+// grid of squares sharing their edges (each edge in two features, run opposite ways) and a
+// lattice of points, where most ranks are ties, both sidecars print the same rows, -k 2's
+// answer is the first rows of -k 5's, and each row's distance is brute force's.
+TEST_F(LayersCli, NearestTiesRankByFidInEitherGranularity) {
+  std::string text = R"({"type":"FeatureCollection","features":[)";
+  int fid = 0;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) {
+      // FIDs not in the order of the squares: 7 * n mod 37.
+      const int id = (7 * fid++) % 37;
+      text += std::string(fid > 1 ? "," : "") + R"({"type":"Feature","id":)" + std::to_string(id) +
+              R"(,"properties":{},"geometry":{"type":"Polygon",)" + R"("coordinates":[[)";
+      const int x = 2 * i, y = 2 * j;
+      text += "[" + std::to_string(x) + "," + std::to_string(y) + "],[" + std::to_string(x + 2) +
+              "," + std::to_string(y) + "],[" + std::to_string(x + 2) + "," +
+              std::to_string(y + 2) + "],[" + std::to_string(x) + "," + std::to_string(y + 2) +
+              "],[" + std::to_string(x) + "," + std::to_string(y) + "]]]}}";
+    }
+  text += "]}";
+  const std::string layer = path("squares.geojson");
+  std::ofstream(layer) << text;
+  std::string points;
+  for (double x = -1.5; x <= 13.5; x += 0.75)
+    for (double y = -1.5; y <= 13.5; y += 1.25)
+      points += std::to_string(x) + "," + std::to_string(y) + "\n";
+  const std::string queries = path("lattice.txt");
+  std::ofstream(queries) << points;
+  std::string answers[2];
+  for (int g = 0; g < 2; ++g) {
+    const std::string sidecar = path(g ? "squares.segment.loci" : "squares.feature.loci");
+    ASSERT_EQ(
+        run_loci("index -q " + layer + " -o " + sidecar + " --per " + (g ? "segment" : "feature"))
+            .status,
+        0);
+    const std::string run =
+        "query " + layer + " --index " + sidecar + " --nearest-file " + queries + " -f csv";
+    const CliRun five = run_loci(run + " -k 5"), two = run_loci(run + " -k 2");
+    ASSERT_EQ(five.status, 0) << five.err;
+    ASSERT_EQ(two.status, 0) << two.err;
+    answers[g] = five.out;
+    // -k 2 is the first two rows of each query's five.
+    std::map<std::string, std::vector<std::string>> rows5, rows2;
+    for (const auto& l : lines(five.out))
+      rows5[l.substr(0, l.find(','))].push_back(l);
+    for (const auto& l : lines(two.out))
+      rows2[l.substr(0, l.find(','))].push_back(l);
+    ASSERT_EQ(rows2.size(), rows5.size());
+    for (const auto& [q, rows] : rows2)
+      if (q != "query")
+        EXPECT_EQ(rows, std::vector<std::string>(rows5[q].begin(), rows5[q].begin() + 2)) << q;
+  }
+  EXPECT_EQ(answers[0], answers[1]);
+  // Against brute force through OGR: the distances in order, the FIDs ascending within ties.
+  const OgrFeatureSet squares = read_with_ogr(layer);
+  const auto rows = lines(answers[1]);
+  std::size_t at = 1, ties = 0;
+  std::istringstream in(points);
+  for (std::size_t n = 1; std::getline(in, points); ++n) {
+    const double x = std::stod(points), y = std::stod(points.substr(points.find(',') + 1));
+    OGRPoint p(x, y);
+    std::vector<std::pair<double, long long>> want;
+    for (std::size_t i = 0; i < squares.geoms.size(); ++i)
+      want.emplace_back(squares.geoms[i]->Distance(&p), squares.fids[i]);
+    std::sort(want.begin(), want.end());
+    for (std::size_t r = 0; r < 5; ++r, ++at) {
+      ASSERT_LT(at, rows.size());
+      const std::string expected = std::to_string(n) + "," + std::to_string(want[r].second) + ",";
+      EXPECT_EQ(rows[at].rfind(expected, 0), 0u) << rows[at] << " rank " << r;
+      ties += r > 0 && want[r].first == want[r - 1].first;
+    }
+  }
+  EXPECT_EQ(at, rows.size());
+  EXPECT_GT(ties, 100u);
+}
+
 TEST_F(LayersCli, PointFileLocatesEveryPoint) {
   const std::string layer = path("polys.shp");
   const OgrFeatureSet s = read_with_ogr(layer);
