@@ -214,6 +214,12 @@ Args parse(const Command& c, int first, int argc, char** argv) {
       throw UsageError(arg + " -: loci " + c.name +
                        " writes a file, not stdout; name it (./- for a file named -)");
     }
+    // A query file `-` is stdin, as usual (a file named "-" is ./-).
+    const std::string_view long_name = flag->name;
+    if (value == "-" && long_name.size() > 5 && long_name.ends_with("-file")) {
+      a.values[flag->name] = "/dev/stdin";
+      continue;
+    }
     a.values[flag->name] = value;
   }
   return a;

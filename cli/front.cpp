@@ -116,7 +116,7 @@ bool copy_query_files(const Command& c, const std::vector<std::string>& once) {
         std::find(once.begin(), once.end(), std::string(flag->name)) == once.end())
       continue;
     const std::string file = eq == std::string::npos ? g_args[at] : arg.substr(eq + 1);
-    const std::optional<std::string> copy = copy_in_memory(file);
+    const std::optional<std::string> copy = copy_in_memory(file == "-" ? "/dev/stdin" : file);
     copied = copy.has_value();
     if (!copied) break;
     g_copies.emplace_back(*copy, file);

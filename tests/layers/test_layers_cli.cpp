@@ -2450,19 +2450,24 @@ TEST_F(LayersCli, TheFrontAnswersSidecarQueriesWithoutGdalAndHandsTheRestOver) {
     EXPECT_EQ(run_with(LOCI_EXE, batch_args + windows_file + " -o " + path("front-odd.txt")).status,
               0);
     EXPECT_EQ(read_text(path("front-odd.txt")), expected.out);
-    EXPECT_EQ(run_with("cat " + shell_quote(windows_file) + " | " + std::string(LOCI_EXE),
-                       batch_args + "/dev/stdin")
-                  .out,
-              expected.out);
+    for (const char* stdin_name : {"/dev/stdin", "-"})  // `-` is stdin too
+      EXPECT_EQ(run_with("cat " + shell_quote(windows_file) + " | " + std::string(LOCI_EXE),
+                         batch_args + stdin_name)
+                    .out,
+                expected.out)
+          << stdin_name;
     // Queries read once (a pipe, a file named as a descriptor) are copied in memory first: the
     // front alone answers those that meet no such record, and hands over those that do (the
     // whole program answered them above, from the copy).
     const std::string far_file = path("front-odd-far.txt");
     std::ofstream(far_file) << "199,-1,201,1\n";
     EXPECT_EQ(run_with(LOCI_EXE, batch_args + far_file).out, "1 0\n");
-    for (const std::string& from : {"/dev/stdin < " + shell_quote(far_file),
-                                    "--bbox-file=/dev/stdin < " + shell_quote(far_file)}) {
-      const std::string args = from[0] == '-' ? "query " + odd + " " + from : batch_args + from;
+    for (const std::string& from :
+         {"/dev/stdin < " + shell_quote(far_file),
+          "--bbox-file=/dev/stdin < " + shell_quote(far_file), "- < " + shell_quote(far_file),
+          "--bbox-file=- < " + shell_quote(far_file)}) {
+      const std::string args =
+          from.rfind("--", 0) == 0 ? "query " + odd + " " + from : batch_args + from;
       const CliRun named = run_with(front, args);
       EXPECT_EQ(named.status, 0) << from << ": " << named.out;
       EXPECT_EQ(named.out, "1 0\n") << from;
