@@ -25,6 +25,9 @@ void check_function(sqlite3_context* ctx, int, sqlite3_value** argv) {
     sqlite3* db = sqlite3_context_db_handle(ctx);
     ReadHold hold;
     ShadowTable& t = table_named<ShadowTable>(db, registry, name, "loci_check", hold);
+    // A shadow table dropped by this connection while the table stays connected is named as
+    // missing, as a connection made afterwards names it (not "no such table").
+    if (t.missing_shadow.empty()) t.find_missing_shadow();
     const std::string verdict = t.check();
     sqlite3_result_text(ctx, verdict.c_str(), int(verdict.size()), SQLITE_TRANSIENT);
   } catch (const SqlError& e) {

@@ -1,6 +1,9 @@
 // The virtual-table machinery of the extension's table-valued functions.
 #include "table_function.hpp"
 
+#include <string>
+#include <string_view>
+
 namespace loci::sqlite {
 
 namespace {
@@ -121,8 +124,16 @@ int x_filter(sqlite3_vtab_cursor* cur, int, const char*, int argc, sqlite3_value
     } catch (const std::bad_alloc&) {
       throw;
     } catch (const std::exception& e) {
-      // The library's refusals ("nearest time is beyond 1e150") name the function asked.
-      throw SqlError{SQLITE_ERROR, std::string(f.name) + ": " + e.what()};
+      // The library's refusals ("nearest time is beyond 1e150") name the function asked; one
+      // that names its operation first ("conflicts: ...") has it in the function's name
+      // already (loci_conflicts).
+      std::string_view what = e.what();
+      const std::string_view name = f.name;
+      if (const std::size_t colon = what.find(": ");
+          colon != std::string_view::npos && colon > 0 &&
+          name.ends_with(std::string("_") + std::string(what.substr(0, colon))))
+        what.remove_prefix(colon + 2);
+      throw SqlError{SQLITE_ERROR, std::string(f.name) + ": " + std::string(what)};
     }
     c.count = c.rows.rows(f.columns);
     return SQLITE_OK;

@@ -485,6 +485,9 @@ TEST(SqliteFleetSql, BadInputIsAnSqlErrorWithAClearMessage) {
     const std::string function = std::string(sql).substr(14, std::string(sql).find('(') - 14);
     const std::string error = db.error_of(sql);
     EXPECT_EQ(error.rfind(function + ": ", 0), 0u) << sql << " -> " << error;
+    // (once: "loci_conflicts: conflicts: ..." said the operation twice)
+    EXPECT_EQ(error.find(": conflicts: "), std::string::npos) << error;
+    EXPECT_EQ(error.find(": nearest: "), std::string::npos) << error;
   }
   db.exec("DELETE FROM f WHERE id IN (2, 3, 4)");
   // The object that would leave the range is named by its SQL id, negative ones too.
