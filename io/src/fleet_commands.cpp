@@ -387,11 +387,31 @@ std::vector<Hit> window_hits(const Loaded& l, const FleetQueryOptions& o) {
     FleetIndex ix;
     for (std::size_t i = 0; i < pieces.size(); ++i)
       ix.insert(i, pieces[i].m);
-    ix.query(MovingWindow<2>::during(box, t1, t2), [&](Id i, const Motion2& m) {
+    // The index asked with a window a few ulps wider (a superset: the ends of each piece are
+    // decided below by their positions, which its roots may miss by as much).
+    const Box2 wider = outset(box, 1e-13 * magnitude(box) + 1e-300);
+    ix.query(MovingWindow<2>::during(wider, t1, t2), [&](Id i, const Motion2& m) {
       const Piece& pc = pieces[i];
       const LinearSpan s = meets(m, MovingWindow<2>::during(box, pc.lo, pc.hi));
-      if (s.empty()) return true;
       double t = s.lo;
+      if (poly) {
+        if (s.empty()) return true;
+      } else {
+        // The piece's ends as --at tests a time, by the rounded position there (the roots of
+        // the linear constraints may fall a few ulps either side of an end: `--during T,T`
+        // and `--at T` disagreed on windows through a computed position).
+        const auto in_box = [&](double at) {
+          return intersects(box, Box2::of_point(position(m, at)));
+        };
+        if (in_box(pc.lo))
+          t = pc.lo;
+        else if (pc.lo == pc.hi)
+          return true;
+        else if (s.empty() && !pc.open && in_box(pc.hi))
+          t = pc.hi;
+        else if (s.empty())
+          return true;
+      }
       if (const auto ll = reported_lonlat(l, pc.id, m, pc.lo)) {
         // At the piece's start where its report put it (at the report's time, or at rest all
         // along): in the window by its reported lon/lat, as --at tests it (a window's edge
