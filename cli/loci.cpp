@@ -599,7 +599,8 @@ void print_help() {
   std::printf(
       "\nloci COMMAND --help (loci fleet SUB --help) documents every option of COMMAND; an\n"
       "option's value follows it (-k 3, --bbox 0,0,1,1) or is joined to it (-k3, --bbox=...).\n"
-      "Exit status 0 on success, 1 on failure with one line 'loci: error: ...' on stderr.\n\n"
+      "Exit status 0 on success, 1 on failure with one line 'loci: error: ...' on stderr.\n"
+      "loci --version prints the version.\n\n"
       "example:\n  loci index countries.shp && loci query countries.shp --bbox 5,45,15,55\n");
 }
 
@@ -620,6 +621,10 @@ int main(int argc, char** argv) {
   const auto is_help = [](const char* a) {
     return !std::strcmp(a, "--help") || !std::strcmp(a, "-h");
   };
+  if (argc == 2 && (!std::strcmp(argv[1], "--version") || !std::strcmp(argv[1], "-V"))) {
+    std::printf("loci %s\n", LOCI_VERSION);
+    return help_status();
+  }
   // Without a command: the help on stdout, and the failure said in one line on stderr.
   if (argc < 2 || is_help(argv[1])) {
     print_help();

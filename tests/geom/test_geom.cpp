@@ -84,6 +84,15 @@ TEST(Box, RejectsBadCoordinates) {
     EXPECT_NE(std::string(e.what()).find("box 17"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("axis 1"), std::string::npos);
   }
+  // The message shows the coordinates as they are (six decimals showed 2e-9 > 1e-9 as
+  // 0.000000 against 0.000000, and 1e100 in a hundred digits).
+  try {
+    check_box(Box2{{2e-9, 0}, {1e-9, 1e100}});
+    FAIL();
+  } catch (const InvalidGeometry& e) {
+    EXPECT_NE(std::string(e.what()).find("(2e-09, 0) .. (1e-09, 1e+100)"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Orientation, ExactOnNearlyCollinearPoints) {

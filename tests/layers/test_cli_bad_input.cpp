@@ -369,7 +369,11 @@ TEST_F(BadInput, FullDiskAndFullStdoutFailAndKeepTheOldFile) {
     expect_one_line_error(r);
   }
   expect_one_line_error(run_loci("info " + shell_quote(l) + " > /dev/full"));
-  // the help too (it said nothing and exited 0)
+  // the help and the version too (the help said nothing and exited 0)
+  const CliRun version = run_loci("--version");
+  EXPECT_EQ(version.status, 0) << version.err;
+  EXPECT_EQ(version.out.rfind("loci 0.", 0), 0u) << version.out;
+  expect_one_line_error(run_loci("--version > /dev/full"));
   for (const char* help : {"--help", "fleet --help", "query --help", "fleet query -h"}) {
     const CliRun r = run_loci(std::string(help) + " > /dev/full");
     expect_one_line_error(r);

@@ -5,6 +5,7 @@
 // boost_adapt.hpp.
 #pragma once
 
+#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -35,12 +36,15 @@ constexpr bool is_finite(const Point<D>& p) {
   return true;
 }
 
+// "(x, y)", each coordinate in the shortest text that reads back as it (std::to_string's six
+// decimals showed 2e-9 as 0.000000 and 1e100 in a hundred digits).
 template <int D>
 std::string to_string(const Point<D>& p) {
   std::string s = "(";
   for (int i = 0; i < D; ++i) {
     if (i) s += ", ";
-    s += std::to_string(p[i]);
+    char buf[32];
+    s.append(buf, std::to_chars(buf, buf + sizeof buf, p[i]).ptr);
   }
   return s + ")";
 }
