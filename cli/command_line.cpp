@@ -16,6 +16,7 @@
 #include <string_view>
 
 #include "loci/io/atomic_file.hpp"
+#include "loci/io/number_text.hpp"
 
 namespace loci::cli {
 
@@ -42,9 +43,11 @@ const std::string& layer_arg(const Args& a, const char* command, const char* wha
 
 std::size_t parse_count(const char* flag, const std::string& text, std::size_t lo, std::size_t hi) {
   long long v = 0;  // signed, so that "-3" is out of range rather than not a number
-  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+  std::string_view digits = text;
+  const bool plus_ok = io::detail::drop_plus(digits);  // "+3" as every number is read
+  const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), v);
   const std::string shown = "'" + text.substr(0, 40) + "'";
-  if (text.empty() || r.ptr != text.data() + text.size() ||
+  if (!plus_ok || digits.empty() || r.ptr != digits.data() + digits.size() ||
       (r.ec != std::errc() && r.ec != std::errc::result_out_of_range))
     throw UsageError(std::string("bad ") + flag + " " + shown + ": expected a whole number from " +
                      std::to_string(lo) + " to " + std::to_string(hi));
@@ -124,8 +127,20 @@ Format output_format(const Args& a, std::initializer_list<Format> choices, Forma
     if (!named.empty()) refuse_named_other(out, named, format_name(fallback), offered);
     return fallback;
   }
-  const Format f = parse_flag("--format", a.get("--format"), parse_format);
-  if (!named.empty() && named != format_name(f) && !(f == Format::ids && named == "csv"))
+  const std::string given = a.get("--format");
+  std::optional<Format> chosen;
+  std::string listed;  // "ids, csv or geojson"
+  std::size_t i = 0;
+  for (const Format c : choices) {
+    if (given == format_name(c)) chosen = c;
+    listed += std::string(i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ") + format_name(c);
+    ++i;
+  }
+  if (!chosen)
+    throw UsageError("--format: '" + printable(given.substr(0, 40)) +
+                     "' is not a format this command writes (choose " + listed + ")");
+  const Format f = *chosen;
+  if (!named.empty() && named != format_name(f))
     refuse_named_other(out, named, format_name(f), offered);
   return f;
 }

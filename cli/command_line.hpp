@@ -86,9 +86,9 @@ io::LoadOptions load_options(const Args& a, const std::string& layer);
 std::string format_named_by(const std::string& out);
 
 // The answer format of a text output: -f where given, else the one -o's name says when
-// `choices` holds it (`loci query -o near.geojson` writes GeoJSON), else `fallback`. A name
-// saying another format than the one chosen is refused (an ids answer may go to a .csv), so
-// that no file says it is what it is not (`-o pairs.shp` holding CSV).
+// `choices` holds it (`loci query -o near.geojson` writes GeoJSON), else `fallback`. A -f
+// outside `choices` is refused, and so is a name saying another format than the one chosen
+// (ids rows are not CSV), so that no file says it is what it is not (`-o pairs.shp` of CSV).
 io::Format output_format(const Args& a, std::initializer_list<io::Format> choices,
                          io::Format fallback);
 

@@ -23,6 +23,7 @@
 #include "loci/io/intersections.hpp"
 #include "loci/io/join.hpp"
 #include "loci/io/layer_cells.hpp"
+#include "loci/io/number_text.hpp"
 
 namespace {
 
@@ -215,8 +216,10 @@ int run_bench(const Args& a) {
 // A real number given to `flag`, finite and >= 0 (> 0 when `positive`).
 double parse_nonnegative(const char* flag, const std::string& text, bool positive = false) {
   double v = 0;
-  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() ||
+  std::string_view digits = text;
+  const bool plus_ok = io::detail::drop_plus(digits);  // "+5" as every number is read
+  const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+  if (!plus_ok || digits.empty() || r.ec != std::errc() || r.ptr != digits.data() + digits.size() ||
       !std::isfinite(v) || v < 0 || (positive && v == 0))
     throw UsageError(std::string("bad ") + flag + " '" + text.substr(0, 40) +
                      "': expected a finite number " + (positive ? "> 0" : ">= 0"));
@@ -276,9 +279,6 @@ int run_fleet_conflicts(const Args& a) {
   o.within = parse_nonnegative("--within", a.get("--within"));
   o.horizon = parse_nonnegative("--horizon", a.get("--horizon"));
   o.at = at_flag(a);
-  const std::string format = a.get("--format", "csv");
-  if (format != "csv" && format != "geojson")
-    throw UsageError("--format: '" + format + "' for conflicts (choose csv or geojson)");
   o.format = output_format(a, {Format::csv, Format::geojson}, Format::csv);
   o.out_path = a.get("--output");
   const FleetRun r = fleet_conflicts(o, stdout);

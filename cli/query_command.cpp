@@ -50,6 +50,8 @@ QueryOptions query_options(const Args& a, bool read_queries) {
   }
   if (a.has("--first") && !a.has("--segment"))
     throw UsageError("--first goes with --segment (the feature the segment meets first)");
+  // The output's format (and a name saying another) before any query file is read.
+  o.format = output_format(a, {Format::ids, Format::csv, Format::geojson}, Format::ids);
   for (const char* file : {"--bbox-file", "--nearest-file", "--point-file"})
     if (a.has(file) && a.has("--output"))
       refuse_overwriting(a.get("--output"), a.get(file), "query file");
@@ -70,7 +72,6 @@ QueryOptions query_options(const Args& a, bool read_queries) {
     o.queries.emplace_back(1, q);
   }
   o.candidates = a.has("--candidates");
-  o.format = output_format(a, {Format::ids, Format::csv, Format::geojson}, Format::ids);
   o.out_path = a.get("--output");
   o.progress = progress_bar(a, "querying");
   if (a.has("--jobs"))

@@ -90,7 +90,8 @@ void refuse_malformed_rings(const OGRGeometry& window) {
       ++r;
       const int n = ring->getNumPoints();
       if (n == 0) continue;
-      if (!ring->get_IsClosed())
+      // Closed in plan (a ring whose ends differ only in z is closed, as loci reads it).
+      if (ring->getX(0) != ring->getX(n - 1) || ring->getY(0) != ring->getY(n - 1))
         throw InvalidGeometry("--wkt: " + which +
                               " is not closed: a ring ends at the point it starts from");
       if (n < 4)
@@ -102,6 +103,8 @@ void refuse_malformed_rings(const OGRGeometry& window) {
       int k = 1;
       while (k < n && Point2{ring->getX(k), ring->getY(k)} == a)
         ++k;
+      if (k == n)
+        throw InvalidGeometry("--wkt: " + which + " has no area: all its points are one point");
       bool line = true;
       for (int i = k + 1; line && i < n; ++i)
         line = orientation(a, {ring->getX(k), ring->getY(k)}, {ring->getX(i), ring->getY(i)}) ==

@@ -17,7 +17,7 @@
 #include "loci/geom/error.hpp"
 #include "loci/io/commands.hpp"
 #include "loci/io/fleet.hpp"
-#include "number_text.hpp"
+#include "loci/io/number_text.hpp"
 
 namespace loci::io {
 namespace {
@@ -586,7 +586,8 @@ FleetData read_fleet_csv(std::string_view text, const std::string& source) {
 }
 
 FleetData read_ais_csv(std::string_view text, const std::string& source) {
-  static const char* kHeader = "MMSI,BaseDateTime,LAT,LON,SOG,COG,...";
+  static const char* kHeader =
+      "MMSI,BaseDateTime,LAT,LON,SOG,COG,... or mmsi,base_date_time,longitude,latitude,sog,cog,...";
   CsvRecords csv(text, source);
   Header h = read_header(csv, source);
   for (std::string& name : h.names)

@@ -21,8 +21,8 @@
 #include "loci/index/detail/hilbert.hpp"
 #include "loci/io/atomic_file.hpp"
 #include "loci/io/commands.hpp"
+#include "loci/io/number_text.hpp"
 #include "loci/io/sidecar.hpp"
-#include "number_text.hpp"
 #include "shapefile_records.hpp"
 
 namespace loci::io {

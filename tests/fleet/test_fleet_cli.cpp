@@ -896,7 +896,7 @@ TEST_F(FleetCli, BadInputAndFlagsAreOneLineErrors) {
   expect_one_line_error(run_loci(g + " --within 1"), "--horizon");
   expect_one_line_error(run_loci(g + " --within 1 --horizon 5 --at soon"), "--at");
   expect_one_line_error(run_loci(g + " --within 1 --horizon 5 -f ids"), "--format");
-  expect_one_line_error(run_loci(g + " --within 1 --horizon 5 -f xml"), "choose csv or geojson");
+  expect_one_line_error(run_loci(g + " --within 1 --horizon 5 -f xml"), "(choose csv or geojson)");
   expect_one_line_error(
       run_loci("fleet simulate " + shell_quote(good) +
                " --ticks 3 --within 1 --horizon 1 --tick 1e300 -o " + shell_quote(path("sim.csv"))),

@@ -649,8 +649,6 @@ TEST_F(BadInput, OutputNamesSayWhatTheyHold) {
   EXPECT_NE(read_text(path("a.GeoJSON")).find("\"FeatureCollection\""), std::string::npos);
   ASSERT_EQ(run_loci(q + " -o " + shell_quote(path("a.txt"))).status, 0);
   EXPECT_EQ(read_text(path("a.txt")), "0\n1\n");
-  ASSERT_EQ(run_loci(q + " -f ids -o " + shell_quote(path("ids.csv"))).status, 0);
-  EXPECT_EQ(read_text(path("ids.csv")), "0\n1\n");
   ASSERT_EQ(run_loci("fleet query " + shell_quote(fleet) + " --bbox -1,-1,2,1 -q -o " +
                      shell_quote(path("f.json")))
                 .status,
@@ -663,6 +661,11 @@ TEST_F(BadInput, OutputNamesSayWhatTheyHold) {
       "fleet conflicts " + shell_quote(fleet) + " --within 1 --horizon 10 -q";
   const std::vector<Refused> refused = {
       {q, "x.shp", "its name says a .shp file but the output is feature ids"},
+      {q + " -f ids", "ids.csv", "its name says CSV but the output is feature ids"},
+      {"join " + shell_quote(l) + " " + shell_quote(l) + " -p intersects -f ids -q", "j.csv",
+       "its name says CSV but the output is feature ids"},
+      {"join " + shell_quote(l) + " " + shell_quote(l) + " -p intersects -f geojson -q", "j.csv",
+       "'geojson' is not a format this command writes (choose csv or ids)"},
       {q + " -f csv", "x.geojson", "its name says GeoJSON but the output is CSV"},
       {q + " -f geojson", "x.csv", "its name says CSV but the output is GeoJSON"},
       {q, "x.svg", "its name says an SVG drawing but the output is feature ids"},
@@ -736,6 +739,21 @@ TEST_F(BadInput, CoordinatesTooLargeForDistancesAreRefused) {
     expect_one_line_error(r);
     EXPECT_EQ(r.err.find("1e150"), std::string::npos) << q << ": " << r.err;
   }
+  // A plus before a number is read alike everywhere: in counts and single values too (-k +2
+  // was refused while --nearest +0,+0 was taken), a sign after it nowhere.
+  const CliRun plus = run_loci("query " + shell_quote(ok) + " --nearest +0,+0 -k +2");
+  EXPECT_EQ(plus.status, 0) << plus.err;
+  EXPECT_EQ(plus.out, run_loci("query " + shell_quote(ok) + " --nearest 0,0 -k 2").out);
+  const std::string fleet = write("plus.csv", "id,t,x,y,vx,vy\n1,0,0,0,1,0\n2,0,3,0,-1,0\n");
+  const CliRun conflicts =
+      run_loci("fleet conflicts " + shell_quote(fleet) + " --within +1 --horizon +5 -q");
+  EXPECT_EQ(conflicts.status, 0) << conflicts.err;
+  EXPECT_EQ(lines(conflicts.out).size(), 2u) << conflicts.out;
+  for (const std::string& bad :
+       {"query " + shell_quote(ok) + " --nearest 0,0 -k +-2",
+        "fleet conflicts " + shell_quote(fleet) + " --within +-1 --horizon 5",
+        std::string("fleet generate --count ++2")})
+    expect_one_line_error(run_loci(bad));
   // Large but carryable coordinates still answer exactly.
   const std::string big = write("big.geojson", R"({"type":"FeatureCollection","features":[
 {"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1e149,1e149]}},

@@ -1206,7 +1206,8 @@ TEST_F(LayersCli, ReportsBadInput) {
   expect_error("query " + polys + " --nearest 1,1 -k x", "bad -k");
   expect_error("query " + polys, "exactly one of");
   expect_error("query " + polys + " --bbox 0,0,1,1 --frobnicate", "unknown option --frobnicate");
-  expect_error("query " + polys + " --bbox 0,0,1,1 -f xml", "unknown format 'xml'");
+  expect_error("query " + polys + " --bbox 0,0,1,1 -f xml",
+               "'xml' is not a format this command writes (choose ids, csv or geojson)");
   // A value option given twice is refused rather than the last one taken, under either name.
   expect_error("query " + polys + " --bbox 0,0,1,1 --bbox 2,2,3,3",
                "--bbox is given twice; loci query takes one --bbox");
@@ -1716,6 +1717,8 @@ TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
       {"POLYGON((0 0,4 0,0 0))", "ring 1 of polygon 1 (its shell) has 3 points"},
       {"POLYGON((0 0,4 0,2 0,0 0))", "ring 1 of polygon 1 (its shell) has no area"},
       {"POLYGON((0 0,0 0,1 1,3 3,0 0))", "ring 1 of polygon 1 (its shell) has no area"},
+      {"POLYGON((2 2,2 2,2 2,2 2))",
+       "ring 1 of polygon 1 (its shell) has no area: all its points are one point"},
       {"POLYGON((0 0,9 0,9 9,0 9,0 0),(1 1,2 1,2 2,1 2))",
        "ring 2 of polygon 1 (a hole) is not closed"},
       {"MULTIPOLYGON(((0 0,1 0,1 1,0 0)),((5 5,6 5,7 5,5 5)))",
@@ -1724,6 +1727,11 @@ TEST_F(LayersCli, ClipWritesCutsOfMixedDimensionAsTheirParts) {
     expect_error("clip " + u + " --wkt " + shell_quote(wkt) + " -o " + path("w.geojson"),
                  std::string("--wkt: ") + says);
   EXPECT_FALSE(fs::exists(path("w.geojson")));
+  // A ring whose ends differ only in z is closed in plan.
+  const CliRun z =
+      run_loci("clip " + u + " --wkt " + shell_quote("POLYGON Z((0 0 0,4 0 0,4 4 0,0 0 5))") +
+               " -q -o " + path("z.geojson"));
+  EXPECT_EQ(z.status, 0) << z.err;
 }
 
 // Attributes reach every output format by position, whatever the driver makes of their names
