@@ -29,10 +29,6 @@ std::string csv_quoted(const std::string& s) {
   return q + "\"";
 }
 
-std::string number(double d) {
-  return detail::shortest(d);
-}
-
 OGRFeatureUniquePtr found(OGRFeatureUniquePtr f, const AnswerSource& src, std::int64_t fid) {
   if (!f) throw Error(detail::where(src.layer_path, fid) + " is not in the layer");
   return f;
@@ -128,8 +124,8 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
     const OGRFeature* f = &features.at(a.fid);
     line = numbered ? std::to_string(a.query) + "," : "";
     line += std::to_string(a.fid);
-    if (with_distance) line += "," + number(a.distance);
-    if (with_point) line += "," + number(a.at[0]) + "," + number(a.at[1]);
+    if (with_distance) line += "," + detail::shortest(a.distance);
+    if (with_point) line += "," + detail::shortest_pair(a.at[0], a.at[1]);
     for (int i = 0; i < defn->GetFieldCount(); ++i) {
       line += ',';
       if (!f->IsFieldSetAndNotNull(i)) continue;

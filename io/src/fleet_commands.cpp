@@ -30,11 +30,6 @@ namespace {
 constexpr double kNauticalMile = 1852.0;
 constexpr double kKnot = kNauticalMile / 3600.0;
 
-// The shortest text that reads back as the same double.
-std::string num(double d) {
-  return detail::shortest(d);
-}
-
 std::string fixed(double d, int decimals) {
   char buf[48];
   std::snprintf(buf, sizeof buf, "%.*f", decimals, d);
@@ -913,8 +908,9 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
     for (const Out& r : rows) {
       ticker.tick(double(o.count + ++written));
       std::fprintf(f, "%llu,%s,%s,%s,%s,%s\n", static_cast<unsigned long long>(r.id),
-                   num(r.t).c_str(), num(r.p[0]).c_str(), num(r.p[1]).c_str(), num(r.v[0]).c_str(),
-                   num(r.v[1]).c_str());
+                   detail::shortest(r.t).c_str(), detail::shortest(r.p[0]).c_str(),
+                   detail::shortest(r.p[1]).c_str(), detail::shortest(r.v[0]).c_str(),
+                   detail::shortest(r.v[1]).c_str());
     }
   }
   out.commit();
@@ -952,8 +948,8 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
   const double latest = std::max(std::abs(l.now), std::abs(l.now + o.tick * double(o.ticks)));
   if (o.ticks > 0 &&
       !(o.tick >= 2 * (std::nextafter(latest, std::numeric_limits<double>::infinity()) - latest)))
-    throw InvalidArgument("--tick " + num(o.tick) + " is too small for the clock at " + num(l.now) +
-                          ": the ticks would not advance it");
+    throw InvalidArgument("--tick " + detail::shortest(o.tick) + " is too small for the clock at " +
+                          detail::shortest(l.now) + ": the ticks would not advance it");
   for (std::size_t i = 0; i < motions.size(); ++i) {
     const Motion2& m = motions[i];
     const Point2 p = position(m, l.now);
@@ -962,7 +958,7 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
       throw InvalidArgument("id " + std::to_string(ids[i]) +
                             " would move beyond 1e150 during the simulation (--ticks x --tick "
                             "+ --horizon = " +
-                            num(span) + ")");
+                            detail::shortest(span) + ")");
   }
   FleetIndex ix = index_of(start);
   FleetSimulateReport rep;
@@ -1010,8 +1006,8 @@ FleetSimulateReport fleet_simulate(const FleetSimulateOptions& o, std::FILE* fal
       full = monitor.full_computations() != before;
     }
     const double conflict_ms = 1e3 * seconds_since(t1);
-    std::fprintf(f, "%zu,%s,%zu,%.3f,%.3f,%zu,%d\n", tick, num(t).c_str(), per_tick, update_ms,
-                 conflict_ms, pairs, int(full));
+    std::fprintf(f, "%zu,%s,%zu,%.3f,%.3f,%zu,%d\n", tick, detail::shortest(t).c_str(), per_tick,
+                 update_ms, conflict_ms, pairs, int(full));
     total_update += update_ms;
     total_conflict += conflict_ms;
     total_pairs += double(pairs);
@@ -1120,7 +1116,8 @@ FleetDrawReport fleet_draw(const FleetDrawOptions& o, std::FILE* fallback) {
     const auto& [a, b] = closest[i];
     const double x1 = f.x(a[0]), y1 = f.y(a[1]), x2 = f.x(b[0]), y2 = f.y(b[1]);
     const std::string title = std::to_string(c.a) + " " + std::to_string(c.b) + ": dcpa " +
-                              num(c.approach.dcpa) + " at " + num(c.approach.tcpa);
+                              detail::shortest(c.approach.dcpa) + " at " +
+                              detail::shortest(c.approach.tcpa);
     // Closer than a pixel: a dot (a line that short, drawn round-capped and wide).
     std::fprintf(svg,
                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"%s><title>%s</title>"
