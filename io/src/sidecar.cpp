@@ -50,7 +50,10 @@ constexpr std::uint8_t kCoordFloat64 = 1;
 constexpr std::uint32_t kFlagPolygons = 1;
 constexpr std::uint32_t kFlagPerChosen = 2;  // the granularity was chosen by loci index
 constexpr std::size_t kAlign = 64;
-constexpr unsigned kChunkShift = 16;  // 64 KiB checked at a time
+// Data is checked a chunk at a time; a chunk is 2^chunk_shift bytes. loci writes pages (4 KiB):
+// a query verifies only what it reads, not the neighbours of what it reads. Files with chunks of
+// up to 64 KiB (what loci wrote before) are read as they are.
+constexpr unsigned kMinChunkShift = 12, kMaxChunkShift = 16;
 
 struct SidecarHeader {
   char magic[8];
@@ -162,8 +165,8 @@ std::shared_ptr<const Mapping> map_file(const std::string& path) {
 class ChunkCheck final : public loci::detail::LazyCheck {
  public:
   ChunkCheck(std::shared_ptr<const Mapping> m, std::string path, std::uint64_t data_offset,
-             std::uint64_t checks_offset)
-      : LazyCheck(m->data + data_offset, m->size - data_offset, kChunkShift),
+             std::uint64_t checks_offset, unsigned chunk_shift)
+      : LazyCheck(m->data + data_offset, m->size - data_offset, chunk_shift),
         mapping_(std::move(m)),
         path_(std::move(path)),
         checks_(mapping_->data + checks_offset) {}
@@ -394,6 +397,8 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
                    std::span<const ItemRecord> records, const SidecarInfo& info,
                    const Hierarchies* hierarchies) {
   if (records.size() != tree.size()) throw InvalidArgument("sidecar: one record per item");
+  if (info.chunk_shift < kMinChunkShift || info.chunk_shift > kMaxChunkShift)
+    throw InvalidArgument("sidecar: chunks of 4 KiB to 64 KiB (a chunk_shift of 12 to 16)");
   const auto blocks = tree.blocks();
   const auto items = tree.item_indices();
   if (hierarchies && (!hierarchies->root_tree || info.per != Per::segment ||
@@ -444,9 +449,9 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   }
   const std::size_t hierarchy_bytes =
       hierarchies ? align_up(records.size_bytes()) - records.size_bytes() + hl.end : 0;
-  h.chunk_shift = kChunkShift;
+  h.chunk_shift = info.chunk_shift;
   const std::size_t all_data = data_bytes + hierarchy_bytes;
-  h.chunk_count = all_data == 0 ? 0 : ((all_data - 1) >> kChunkShift) + 1;
+  h.chunk_count = all_data == 0 ? 0 : ((all_data - 1) >> h.chunk_shift) + 1;
   h.data_offset = align_up(h.checks_offset + 8 * h.chunk_count);
   h.blocks_offset = h.data_offset;
   h.items_offset = align_up(h.blocks_offset + blocks.size_bytes());
@@ -524,8 +529,8 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   };
   put(h.name_offset, info.layer_name.data(), info.layer_name.size());
   for (std::uint64_t c = 0; c < h.chunk_count; ++c) {
-    const std::uint64_t first = h.data_offset + (c << kChunkShift);
-    const std::size_t bytes = std::min<std::uint64_t>(h.file_size - first, 1ull << kChunkShift);
+    const std::uint64_t first = h.data_offset + (c << h.chunk_shift);
+    const std::size_t bytes = std::min<std::uint64_t>(h.file_size - first, 1ull << h.chunk_shift);
     const std::uint64_t sum = hash_bytes(data_bytes_at(first, bytes), bytes);
     put(h.checks_offset + 8 * c, &sum, 8);
   }
@@ -587,12 +592,12 @@ Sidecar Sidecar::open(const std::string& path) {
            count <= (m->size - offset) / size;
   };
   const bool chunks_fit =
-      h.chunk_shift == kChunkShift && h.data_offset == h.blocks_offset &&
-      h.data_offset <= m->size && h.checks_offset % 8 == 0 &&
+      h.chunk_shift >= kMinChunkShift && h.chunk_shift <= kMaxChunkShift &&
+      h.data_offset == h.blocks_offset && h.data_offset <= m->size && h.checks_offset % 8 == 0 &&
       h.checks_offset >= h.name_offset + h.name_size && fits(h.checks_offset, h.chunk_count, 8) &&
       h.checks_offset + 8 * h.chunk_count <= h.data_offset &&
       h.chunk_count ==
-          (m->size == h.data_offset ? 0 : ((m->size - h.data_offset - 1) >> kChunkShift) + 1);
+          (m->size == h.data_offset ? 0 : ((m->size - h.data_offset - 1) >> h.chunk_shift) + 1);
   // The hierarchies: only in a per-segment index of at least one item, one root per feature
   // and at most one feature per item, after the records and ending the file.
   const bool hierarchical = h.hierarchy_offset != 0;
@@ -634,7 +639,8 @@ Sidecar Sidecar::open(const std::string& path) {
   s.info_.bounds = {{h.bounds[0], h.bounds[1]}, {h.bounds[2], h.bounds[3]}};
   s.info_.source = {h.source_size, h.source_mtime_ns, h.source_inode, h.source_hash};
   s.info_.file_size = h.file_size;
-  auto check = std::make_shared<ChunkCheck>(m, path, h.data_offset, h.checks_offset);
+  s.info_.chunk_shift = h.chunk_shift;
+  auto check = std::make_shared<ChunkCheck>(m, path, h.data_offset, h.checks_offset, h.chunk_shift);
   const auto* blocks = reinterpret_cast<const Block*>(m->data + h.blocks_offset);
   const auto* items = reinterpret_cast<const std::uint32_t*>(m->data + h.items_offset);
   s.records_ = {reinterpret_cast<const ItemRecord*>(m->data + h.records_offset),

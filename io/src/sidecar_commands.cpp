@@ -270,7 +270,8 @@ std::string check_sidecar(const std::string& arg) {
   const auto& i = info;
   return path + ": ok, " + (i.packing == Packing::str ? "packed-str" : "packed-hilbert") + " per " +
          to_string(i.per) + ", layer " + i.layer_name + ", " + std::to_string(i.items) +
-         " entries, " + std::to_string(chunks) + " chunks verified, " +
+         " entries, " + std::to_string(chunks) + " chunks of " +
+         std::to_string(1u << (i.chunk_shift - 10)) + " KiB verified, " +
          std::to_string(i.file_size) + " bytes" + unchecked;
 }
 

@@ -2009,6 +2009,7 @@ TEST_F(LayersCli, RefusesCorruptAndTruncatedSidecars) {
   const CliRun ok = run_loci("check " + sidecar);
   EXPECT_EQ(ok.status, 0) << ok.err;
   EXPECT_NE(ok.out.find(": ok,"), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find(" chunks of 4 KiB verified, "), std::string::npos) << ok.out;
   fs::remove(sidecar);
 }
 

@@ -31,7 +31,8 @@ struct Fixture {
   std::size_t data_offset = 0;  // where the blocks start in the file
 };
 
-Fixture make(std::size_t n, std::uint64_t seed) {
+// chunk_shift: loci writes 4 KiB chunks (12) and reads files written with 64 KiB ones (16).
+Fixture make(std::size_t n, std::uint64_t seed, unsigned chunk_shift = 12) {
   Fixture f;
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> pos(0, 1000), size(0, 3);
@@ -45,6 +46,7 @@ Fixture make(std::size_t n, std::uint64_t seed) {
   info.layer_name = "boxes";
   info.items = n;
   info.bounds = tree.bounds();
+  info.chunk_shift = chunk_shift;
   write_sidecar(f.path, tree, f.records, info);
   std::ifstream in(f.path, std::ios::binary);
   f.bytes.assign(std::istreambuf_iterator<char>(in), {});
@@ -82,67 +84,102 @@ std::vector<std::int64_t> brute_fids(const Fixture& f, const Box2& w) {
 }
 
 TEST(SidecarChunks, OpeningReadsNoDataAndASmallQueryAFewChunks) {
-  const Fixture f = make(60000, 1);
-  const Sidecar s = Sidecar::open(f.path);
-  const std::size_t chunks = s.check().chunks();
-  EXPECT_GT(chunks, 40u);
-  EXPECT_EQ(s.check().verified(), 0u);
-  const Box2 w{{500, 500}, {503, 503}};
-  EXPECT_EQ(window_fids(s, w), brute_fids(f, w));
-  EXPECT_GT(s.check().verified(), 0u);
-  EXPECT_LE(s.check().verified(), 12u) << "of " << chunks;
-  s.verify();
-  EXPECT_EQ(s.check().verified(), chunks);
+  for (const unsigned shift : {12u, 16u}) {
+    const Fixture f = make(60000, 1, shift);
+    const Sidecar s = Sidecar::open(f.path);
+    EXPECT_EQ(s.info().chunk_shift, shift);
+    const std::size_t chunks = s.check().chunks();
+    EXPECT_EQ(chunks, ((f.bytes.size() - f.data_offset - 1) >> shift) + 1);
+    EXPECT_GT(chunks, 40u);
+    EXPECT_EQ(s.check().verified(), 0u);
+    const Box2 w{{500, 500}, {503, 503}};
+    EXPECT_EQ(window_fids(s, w), brute_fids(f, w));
+    EXPECT_GT(s.check().verified(), 0u);
+    EXPECT_LE(s.check().verified(), 12u) << "of " << chunks;
+    s.verify();
+    EXPECT_EQ(s.check().verified(), chunks);
+  }
+}
+
+// Chunks of a page: what a small query hashes is a few pages, not a few 64 KiB chunks.
+TEST(SidecarChunks, ASmallQueryHashesFewerBytesInPages) {
+  std::size_t bytes[2];
+  for (const unsigned shift : {12u, 16u}) {
+    const Fixture f = make(60000, 1, shift);
+    const Sidecar s = Sidecar::open(f.path);
+    for (int i = 0; i < 20; ++i) {
+      const Box2 w{{50.0 * i, 40.0 * i}, {50.0 * i + 2, 40.0 * i + 2}};
+      EXPECT_EQ(window_fids(s, w), brute_fids(f, w));
+    }
+    bytes[shift == 16] = s.check().verified() << shift;
+  }
+  EXPECT_LT(bytes[0] * 4, bytes[1]) << bytes[0] << " bytes against " << bytes[1];
+}
+
+TEST(SidecarChunks, ChunksOutsideFourToSixtyFourKiBAreNotWritten) {
+  for (const unsigned shift : {0u, 11u, 17u, 64u}) {
+    Fixture f;
+    f.boxes = {{{0, 0}, {1, 1}}};
+    f.records = {{1, 0, 0}};
+    SidecarInfo info;
+    info.items = 1;
+    info.chunk_shift = shift;
+    EXPECT_THROW(write_sidecar(f.path, PackedRTree2::build(f.boxes), f.records, info),
+                 InvalidArgument)
+        << shift;
+  }
 }
 
 TEST(SidecarChunks, AFlippedByteIsRefusedWhenItsChunkIsRead) {
-  const Fixture f = make(20000, 2);
-  std::mt19937_64 rng(3);
-  std::size_t refused_small = 0, refused_whole = 0;
-  for (int i = 0; i < 40; ++i) {
-    std::string bad = f.bytes;
-    const std::size_t at = f.data_offset + rng() % (bad.size() - f.data_offset);
-    bad[at] = char(bad[at] ^ (1 << (rng() % 8)));
-    put(f, bad);
-    const Sidecar s = Sidecar::open(f.path);  // the data is not read: opening succeeds
-    // The chunk holding the byte is refused as soon as it is touched; the others are not.
-    // The records end the file: from them back to the start of the data.
-    const std::size_t records_offset = f.bytes.size() - f.records.size() * sizeof(ItemRecord);
-    const auto* base = reinterpret_cast<const std::byte*>(s.mapped_records().data()) -
-                       (records_offset - f.data_offset);
-    const std::byte* flipped = base + (at - f.data_offset);
-    EXPECT_THROW(s.check().touch(flipped, 1), Error) << "byte " << at;
-    const std::size_t other = (at - f.data_offset + 70000) % (f.bytes.size() - f.data_offset);
-    if ((other >> 16) != ((at - f.data_offset) >> 16))
-      EXPECT_NO_THROW(s.check().touch(base + other, 1));
-    EXPECT_THROW(s.verify(), Error);
-    // A fresh mapping: queries answer exactly or are refused, never otherwise.
-    const Sidecar t = Sidecar::open(f.path);
-    const Box2 w{{double(rng() % 990), double(rng() % 990)}, {0, 0}};
-    const Box2 window{w.min, {w.min[0] + 10, w.min[1] + 10}};
-    try {
-      EXPECT_EQ(window_fids(t, window), brute_fids(f, window)) << "byte " << at;
-    } catch (const Error& e) {
-      ++refused_small;
-      EXPECT_NE(std::string(e.what()).find(f.path), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find("corrupt"), std::string::npos) << e.what();
+  for (const unsigned shift : {12u, 16u}) {
+    const Fixture f = make(20000, 2, shift);
+    std::mt19937_64 rng(3);
+    std::size_t refused_small = 0, refused_whole = 0;
+    for (int i = 0; i < 40; ++i) {
+      std::string bad = f.bytes;
+      const std::size_t at = f.data_offset + rng() % (bad.size() - f.data_offset);
+      bad[at] = char(bad[at] ^ (1 << (rng() % 8)));
+      put(f, bad);
+      const Sidecar s = Sidecar::open(f.path);  // the data is not read: opening succeeds
+      // The chunk holding the byte is refused as soon as it is touched; the others are not.
+      // The records end the file: from them back to the start of the data.
+      const std::size_t records_offset = f.bytes.size() - f.records.size() * sizeof(ItemRecord);
+      const auto* base = reinterpret_cast<const std::byte*>(s.mapped_records().data()) -
+                         (records_offset - f.data_offset);
+      const std::byte* flipped = base + (at - f.data_offset);
+      EXPECT_THROW(s.check().touch(flipped, 1), Error) << "byte " << at;
+      const std::size_t other = (at - f.data_offset + 70000) % (f.bytes.size() - f.data_offset);
+      if ((other >> shift) != ((at - f.data_offset) >> shift))
+        EXPECT_NO_THROW(s.check().touch(base + other, 1));
+      EXPECT_THROW(s.verify(), Error);
+      // A fresh mapping: queries answer exactly or are refused, never otherwise.
+      const Sidecar t = Sidecar::open(f.path);
+      const Box2 w{{double(rng() % 990), double(rng() % 990)}, {0, 0}};
+      const Box2 window{w.min, {w.min[0] + 10, w.min[1] + 10}};
+      try {
+        EXPECT_EQ(window_fids(t, window), brute_fids(f, window)) << "byte " << at;
+      } catch (const Error& e) {
+        ++refused_small;
+        EXPECT_NE(std::string(e.what()).find(f.path), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("corrupt"), std::string::npos) << e.what();
+      }
+      std::size_t whole_refused = 0;
+      try {
+        EXPECT_EQ(window_fids(t, t.tree().bounds()), brute_fids(f, t.tree().bounds()));
+      } catch (const Error&) {
+        ++whole_refused;
+      }
+      refused_whole += whole_refused;
     }
-    std::size_t whole_refused = 0;
-    try {
-      EXPECT_EQ(window_fids(t, t.tree().bounds()), brute_fids(f, t.tree().bounds()));
-    } catch (const Error&) {
-      ++whole_refused;
-    }
-    refused_whole += whole_refused;
+    // Small windows read few chunks: most flips are elsewhere and do not stop them.
+    EXPECT_LT(refused_small, 40u);
+    // A whole-layer window reads every leaf, item index and record: nearly all flips stop it.
+    EXPECT_GT(refused_whole, 30u);
   }
-  // Small windows read few chunks: most flips are elsewhere and do not stop them.
-  EXPECT_LT(refused_small, 40u);
-  // A whole-layer window reads every leaf, item index and record: nearly all flips stop it.
-  EXPECT_GT(refused_whole, 30u);
 }
 
 TEST(SidecarChunks, CorruptFrontIsRefusedAtOpen) {
-  const Fixture f = make(3000, 4);
+  const Fixture f = make(3000, 4, 16);
   std::mt19937_64 rng(5);
   for (int i = 0; i < 20; ++i) {
     std::string bad = f.bytes;

@@ -27,11 +27,9 @@ src="$root/datasets/cache/countries-coastline-1m/map.geo.json"
 [ -s "$src" ] || { echo "skip: run datasets/fetch.sh"; exit 0; }
 ln -sf "$src" "$work/coast.geojson"
 cp "$root/datasets/samples/coastline-denmark.geojson" "$work/sample.geojson"
-# Kept from an earlier run when newer than the layer and readable by this loci (not of an
-# earlier format).
-{ [ "$work/coast.geojson.loci" -nt "$src" ] &&
-  "$loci" query "$work/coast.geojson" --bbox 0,0,0,0 -f ids > /dev/null 2>&1; } ||
-  "$loci" index -q --per segment "$work/coast.geojson"
+# Indexed afresh, so that the file is what this loci writes (a sidecar of an earlier release
+# may still be read, with other chunk sizes).
+"$loci" index -q --per segment "$work/coast.geojson"
 "$loci" index -q --per segment "$work/sample.geojson"
 
 median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }

@@ -10,8 +10,11 @@
 //        count, a checksum of the name and checksum table, the offset and counts (features,
 //        levels, nodes) of the hierarchies, and last a checksum of the header bytes before it
 //   256  the layer name (UTF-8, not terminated)
-//   ...  the checksum table: XXH3-64 (seed 0) of each 64 KiB chunk of the data below, the last
-//        chunk shorter; chunk c is [data + c * 65536, min(data + (c + 1) * 65536, file end))
+//   ...  the checksum table: XXH3-64 (seed 0) of each chunk of the data below, the last chunk
+//        shorter; a chunk is 2^s bytes, s the header's chunk shift, and chunk c is
+//        [data + c * 2^s, min(data + (c + 1) * 2^s, file end)). loci writes s = 12 (4 KiB, a
+//        page, so that a query hashes little more than it reads) and reads s from 12 to 16
+//        (files written with 64 KiB chunks before stay valid)
 //   data blocks: the tree's nodes exactly as PackedRTree::blocks() holds them (SoA doubles)
 //   ...  item indices: PackedRTree::item_indices(), 32-bit, one per slot of level 0
 //   ...  records: one 16-byte ItemRecord per item (fid, part, flags), indexed by item id
@@ -225,6 +228,9 @@ struct SidecarInfo {
   Box2 bounds = Box2::empty();
   Fingerprint source;
   std::uint64_t file_size = 0;
+  // The data is checksummed in chunks of 2^chunk_shift bytes, 12 to 16 (4 KiB to 64 KiB): a
+  // query verifies the chunks it reads, whole.
+  unsigned chunk_shift = 12;
 };
 
 // Throws loci::Error when the file cannot be written (the target is left untouched).
