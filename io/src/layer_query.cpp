@@ -738,7 +738,8 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
   };
   auto& top = top_;
   top.clear();
-  auto kth = [&] { return top.size() < q.k ? kInf : reach(top.front().d); };
+  double kth_reach = kInf;  // reach of the k-th distance once there are k, kept as top changes
+  auto kth = [&] { return kth_reach; };
   auto keep = [&](double d2, std::uint32_t f) {
     const Ranked r{std::sqrt(d2), features.fid_of(f), f};
     if (top.size() == q.k) {
@@ -748,6 +749,7 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     }
     top.push_back(r);
     std::push_heap(top.begin(), top.end());
+    if (top.size() == q.k) kth_reach = reach(top.front().d);
   };
   // Every feature has one root; one met twice is a forged file, refused (its hull would
   // otherwise answer for roots that are not its own).
@@ -763,7 +765,8 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
   // no nearer than the k-th smallest upper bound (no feature from there on can rank).
   auto& bounds = bounds_;  // the k smallest upper bounds, as a max-heap
   bounds.assign(top.size(), 0.0);
-  auto bound = [&] { return bounds.size() < q.k ? kInf : reach(std::sqrt(bounds.front())); };
+  double bound_reach = bounds.size() < q.k ? kInf : reach(0.0);  // kept as bounds changes
+  auto bound = [&] { return bound_reach; };
   const FeatureDescent descend{features, *index_.packed(), p, candidates_only};
   auto& candidates = candidates_;
   candidates.clear();
@@ -789,6 +792,7 @@ void LayerQuery::nearest_through_hierarchies(const Query& q, std::size_t number,
     }
     bounds.push_back(upper);
     std::push_heap(bounds.begin(), bounds.end());
+    if (bounds.size() == q.k) bound_reach = reach(std::sqrt(bounds.front()));
     return true;
   });
   // Then each candidate measured exactly, nearest upper bound first (so that the k-th
