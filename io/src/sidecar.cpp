@@ -50,10 +50,12 @@ constexpr std::uint8_t kCoordFloat64 = 1;
 constexpr std::uint32_t kFlagPolygons = 1;
 constexpr std::uint32_t kFlagPerChosen = 2;  // the granularity was chosen by loci index
 constexpr std::size_t kAlign = 64;
-// Data is checked a chunk at a time; a chunk is 2^chunk_shift bytes. loci writes pages (4 KiB):
-// a query verifies only what it reads, not the neighbours of what it reads. Files with chunks of
-// up to 64 KiB (what loci wrote before) are read as they are.
-constexpr unsigned kMinChunkShift = 12, kMaxChunkShift = 16;
+// Data is checked a chunk at a time; a chunk is 2^chunk_shift bytes. loci writes pages (4 KiB),
+// so that a query verifies little more than what it reads, and larger chunks only where the
+// checksum table, which opening reads whole, would pass kMaxChunks sums (data over 512 MiB).
+// Files with 64 KiB chunks (what loci wrote before) are read as they are.
+constexpr unsigned kMinChunkShift = 12, kMaxChunkShift = 30;
+constexpr std::uint64_t kMaxChunks = std::uint64_t(1) << 17;  // a table of at most 1 MiB
 
 struct SidecarHeader {
   char magic[8];
@@ -393,12 +395,19 @@ bool starts_as_sidecar(const std::string& path) {
   return whole && std::memcmp(magic, kMagic, sizeof magic) == 0;
 }
 
+unsigned sidecar_chunk_shift(std::uint64_t data_bytes, unsigned least) {
+  unsigned shift = std::clamp(least, kMinChunkShift, kMaxChunkShift);
+  while (shift < kMaxChunkShift && data_bytes > (kMaxChunks << shift))
+    ++shift;
+  return shift;
+}
+
 void write_sidecar(const std::string& path, const PackedRTree2& tree,
                    std::span<const ItemRecord> records, const SidecarInfo& info,
                    const Hierarchies* hierarchies) {
   if (records.size() != tree.size()) throw InvalidArgument("sidecar: one record per item");
   if (info.chunk_shift < kMinChunkShift || info.chunk_shift > kMaxChunkShift)
-    throw InvalidArgument("sidecar: chunks of 4 KiB to 64 KiB (a chunk_shift of 12 to 16)");
+    throw InvalidArgument("sidecar: chunks of 4 KiB to 1 GiB (a chunk_shift of 12 to 30)");
   const auto blocks = tree.blocks();
   const auto items = tree.item_indices();
   if (hierarchies && (!hierarchies->root_tree || info.per != Per::segment ||
@@ -449,8 +458,8 @@ void write_sidecar(const std::string& path, const PackedRTree2& tree,
   }
   const std::size_t hierarchy_bytes =
       hierarchies ? align_up(records.size_bytes()) - records.size_bytes() + hl.end : 0;
-  h.chunk_shift = info.chunk_shift;
   const std::size_t all_data = data_bytes + hierarchy_bytes;
+  h.chunk_shift = sidecar_chunk_shift(all_data, info.chunk_shift);
   h.chunk_count = all_data == 0 ? 0 : ((all_data - 1) >> h.chunk_shift) + 1;
   h.data_offset = align_up(h.checks_offset + 8 * h.chunk_count);
   h.blocks_offset = h.data_offset;

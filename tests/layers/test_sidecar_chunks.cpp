@@ -116,8 +116,8 @@ TEST(SidecarChunks, ASmallQueryHashesFewerBytesInPages) {
   EXPECT_LT(bytes[0] * 4, bytes[1]) << bytes[0] << " bytes against " << bytes[1];
 }
 
-TEST(SidecarChunks, ChunksOutsideFourToSixtyFourKiBAreNotWritten) {
-  for (const unsigned shift : {0u, 11u, 17u, 64u}) {
+TEST(SidecarChunks, ChunksOutsideFourKiBToOneGiBAreNotWritten) {
+  for (const unsigned shift : {0u, 11u, 31u, 64u}) {
     Fixture f;
     f.boxes = {{{0, 0}, {1, 1}}};
     f.records = {{1, 0, 0}};
@@ -127,6 +127,28 @@ TEST(SidecarChunks, ChunksOutsideFourToSixtyFourKiBAreNotWritten) {
     EXPECT_THROW(write_sidecar(f.path, PackedRTree2::build(f.boxes), f.records, info),
                  InvalidArgument)
         << shift;
+  }
+}
+
+// Opening hashes the checksum table whole: chunks grow past 4 KiB only where the table would
+// hold more than 2^17 sums, so that opening costs at most that whatever the file's size.
+TEST(SidecarChunks, TheChecksumTableStaysWithinOneMiB) {
+  constexpr std::uint64_t MiB = 1 << 20;
+  EXPECT_EQ(sidecar_chunk_shift(0), 12u);
+  EXPECT_EQ(sidecar_chunk_shift(285 * MiB), 12u);
+  EXPECT_EQ(sidecar_chunk_shift(512 * MiB), 12u);
+  EXPECT_EQ(sidecar_chunk_shift(512 * MiB + 1), 13u);
+  EXPECT_EQ(sidecar_chunk_shift(1024 * MiB), 13u);
+  EXPECT_EQ(sidecar_chunk_shift(1024 * MiB + 1), 14u);
+  EXPECT_EQ(sidecar_chunk_shift(MiB * MiB), 23u);  // 1 TiB: 8 MiB chunks
+  EXPECT_EQ(sidecar_chunk_shift(std::uint64_t(1) << 62), 30u);
+  EXPECT_EQ(sidecar_chunk_shift(MiB, 16), 16u);  // the least asked for
+  EXPECT_EQ(sidecar_chunk_shift(MiB, 40), 30u);
+  // Up to 2^47 bytes (128 TiB), where chunks reach 1 GiB.
+  for (std::uint64_t bytes = 1; bytes <= (std::uint64_t(1) << 47); bytes = bytes * 3 + 1) {
+    const unsigned s = sidecar_chunk_shift(bytes);
+    EXPECT_LE(((bytes - 1) >> s) + 1, std::uint64_t(1) << 17) << bytes;
+    if (s > 12) EXPECT_GT(((bytes - 1) >> (s - 1)) + 1, std::uint64_t(1) << 17) << bytes;
   }
 }
 

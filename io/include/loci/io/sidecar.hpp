@@ -13,7 +13,8 @@
 //   ...  the checksum table: XXH3-64 (seed 0) of each chunk of the data below, the last chunk
 //        shorter; a chunk is 2^s bytes, s the header's chunk shift, and chunk c is
 //        [data + c * 2^s, min(data + (c + 1) * 2^s, file end)). loci writes s = 12 (4 KiB, a
-//        page, so that a query hashes little more than it reads) and reads s from 12 to 16
+//        page, so that a query hashes little more than it reads), or the least s that keeps
+//        the table within 131,072 sums for data over 512 MiB, and reads s from 12 to 30
 //        (files written with 64 KiB chunks before stay valid)
 //   data blocks: the tree's nodes exactly as PackedRTree::blocks() holds them (SoA doubles)
 //   ...  item indices: PackedRTree::item_indices(), 32-bit, one per slot of level 0
@@ -228,10 +229,17 @@ struct SidecarInfo {
   Box2 bounds = Box2::empty();
   Fingerprint source;
   std::uint64_t file_size = 0;
-  // The data is checksummed in chunks of 2^chunk_shift bytes, 12 to 16 (4 KiB to 64 KiB): a
-  // query verifies the chunks it reads, whole.
+  // The data is checksummed in chunks of 2^chunk_shift bytes, 12 to 30 (4 KiB to 1 GiB): a
+  // query verifies the chunks it reads, whole. write_sidecar takes this as the least, and
+  // writes sidecar_chunk_shift() of it.
   unsigned chunk_shift = 12;
 };
+
+// The chunk size write_sidecar uses for `data_bytes` of data: 2^least (clamped to 12..30)
+// bytes, doubled while the checksum table, which opening reads and hashes whole, would hold
+// more than 131,072 sums (1 MiB): 4 KiB chunks up to 512 MiB of data, then larger, so that
+// opening costs at most that whatever the file's size.
+unsigned sidecar_chunk_shift(std::uint64_t data_bytes, unsigned least = 12);
 
 // Throws loci::Error when the file cannot be written (the target is left untouched).
 // `hierarchies` (a per-segment index's, or null) are stored with the tree.
