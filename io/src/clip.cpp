@@ -350,6 +350,13 @@ ClipResult clip_layer(const ClipOptions& options) {
         faces.reset(OGRGeometryFactory::forceToMultiPolygon(g->clone()));
         g = faces.get();
       }
+      // A ring read closed by the queries (detail::for_each_curve) is cut closed.
+      std::unique_ptr<OGRGeometry> closed;
+      if (detail::has_unclosed_ring(*g)) {
+        closed.reset(g->clone());
+        closed->closeRings();
+        g = closed.get();
+      }
       const std::unique_ptr<OGRGeometry> near = near_window(*g, window_envelope);
       if (near) g = near.get();
       // Polygons of one feature that overlap keep their overlap, as queries count it: an

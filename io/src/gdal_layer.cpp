@@ -123,6 +123,11 @@ bool same_layer(const std::string& path_a, const std::string& name_a, const std:
 
 namespace {
 
+bool unclosed(const OGRLinearRing& ring) {
+  const int n = ring.getNumPoints();
+  return n > 1 && (ring.getX(0) != ring.getX(n - 1) || ring.getY(0) != ring.getY(n - 1));
+}
+
 void walk(const OGRGeometry* g, std::uint32_t& polygons,
           const std::function<void(const OGRSimpleCurve&, bool, std::uint32_t)>& f) {
   if (!g) return;
@@ -134,8 +139,15 @@ void walk(const OGRGeometry* g, std::uint32_t& polygons,
     case wkbPolygon:
     case wkbTriangle: {
       const std::uint32_t id = polygons++;
-      for (const auto* ring : *g->toPolygon())
+      for (const auto* ring : *g->toPolygon()) {
+        if (unclosed(*ring)) {  // read closed (for_each_curve)
+          OGRLinearRing closed(*ring);
+          closed.closeRings();
+          f(closed, true, id);
+          continue;
+        }
         f(*ring, true, id);
+      }
       break;
     }
     case wkbPolyhedralSurface:
@@ -188,6 +200,28 @@ void for_each_point(const OGRGeometry* g, const std::string& what,
 
 void check_points(const OGRGeometry* g, const std::string& what) {
   for_each_point(g, what, [](const Point2&) {});
+}
+
+bool has_unclosed_ring(const OGRGeometry& g) {
+  switch (wkbFlatten(g.getGeometryType())) {
+    case wkbPolygon:
+    case wkbTriangle:
+      for (const auto* ring : *g.toPolygon())
+        if (unclosed(*ring)) return true;
+      return false;
+    case wkbPolyhedralSurface:
+    case wkbTIN:
+      for (const auto* face : *g.toPolyhedralSurface())
+        if (has_unclosed_ring(*face)) return true;
+      return false;
+    case wkbMultiPolygon:
+    case wkbGeometryCollection:
+      for (const auto* part : *g.toGeometryCollection())
+        if (has_unclosed_ring(*part)) return true;
+      return false;
+    default:
+      return false;
+  }
 }
 
 void for_each_curve(const OGRGeometry* g,

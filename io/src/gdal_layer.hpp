@@ -83,9 +83,15 @@ void for_each_point(const OGRGeometry* g, const std::string& what,
                     const std::function<void(const Point2&)>& f);
 
 // Calls f(curve, is_ring, polygon) for every line string and ring of g, in reading order;
-// `polygon` counts the polygons met so far (rings of one polygon share it).
+// `polygon` counts the polygons met so far (rings of one polygon share it). A ring whose last
+// point is not its first (GDAL reads one, with a warning) is handed over closed: the
+// closing edge is implied, by every command alike.
 void for_each_curve(const OGRGeometry* g,
                     const std::function<void(const OGRSimpleCurve&, bool, std::uint32_t)>& f);
+
+// Whether a ring of g (of its polygons, at any depth of collections) does not end at the
+// point it starts from, in plan.
+bool has_unclosed_ring(const OGRGeometry& g);
 
 // Throws InvalidGeometry (naming `what`) on a NaN or infinite coordinate.
 FlatGeometry flatten(const OGRGeometry* g, const std::string& what);

@@ -268,6 +268,12 @@ bool add_record_segments(const unsigned char* c, std::uint32_t file_type, std::i
           out.records.push_back({fid, std::int32_t(k), segment_flags(a, b, ring, polygon[k])});
           a = b;
         }
+        // A ring that does not end where it starts is closed, as GDAL builds it.
+        const Point2 first = point(xy + 16 * std::uint64_t(begin));
+        if (ring && end - begin > 1 && !(a == first)) {
+          out.boxes.push_back(Segment2{a, first}.box());
+          out.records.push_back({fid, std::int32_t(k), segment_flags(a, first, ring, polygon[k])});
+        }
       }
       break;
     }

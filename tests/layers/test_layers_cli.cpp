@@ -408,6 +408,69 @@ TEST_F(LayersCli, NearestTiesRankByFidInEitherGranularity) {
   EXPECT_GT(ties, 100u);
 }
 
+// A polygon ring whose last point is not its first (GDAL reads it, with a warning) is read
+// closed by every command, with or without an index of either granularity: the answers are
+// those of the same layer with the ring closed. Here the closing edge, x = 0, is the only
+// one a line from (-1, 2) to (1, 2) crosses.
+TEST_F(LayersCli, UnclosedRingsAreReadClosedEverywhere) {
+  const std::string head =
+      R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
+      R"("geometry":{"type":"Polygon","coordinates":[[[0,0],[4,0],[4,4],[0,4])";
+  const std::string tail =
+      R"(]]}},{"type":"Feature","properties":{},"geometry":{"type":"LineString",)"
+      R"("coordinates":[[-1,2],[1,2]]}}]})";
+  const std::string open = path("unclosed.geojson"), closed = path("closed.geojson");
+  std::ofstream(open) << head << tail;
+  std::ofstream(closed) << head << ",[0,0]" << tail;
+  const std::vector<std::string> commands = {
+      "query L --nearest -1,3.5 -k 2 -f csv",  // 0 at 1 (the closing edge), 1 at 1.5
+      "query L --point -0.5,3.5 -f ids",       // outside
+      "query L --point 2,2 -f ids",            // inside
+      "query L --within -1,3.5,1 -f ids",
+      "query L --bbox -5,1.5,-4,3 -f ids",
+      "query L --segment -1,1,-0.5,1 -f ids",
+      "join L L --predicate intersects",
+      "join L L --closest",
+      "intersections L",
+  };
+  std::map<std::string, std::string> reference;
+  for (const std::string& per : {"", "feature", "segment"}) {
+    for (const std::string& layer : {closed, open}) {
+      const std::string sidecar = layer + ".loci";
+      std::filesystem::remove(sidecar);
+      if (!per.empty()) ASSERT_EQ(run_loci("index -q " + layer + " --per " + per).status, 0);
+      for (const std::string& c : commands) {
+        std::string args = c;
+        for (std::size_t at; (at = args.find(" L")) != std::string::npos;)
+          args.replace(at, 2, " " + layer);
+        const CliRun r = run_loci(args);
+        ASSERT_EQ(r.status, 0) << args << ": " << r.err;
+        if (layer == closed && per.empty())
+          reference[c] = r.out;
+        else
+          EXPECT_EQ(r.out, reference[c]) << args << " (per " << per << ")";
+      }
+      std::filesystem::remove(sidecar);
+    }
+  }
+  EXPECT_EQ(reference[commands[0]], "fid,distance\n0,1\n1,1.5\n");
+  EXPECT_EQ(reference[commands[1]], "");
+  EXPECT_EQ(reference[commands[2]], "0\n");
+  EXPECT_NE(reference[commands[6]].find("\n0,1\n"), std::string::npos);
+  EXPECT_NE(reference[commands[8]].find("\n0,1,0,2\n"), std::string::npos);
+  // clip cuts the ring closed (GEOS would refuse it open).
+  std::string cut[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string out = path(i ? "unclosed-cut.csv" : "closed-cut.csv");
+    const CliRun r = run_loci("clip " + (i ? open : closed) + " --bbox -1,-1,2,2 -o " + out);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::ifstream in(out);
+    cut[i].assign(std::istreambuf_iterator<char>(in), {});
+  }
+  EXPECT_EQ(cut[1], cut[0]);
+  EXPECT_NE(cut[0].find("POLYGON ((0 0,0 2,2 2,2 0,0 0))"), std::string::npos) << cut[0];
+}
+
 TEST_F(LayersCli, PointFileLocatesEveryPoint) {
   const std::string layer = path("polys.shp");
   const OgrFeatureSet s = read_with_ogr(layer);

@@ -1142,6 +1142,26 @@ void write_shapes(const std::string& shp, std::int32_t type,
   write(fs::path(shp).replace_extension(".shx").string(), index);
 }
 
+// A ring whose last point is not its first is closed, by the direct read as through GDAL:
+// the closing edge is a segment of the ring like the others (a point inside the triangle it
+// closes is inside the polygon).
+TEST(ShapefileBoxes, AnUnclosedRingIsReadClosed) {
+  const std::vector<std::pair<double, double>> open{{0, 0}, {0, 4}, {4, 4}},
+      square{{5, 5}, {5, 6}, {6, 6}, {6, 5}, {5, 5}};
+  const std::string path = write_shapefile(
+      "unclosed", wkbPoint, 2,
+      [](int, std::mt19937_64&) { return std::make_unique<OGRPoint>(0, 0); }, 0);
+  write_shapes(path, 5, {shape_record(5, open, false, {}), shape_record(5, square, false, {})});
+  const auto direct = loci::io::read_shapefile_segments(path);
+  ASSERT_TRUE(direct);
+  expect_segments_like_gdal(path, *direct);
+  std::vector<loci::Box2> first;
+  for (std::size_t i = 0; i < direct->records.size(); ++i)
+    if (direct->records[i].fid == 0) first.push_back(direct->boxes[i]);
+  ASSERT_EQ(first.size(), 3u);
+  EXPECT_EQ(first[2], (loci::Box2{{0, 0}, {4, 4}}));  // (4, 4) back to (0, 0)
+}
+
 TEST(ShapefileBoxes, GeometryTypesNameZAndMAsGdalDoes) {
   // GDAL gives a layer measures when its first record (fid 0) carries M values and one of
   // them is above -1e38 (shapefiles' "no data"); then every geometry has them, a record
