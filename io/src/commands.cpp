@@ -124,6 +124,11 @@ std::string describe_layer(const std::string& layer_path, const std::string& lay
          "an index in memory)\n";
     return o.str();
   }
+  if (only_gdal_opens(layer_path)) {
+    o << "none (a path only GDAL opens is not indexed: nothing on disk tells when it "
+         "changes; loci query builds an index in memory)\n";
+    return o.str();
+  }
   if (std::error_code ec; !std::filesystem::exists(sidecar, ec)) {
     // Of a dataset's other layers than its first, the command names the layer.
     const bool first = s.layer_names.empty() || s.layer_names.front() == s.layer_name;
@@ -160,6 +165,11 @@ IndexReport index_layer(const IndexOptions& options) {
                 ": a VRT's features live in its sources, whose changes an index of it would not "
                 "see; query it without an index (loci query builds one in memory), or index "
                 "its source");
+  if (only_gdal_opens(options.layer_path))
+    throw Error(options.layer_path +
+                ": not a file on disk (a path only GDAL opens), whose changes an index could "
+                "not see; query it without an index (loci query builds one in memory), or "
+                "index a copy on disk");
   if (options.structure == Structure::rstar || options.structure == Structure::rtree)
     throw InvalidArgument(std::string("--structure ") + to_string(options.structure) +
                           " is built in memory only; a sidecar holds packed-hilbert or packed-str");

@@ -276,8 +276,7 @@ std::optional<Fingerprint> stat_fingerprint(const std::string& layer_path, bool&
   if (!stat_file(layer_path, st)) {
     // GDAL paths that are not files (virtual file systems, connection strings) cannot be
     // fingerprinted here; GDAL itself reports whether they open.
-    if (layer_path.rfind("/vsi", 0) == 0 || layer_path.find(':') != std::string::npos)
-      return std::nullopt;
+    if (only_gdal_opens(layer_path)) return std::nullopt;
     throw Error(layer_path + ": no such file");
   }
   Fingerprint f;
@@ -302,6 +301,12 @@ std::optional<Fingerprint> stat_fingerprint(const std::string& layer_path, bool&
 }
 
 }  // namespace
+
+bool only_gdal_opens(const std::string& layer_path) {
+  struct stat st {};
+  return (layer_path.rfind("/vsi", 0) == 0 || layer_path.find(':') != std::string::npos) &&
+         !stat_file(layer_path, st);
+}
 
 Fingerprint fingerprint_stat(const std::string& layer_path) {
   bool regular = false;
@@ -355,6 +360,8 @@ Fingerprint fingerprint_of(const std::string& layer_path) {
 }
 
 std::string stale_reason(const Fingerprint& was, const Fingerprint& now) {
+  if (now.size == 0 && now.mtime_ns == 0 && now.inode == 0)  // nothing on disk (still_fresh)
+    return "no file on disk to compare: a path only GDAL opens";
   if (was.size != now.size)
     return "size " + std::to_string(was.size) + " -> " + std::to_string(now.size) + " bytes";
   if (was.hash != now.hash) return "contents changed";
@@ -364,12 +371,18 @@ std::string stale_reason(const Fingerprint& was, const Fingerprint& now) {
 bool still_fresh(const std::string& layer_path, const Fingerprint& was, Fingerprint* now) {
   bool regular = false;
   const auto stat = stat_fingerprint(layer_path, regular);
-  Fingerprint f = stat.value_or(Fingerprint{});
+  // A path only GDAL opens has nothing to compare: never fresh (an index of it, which loci
+  // index no longer writes, would answer for whatever it holds now).
+  if (!stat) {
+    if (now) *now = Fingerprint{};
+    return false;
+  }
+  Fingerprint f = *stat;
   if (f.size == was.size && f.mtime_ns == was.mtime_ns && f.inode == was.inode) {
     if (now) *now = was;
     return true;
   }
-  if (!stat || !regular || f.size != was.size) {
+  if (!regular || f.size != was.size) {
     if (now) *now = f;
     return false;
   }

@@ -264,13 +264,16 @@ std::string check_sidecar(const std::string& arg) {
     now = fingerprint_of(layer);
     fresh = now.size == info.source.size && now.hash == info.source.hash;
   }
+  if (!fresh && only_gdal_opens(layer))
+    throw Error(path + ": intact, but " + layer +
+                " is a path only GDAL opens: nothing on disk tells whether it changed since");
   if (!fresh)
     throw Error(path + ": intact but stale, " + layer + " changed since it was indexed (" +
                 stale_reason(info.source, now) + "); run 'loci index " + layer + "'");
   const auto& i = info;
   return path + ": ok, " + (i.packing == Packing::str ? "packed-str" : "packed-hilbert") + " per " +
          to_string(i.per) + ", layer " + i.layer_name + ", " + std::to_string(i.items) +
-         " entries, " + std::to_string(chunks) + " chunks of " +
+         " entries, " + std::to_string(chunks) + (chunks == 1 ? " chunk of " : " chunks of ") +
          std::to_string(1u << (i.chunk_shift - 10)) + " KiB verified, " +
          std::to_string(i.file_size) + " bytes" + unchecked;
 }
@@ -298,6 +301,11 @@ namespace {
 [[noreturn]] void refuse_stale(const LoadOptions& o, const std::string& path,
                                const std::string& indexed, const Fingerprint& was,
                                const Fingerprint& now, bool gdal_or_hand_over) {
+  if (only_gdal_opens(o.layer_path))
+    throw Error(path + ": an index of " + o.layer_path +
+                ", a path only GDAL opens, cannot be checked against it (nothing on disk tells "
+                "when it changes); query it without an index (loci query builds one in memory)" +
+                (o.index_path.empty() ? ", after removing " + path : std::string()));
   // A sidecar of another layer altogether says so, rather than "stale".
   std::string actual;
   try {

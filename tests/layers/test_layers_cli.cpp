@@ -471,6 +471,39 @@ TEST_F(LayersCli, UnclosedRingsAreReadClosedEverywhere) {
   EXPECT_NE(cut[0].find("POLYGON ((0 0,0 2,2 2,2 0,0 0))"), std::string::npos) << cut[0];
 }
 
+// A path only GDAL opens (a virtual file system such as /vsigzip/, a connection) has no
+// file on disk to fingerprint: loci index refuses it, an index given for it is refused (it
+// could not tell when the layer changes), and queries without an index answer.
+TEST_F(LayersCli, PathsOnlyGdalOpensAreNotIndexed) {
+  const std::string plain = path("vsi-a.geojson");
+  std::ofstream(plain)
+      << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
+         R"("geometry":{"type":"Point","coordinates":[1,1]}}]})";
+  ASSERT_EQ(std::system(("gzip -kf " + shell_quote(plain)).c_str()), 0);
+  const std::string vsi = "/vsigzip/" + plain + ".gz";
+  const CliRun index = run_loci("index " + vsi);
+  EXPECT_EQ(index.status, 1);
+  EXPECT_NE(index.err.find("a path only GDAL opens"), std::string::npos) << index.err;
+  EXPECT_EQ(lines(index.err).size(), 1u) << index.err;
+  const std::string other = path("vsi-other.loci");
+  const CliRun written = run_loci("index -q " + vsi + " -o " + other);
+  EXPECT_EQ(written.status, 1);
+  EXPECT_FALSE(std::filesystem::exists(other));
+  const CliRun info = run_loci("info " + vsi);
+  EXPECT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("a path only GDAL opens is not indexed"), std::string::npos) << info.out;
+  const CliRun query = run_loci("query " + vsi + " --bbox 0,0,2,2 -f ids");
+  EXPECT_EQ(query.status, 0) << query.err;
+  EXPECT_EQ(query.out, "0\n");
+  // The index of the plain file, given for the compressed one, is not taken for it.
+  const std::string sidecar = path("vsi-plain.loci");
+  ASSERT_EQ(run_loci("index -q " + plain + " -o " + sidecar).status, 0);
+  const CliRun given = run_loci("query " + vsi + " --bbox 0,0,2,2 -f ids --index " + sidecar);
+  EXPECT_EQ(given.status, 1);
+  EXPECT_EQ(given.out, "");
+  EXPECT_NE(given.err.find("cannot be checked against it"), std::string::npos) << given.err;
+}
+
 TEST_F(LayersCli, PointFileLocatesEveryPoint) {
   const std::string layer = path("polys.shp");
   const OgrFeatureSet s = read_with_ogr(layer);

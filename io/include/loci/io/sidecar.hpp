@@ -200,9 +200,14 @@ class StreamHash {
   std::unique_ptr<State> state_;
 };
 
+// Whether `layer_path` names what only GDAL opens (a virtual file system path such as
+// /vsizip/ or /vsistdin/, a connection string) and no file or directory on disk: nothing
+// there for a fingerprint, so loci index refuses it.
+bool only_gdal_opens(const std::string& layer_path);
+
 // Whether the layer still holds what `was` was taken of: size, modification time and inode
 // equal (nothing is read), or else the same size and content hash. `now` receives what was
-// measured (for messages).
+// measured (for messages). Never for a path only GDAL opens.
 bool still_fresh(const std::string& layer_path, const Fingerprint& was, Fingerprint* now = nullptr);
 
 // What changed between `was` and `now` (still_fresh's measure), as messages say it: "size A ->
