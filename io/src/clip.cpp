@@ -423,8 +423,13 @@ ClipResult clip_layer(const ClipOptions& options) {
     // A shapefile's .dbf is written in UTF-8 (with a .cpg saying so): GDAL's default,
     // ISO-8859-1, turns every other character into '?'.
     const char* utf8[] = {"ENCODING=UTF-8", nullptr};
+    // GeoJSON's coordinates to 17 significant figures, which read back as the same doubles
+    // (GDAL's default, 15 decimals, wrote 1e-20 as 0).
+    const bool geojson = std::strcmp(driver->GetDescription(), "GeoJSON") == 0;
+    const char* exact[] = {"SIGNIFICANT_FIGURES=17", nullptr};
     OGRLayer* layer = ds->CreateLayer(src.layer->GetName(), src.layer->GetSpatialRef(), type,
                                       csv         ? const_cast<char**>(as_wkt)
+                                      : geojson   ? const_cast<char**>(exact)
                                       : !mixed_ok ? const_cast<char**>(utf8)
                                                   : nullptr);
     if (!layer) throw Error("cannot write " + options.out_path + ": " + CPLGetLastErrorMsg());

@@ -183,8 +183,11 @@ void write_geojson(const AnswerSource& src, std::span<const Answer> answers, boo
   CPLErrorReset();
   GDALDatasetUniquePtr ds(driver->Create(target.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
   if (!ds) throw Error("cannot write GeoJSON: " + std::string(CPLGetLastErrorMsg()));
-  OGRLayer* layer =
-      ds->CreateLayer(ol.layer->GetName(), ol.layer->GetSpatialRef(), wkbUnknown, nullptr);
+  // Coordinates to 17 significant figures, which read back as the same doubles (GDAL's
+  // default, 15 decimals, wrote 1e-20 as 0).
+  const char* exact[] = {"SIGNIFICANT_FIGURES=17", nullptr};
+  OGRLayer* layer = ds->CreateLayer(ol.layer->GetName(), ol.layer->GetSpatialRef(), wkbUnknown,
+                                    const_cast<char**>(exact));
   if (!layer) throw Error("cannot create the GeoJSON layer: " + std::string(CPLGetLastErrorMsg()));
   std::vector<std::pair<int, int>> copied;  // source field, output field
   int out_index = 0;

@@ -504,6 +504,46 @@ TEST_F(LayersCli, PathsOnlyGdalOpensAreNotIndexed) {
   EXPECT_NE(given.err.find("cannot be checked against it"), std::string::npos) << given.err;
 }
 
+// GeoJSON written by query -f geojson and by clip holds the same doubles as the layer: 17
+// significant figures (GDAL's default, 15 decimals, wrote 1e-20 as 0 and 7.123456789012345e-9
+// as 0.000000007123457).
+TEST_F(LayersCli, GeoJsonOutputKeepsTheCoordinates) {
+  const std::string layer = path("tiny.geojson");
+  std::ofstream(layer)
+      << R"({"type":"FeatureCollection","features":[)"
+         R"({"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1e-20,5e-16]}},)"
+         R"({"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":)"
+         R"([[1.0000000000000002,7.123456789012345e-9],[0.1,2.5],[123456.789,-1e-300]]}}]})";
+  const std::string queried = path("tiny-answers.geojson"), cut = path("tiny-cut.geojson");
+  const CliRun q = run_loci("query " + layer + " --bbox -1,-1,200000,3 -f geojson -o " + queried);
+  ASSERT_EQ(q.status, 0) << q.err;
+  std::filesystem::remove(cut);
+  const CliRun c = run_loci("clip " + layer + " --bbox -1,-1,200000,3 -o " + cut);
+  ASSERT_EQ(c.status, 0) << c.err;
+  const OgrFeatureSet in = read_with_ogr(layer);
+  for (const std::string& out : {queried, cut}) {
+    const OgrFeatureSet got = read_with_ogr(out);
+    ASSERT_EQ(got.geoms.size(), in.geoms.size()) << out;
+    for (std::size_t i = 0; i < in.geoms.size(); ++i) {
+      const auto* la = dynamic_cast<const OGRSimpleCurve*>(in.geoms[i].get());
+      const auto* lb = dynamic_cast<const OGRSimpleCurve*>(got.geoms[i].get());
+      if (!la) {
+        const auto* xa = in.geoms[i]->toPoint();
+        const auto* xb = got.geoms[i]->toPoint();
+        EXPECT_EQ(xb->getX(), xa->getX()) << out;
+        EXPECT_EQ(xb->getY(), xa->getY()) << out;
+        continue;
+      }
+      ASSERT_TRUE(lb) << out;
+      ASSERT_EQ(lb->getNumPoints(), la->getNumPoints()) << out;
+      for (int k = 0; k < la->getNumPoints(); ++k) {
+        EXPECT_EQ(lb->getX(k), la->getX(k)) << out << " point " << k;
+        EXPECT_EQ(lb->getY(k), la->getY(k)) << out << " point " << k;
+      }
+    }
+  }
+}
+
 TEST_F(LayersCli, PointFileLocatesEveryPoint) {
   const std::string layer = path("polys.shp");
   const OgrFeatureSet s = read_with_ogr(layer);
