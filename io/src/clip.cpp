@@ -461,9 +461,18 @@ ClipResult clip_layer(const ClipOptions& options) {
         unique = name + std::to_string(k);
       fd.SetName(unique.c_str());
       const int before = layer->GetLayerDefn()->GetFieldCount();
+      CPLErrorReset();
       if (layer->CreateField(&fd) != OGRERR_NONE ||
-          layer->GetLayerDefn()->GetFieldCount() != before + 1)
-        throw Error("cannot write " + options.out_path + ": field " + name);
+          layer->GetLayerDefn()->GetFieldCount() != before + 1) {
+        // GDAL's reason when it gives one (a shapefile has no list types), else the type.
+        const std::string why = CPLGetLastErrorMsg();
+        throw Error("cannot write " + options.out_path + ": field " + name + " (" +
+                    (why.empty()
+                         ? std::string("of type ") + OGRFieldDefn::GetFieldTypeName(fd.GetType()) +
+                               ", which the format does not hold"
+                         : why) +
+                    ")");
+      }
       fields[std::size_t(i)] = before;
     }
     for (Piece& p : pieces) {

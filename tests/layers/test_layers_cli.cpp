@@ -544,6 +544,19 @@ TEST_F(LayersCli, GeoJsonOutputKeepsTheCoordinates) {
   }
 }
 
+// A field the output format cannot hold is named with the reason, and nothing is left.
+TEST_F(LayersCli, ClipSaysWhyAFieldCannotBeWritten) {
+  const std::string layer = path("list-field.geojson"), out = path("list-field.shp");
+  std::ofstream(layer) << R"({"type":"FeatureCollection","features":[{"type":"Feature",)"
+                          R"("properties":{"lst":[1,2,3]},"geometry":{"type":"Point",)"
+                          R"("coordinates":[1,1]}}]})";
+  const CliRun r = run_loci("clip " + layer + " --bbox 0,0,2,2 -o " + out);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("field lst ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("IntegerList"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST_F(LayersCli, PointFileLocatesEveryPoint) {
   const std::string layer = path("polys.shp");
   const OgrFeatureSet s = read_with_ogr(layer);
