@@ -91,7 +91,6 @@ LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
   x.per_ = info.per;
   x.structure_ = info.packing == Packing::str ? Structure::packed_str : Structure::packed_hilbert;
   x.has_polygons_ = info.has_polygons;
-  x.bounds_ = info.bounds;
   x.layer_name_ = info.layer_name;
   x.source_ = info.source;
   x.records_ = sidecar.mapped_records();
@@ -100,6 +99,8 @@ LayerIndex LayerIndex::adopt(Sidecar&& sidecar) {
   x.stored_ = sidecar.hierarchies();
   x.mapped_items_ = sidecar.mapped_items();
   x.tree_ = std::move(sidecar).take_tree();
+  // The root's box, as the tree holds it (verified when read), not the header's copy of it.
+  x.bounds_ = x.packed()->bounds();
   x.features_ = std::make_shared<LazyFeatures>();
   return x;
 }

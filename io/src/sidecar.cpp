@@ -645,6 +645,15 @@ Sidecar Sidecar::open(const std::string& path) {
       !fits(h.items_offset, h.slot_count, 4) || !fits(h.records_offset, h.item_count, 16) ||
       !chunks_fit || !hierarchies_fit)
     throw refuse("corrupt index file (inconsistent sizes)");
+  // Each section where the writer puts it, from the 64-byte boundary after the one before (the
+  // sizes are within the file, checked above): a forged offset that would read one section
+  // as another, or a section a few bytes off, is refused whatever its checksums.
+  if (h.name_offset != sizeof(SidecarHeader) ||
+      h.checks_offset != align_up(h.name_offset + h.name_size) ||
+      h.data_offset != align_up(h.checks_offset + 8 * h.chunk_count) ||
+      h.items_offset != align_up(h.blocks_offset + h.block_count * sizeof(Block)) ||
+      h.records_offset != align_up(h.items_offset + 4 * h.slot_count))
+    throw refuse("corrupt index file (sections out of place)");
   // The name and the checksum table are read now; the data only where a query reads it.
   if (h.front_checksum !=
       hash_bytes(m->data + sizeof(SidecarHeader), h.data_offset - sizeof(SidecarHeader)))
@@ -703,6 +712,9 @@ std::span<const ItemRecord> Sidecar::records() const {
 void Sidecar::verify() const {
   check_->touch_all();
   tree_.validate();
+  // Queries take the tree's own bounds (LayerIndex::adopt); the header's must be the same.
+  if (!(tree_.bounds() == info_.bounds))
+    throw Error("corrupt index file (the header's bounds are not the tree's)");
 }
 
 }  // namespace loci::io

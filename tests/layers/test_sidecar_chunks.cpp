@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "loci/io/layer_query.hpp"
 #include "loci/io/sidecar.hpp"
 #include "support/scratch.hpp"
 
@@ -212,6 +213,63 @@ TEST(SidecarChunks, CorruptFrontIsRefusedAtOpen) {
   }
   put(f, f.bytes);
   EXPECT_NO_THROW(Sidecar::open(f.path).verify());
+}
+
+// A header forged with its own checksum recomputed: `field` (8 bytes of the header holding
+// `was`, found by its value) set to `now`.
+std::string forged(const Fixture& f, const void* was, const void* now) {
+  std::string bytes = f.bytes;
+  std::size_t at = std::string::npos;
+  for (std::size_t k = 0; k + 8 <= 256; k += 8)
+    if (std::memcmp(bytes.data() + k, was, 8) == 0) {
+      EXPECT_EQ(at, std::string::npos) << "the value is in the header twice";
+      at = k;
+    }
+  EXPECT_NE(at, std::string::npos);
+  if (at == std::string::npos) return bytes;
+  std::memcpy(bytes.data() + at, now, 8);
+  // The header's checksum is its last field: XXH3 of the bytes before it.
+  for (std::size_t k = 248; k > 0; k -= 8) {
+    std::uint64_t stored;
+    std::memcpy(&stored, f.bytes.data() + k, 8);
+    if (stored == XXH3_64bits(f.bytes.data(), k)) {
+      const std::uint64_t sum = XXH3_64bits(bytes.data(), k);
+      std::memcpy(bytes.data() + k, &sum, 8);
+      return bytes;
+    }
+  }
+  ADD_FAILURE() << "no header checksum found";
+  return bytes;
+}
+
+// Sections read where the header says but the writer never puts them (the item indices read
+// from the checksum table) are refused at open, whatever the checksums say.
+TEST(SidecarChunks, SectionsOutOfPlaceAreRefusedAtOpen) {
+  const Fixture f = make(3000, 4);
+  const std::uint64_t items_offset =
+      f.data_offset + PackedRTree2::block_count(3000) * sizeof(PackedRTree2::Block);
+  ASSERT_EQ(items_offset % 64, 0u);
+  const std::uint64_t moved = 320;
+  put(f, forged(f, &items_offset, &moved));
+  try {
+    (void)Sidecar::open(f.path);
+    ADD_FAILURE() << "opened";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("out of place"), std::string::npos) << e.what();
+  }
+}
+
+// Queries take the tree's bounds, not the header's copy, and loci check compares the two.
+TEST(SidecarChunks, ForgedBoundsAreNotTakenAndCheckRefusesThem) {
+  const Fixture f = make(3000, 5);
+  const Box2 truth = PackedRTree2::build(f.boxes).bounds();
+  const double max_x = truth.max[0], less = truth.max[0] / 2;
+  put(f, forged(f, &max_x, &less));
+  const Sidecar s = Sidecar::open(f.path);
+  EXPECT_EQ(s.info().bounds.max[0], less);
+  EXPECT_THROW(s.verify(), Error);
+  const LayerIndex index = LayerIndex::adopt(Sidecar::open(f.path));
+  EXPECT_EQ(index.bounds(), truth);
 }
 
 // The checksums are XXH3-64 whatever instructions compute them (AVX2 where the processor has

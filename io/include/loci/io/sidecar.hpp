@@ -45,7 +45,8 @@
 // transfers and truncation to 7 bits are caught at once, as PNG does.
 //
 // Opening costs the same whatever the file's size: the file is mapped, the header, name and
-// checksum table are checked (every size and offset against the real file size), and the tree
+// checksum table are checked (every size and offset against the real file size, each
+// section where the writer puts it), and the tree
 // adopts the mapping in place. The data is verified one chunk at a time, the first time a query
 // reads from that chunk (detail::LazyCheck), so a flipped bit is refused with a message when its
 // chunk is read and never answers; `loci check` verifies every chunk and the tree's invariants.
