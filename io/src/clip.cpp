@@ -90,8 +90,7 @@ void refuse_malformed_rings(const OGRGeometry& window) {
       ++r;
       const int n = ring->getNumPoints();
       if (n == 0) continue;
-      // Closed in plan (a ring whose ends differ only in z is closed, as loci reads it).
-      if (ring->getX(0) != ring->getX(n - 1) || ring->getY(0) != ring->getY(n - 1))
+      if (detail::unclosed(*ring))
         throw InvalidGeometry("--wkt: " + which +
                               " is not closed: a ring ends at the point it starts from");
       if (n < 4)

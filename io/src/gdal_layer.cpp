@@ -123,11 +123,6 @@ bool same_layer(const std::string& path_a, const std::string& name_a, const std:
 
 namespace {
 
-bool unclosed(const OGRLinearRing& ring) {
-  const int n = ring.getNumPoints();
-  return n > 1 && (ring.getX(0) != ring.getX(n - 1) || ring.getY(0) != ring.getY(n - 1));
-}
-
 void walk(const OGRGeometry* g, std::uint32_t& polygons,
           const std::function<void(const OGRSimpleCurve&, bool, std::uint32_t)>& f) {
   if (!g) return;
@@ -200,6 +195,11 @@ void for_each_point(const OGRGeometry* g, const std::string& what,
 
 void check_points(const OGRGeometry* g, const std::string& what) {
   for_each_point(g, what, [](const Point2&) {});
+}
+
+bool unclosed(const OGRLinearRing& ring) {
+  const int n = ring.getNumPoints();
+  return n > 1 && (ring.getX(0) != ring.getX(n - 1) || ring.getY(0) != ring.getY(n - 1));
 }
 
 bool has_unclosed_ring(const OGRGeometry& g) {

@@ -89,8 +89,11 @@ void for_each_point(const OGRGeometry* g, const std::string& what,
 void for_each_curve(const OGRGeometry* g,
                     const std::function<void(const OGRSimpleCurve&, bool, std::uint32_t)>& f);
 
-// Whether a ring of g (of its polygons, at any depth of collections) does not end at the
-// point it starts from, in plan.
+// Whether the ring does not end at the point it starts from, in plan (ends differing only in
+// z are closed).
+bool unclosed(const OGRLinearRing& ring);
+
+// Whether a ring of g (of its polygons, at any depth of collections) is unclosed().
 bool has_unclosed_ring(const OGRGeometry& g);
 
 // Throws InvalidGeometry (naming `what`) on a NaN or infinite coordinate.
