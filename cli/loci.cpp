@@ -104,6 +104,10 @@ int run_clip(const Args& a) {
   o.window_layer_name = a.get("--window-layer-name");
   o.out_path = a.get("--output");
   const ClipResult r = clip_layer(o);
+  // Values changed on the way are said even with --quiet.
+  for (const std::string& f : r.retyped)
+    std::fprintf(stderr, "loci: warning: field %s, the nearest type %s holds\n",
+                 printable(f).c_str(), printable(o.out_path).c_str());
   if (!a.has("--quiet")) {
     std::fprintf(stderr, "loci: %zu feature%s clipped into %s\n", r.written,
                  r.written == 1 ? "" : "s", printable(o.out_path).c_str());

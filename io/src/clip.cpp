@@ -473,6 +473,10 @@ ClipResult clip_layer(const ClipOptions& options) {
                     ")");
       }
       fields[std::size_t(i)] = before;
+      const OGRFieldDefn* made = layer->GetLayerDefn()->GetFieldDefn(before);
+      if (made->GetType() != fd.GetType())
+        result.retyped.push_back(name + ": " + OGRFieldDefn::GetFieldTypeName(fd.GetType()) +
+                                 " written as " + OGRFieldDefn::GetFieldTypeName(made->GetType()));
     }
     for (Piece& p : pieces) {
       std::unique_ptr<OGRGeometry> piece = std::move(p.geometry);

@@ -557,6 +557,29 @@ TEST_F(LayersCli, ClipSaysWhyAFieldCannotBeWritten) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// A field the output format holds only as another type (a shapefile's Date for a DateTime:
+// the times of day are lost) is written, with a warning naming it, even with --quiet.
+TEST_F(LayersCli, ClipWarnsOfAFieldWrittenAsAnotherType) {
+  const std::string layer = path("datetime-field.geojson");
+  std::ofstream(layer) << R"({"type":"FeatureCollection","features":[{"type":"Feature",)"
+                          R"("properties":{"when":"2024-01-02T03:04:05Z","n":1},)"
+                          R"("geometry":{"type":"Point","coordinates":[1,1]}}]})";
+  for (const char* quiet : {"", " -q"}) {
+    const std::string out = path(std::string("datetime") + (*quiet ? "-q" : "") + ".shp");
+    const CliRun r = run_loci("clip " + layer + " --bbox 0,0,2,2 -o " + out + quiet);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: field when: DateTime written as Date"), std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("field n"), std::string::npos) << r.err;
+    const OgrFeatureSet got = read_with_ogr(out);
+    ASSERT_EQ(got.geoms.size(), 1u);
+  }
+  // A format that holds the type says nothing.
+  const CliRun g = run_loci("clip " + layer + " --bbox 0,0,2,2 -o " + path("datetime.gpkg"));
+  ASSERT_EQ(g.status, 0) << g.err;
+  EXPECT_EQ(g.err.find("warning"), std::string::npos) << g.err;
+}
+
 TEST_F(LayersCli, PointFileLocatesEveryPoint) {
   const std::string layer = path("polys.shp");
   const OgrFeatureSet s = read_with_ogr(layer);

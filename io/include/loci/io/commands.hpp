@@ -171,6 +171,9 @@ struct ClipOptions {
 struct ClipResult {
   std::size_t written = 0;  // features written
   std::size_t dropped = 0;  // cut pieces of a lower dimension than their feature left out
+  // Fields the output format made of another type than the layer's (a shapefile holds a
+  // DateTime as a Date, dropping the times of day): "NAME: DateTime written as Date".
+  std::vector<std::string> retyped;
 };
 ClipResult clip_layer(const ClipOptions& options);
 
