@@ -66,8 +66,18 @@ int run(const std::string& path, const std::string& layer) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || argc > 3) {
-    std::fprintf(stderr, "usage: loci-quickstart LAYER [LAYER_NAME]\n");
+  constexpr const char* kUsage =
+      "usage: loci-quickstart LAYER [LAYER_NAME]\n"
+      "Indexes the segments of a layer in a packed R-tree (Hilbert and STR) and an R*-tree,\n"
+      "and prints what a few windows and nearest-3 queries find in each.\n";
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::fputs(kUsage, stdout);
+    if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return 0;
+    std::fprintf(stderr, "loci-quickstart: error: cannot write the help\n");
+    return 1;
+  }
+  if (argc < 2 || argc > 3 || argv[1][0] == '-') {
+    std::fputs(kUsage, stderr);
     return 1;
   }
   try {

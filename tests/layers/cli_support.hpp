@@ -39,14 +39,14 @@ inline std::string read_text(const std::string& path) {
   return s.str();
 }
 
-// Runs `loci ARGS` (ARGS already quoted as needed) and captures everything.
-inline CliRun run_loci(const std::string& args) {
+// Runs the shell command `command` (quoted as needed) and captures everything.
+inline CliRun run_command(const std::string& command) {
   static int counter = 0;
   const std::string err =
       (std::filesystem::temp_directory_path() /
        ("loci-test-err-" + std::to_string(::getpid()) + "-" + std::to_string(counter++)))
           .string();
-  const std::string cmd = std::string(LOCI_EXE) + " " + args + " 2>" + shell_quote(err);
+  const std::string cmd = command + " 2>" + shell_quote(err);
   CliRun r;
   std::FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -59,6 +59,11 @@ inline CliRun run_loci(const std::string& args) {
   r.err = read_text(err);
   std::filesystem::remove(err);
   return r;
+}
+
+// Runs `loci ARGS` (ARGS already quoted as needed) and captures everything.
+inline CliRun run_loci(const std::string& args) {
+  return run_command(std::string(LOCI_EXE) + " " + args);
 }
 
 inline std::vector<std::string> lines(const std::string& text) {

@@ -361,6 +361,23 @@ TEST_F(BadInput, TheInputLayerIsNeverOverwritten) {
   EXPECT_EQ(read_text(path("other.loci")), other);
 }
 
+// loci-quickstart, beside loci, gives its usage for --help (it took it for a layer's name).
+TEST_F(BadInput, QuickstartHelpIsHelp) {
+  const std::string exe = std::string(LOCI_EXE) + "-quickstart";
+  const CliRun h = run_command(exe + " --help");
+  EXPECT_EQ(h.status, 0) << h.err;
+  EXPECT_EQ(h.out.rfind("usage: loci-quickstart LAYER", 0), 0u) << h.out;
+  EXPECT_TRUE(h.err.empty()) << h.err;
+  const CliRun full = run_command(exe + " --help > /dev/full");
+  EXPECT_EQ(full.status, 1);
+  EXPECT_NE(full.err.find("cannot write the help"), std::string::npos) << full.err;
+  for (const char* bad : {"", " -x", " a b c"}) {
+    const CliRun r = run_command(exe + bad);
+    EXPECT_EQ(r.status, 1) << bad;
+    EXPECT_EQ(r.err.rfind("usage: loci-quickstart LAYER", 0), 0u) << bad << ": " << r.err;
+  }
+}
+
 TEST_F(BadInput, FullDiskAndFullStdoutFailAndKeepTheOldFile) {
   const std::string l = lines_layer();
   for (const char* f : {"ids", "csv", "geojson"}) {
