@@ -1,6 +1,7 @@
 // `loci bench`: see bench.hpp.
 #include "bench.hpp"
 
+#include <algorithm>
 #include <boost/geometry.hpp>
 #include <boost/geometry/index/rtree.hpp>
 #include <chrono>
@@ -99,12 +100,18 @@ std::string bench_layer(const BenchOptions& o) {
   if (std::abs(loci_sum - boost_sum) > 1e-9 * std::max(1.0, std::abs(boost_sum)))
     throw Error("nearest-n distances differ between loci and Boost");
 
+  // A point layer's entries are its points (segments of length 0 to the index).
+  const bool all_points =
+      std::all_of(boxes.begin(), boxes.end(), [](const Box2& b) { return b.min == b.max; });
   char head[200];  // the layer's path goes around it: it may be of any length
   std::snprintf(head, sizeof head,
                 ": %zu boxes (per %s), %zu windows (%zu hits), %zu nearest-%zu queries\n"
                 "%-28s %12s %12s %10s\n",
-                boxes.size(), o.per == Per::segment ? "segment" : "feature", o.queries, loci_hits,
-                o.queries, o.k, "", "loci ms", "Boost ms", "Boost/loci");
+                boxes.size(),
+                o.per == Per::feature ? "feature"
+                : all_points          ? "point"
+                                      : "segment",
+                o.queries, loci_hits, o.queries, o.k, "", "loci ms", "Boost ms", "Boost/loci");
   return o.layer_path + head + row("build (packed)", loci_build, boost_build) +
          row("window queries", loci_window, boost_window) +
          row("nearest-n queries", loci_nearest, boost_nearest);

@@ -580,6 +580,22 @@ TEST_F(LayersCli, ClipWarnsOfAFieldWrittenAsAnotherType) {
   EXPECT_EQ(g.err.find("warning"), std::string::npos) << g.err;
 }
 
+// loci bench compares the packed tree with Boost.Geometry's on the layer's entries and names
+// them: a point layer's are its points, not segments.
+TEST_F(LayersCli, BenchNamesWhatItIndexes) {
+  const std::string pts = path("bench-points.csv"), lines = path("bench-lines.csv");
+  std::ofstream(pts) << "WKT,n\n\"POINT (1 1)\",1\n\"POINT (2 2)\",2\n\"POINT (3 1)\",3\n";
+  std::ofstream(lines) << "WKT,n\n\"LINESTRING (0 0,1 1,2 0)\",1\n\"LINESTRING (5 5,6 6)\",2\n";
+  const CliRun p = run_loci("bench " + pts + " --queries 50");
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_NE(p.out.find(": 3 boxes (per point), 50 windows"), std::string::npos) << p.out;
+  const CliRun l = run_loci("bench " + lines + " --queries 50");
+  ASSERT_EQ(l.status, 0) << l.err;
+  EXPECT_NE(l.out.find(": 3 boxes (per segment), 50 windows"), std::string::npos) << l.out;
+  for (const char* row : {"build (packed)", "window queries", "nearest-n queries"})
+    EXPECT_NE(l.out.find(row), std::string::npos) << l.out;
+}
+
 TEST_F(LayersCli, PointFileLocatesEveryPoint) {
   const std::string layer = path("polys.shp");
   const OgrFeatureSet s = read_with_ogr(layer);
