@@ -75,20 +75,6 @@ std::string shell_word(const std::string& word) {
   return q + "'";
 }
 
-// Whether `path` is an OGR VRT: a file describing layers whose features live in other files
-// or databases, which a fingerprint of the file does not see change.
-bool is_vrt(const std::string& path) {
-  // Only a regular file is read: opening a FIFO would wait for a writer (open_layer refuses
-  // it, with a message, once this says no).
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
-  std::ifstream f(path, std::ios::binary);
-  std::string head(256, '\0');
-  f.read(head.data(), std::streamsize(head.size()));
-  head.resize(std::size_t(f.gcount()));
-  return head.find("<OGRVRTDataSource") != std::string::npos;
-}
-
 }  // namespace
 
 std::string describe_layer(const std::string& layer_path, const std::string& layer_name,

@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -306,6 +307,18 @@ bool only_gdal_opens(const std::string& layer_path) {
   struct stat st {};
   return (layer_path.rfind("/vsi", 0) == 0 || layer_path.find(':') != std::string::npos) &&
          !stat_file(layer_path, st);
+}
+
+bool is_vrt(const std::string& path) {
+  // Only a regular file is read: opening a FIFO would wait for a writer (open_layer refuses
+  // it, with a message, once this says no).
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
+  std::ifstream f(path, std::ios::binary);
+  std::string head(256, '\0');
+  f.read(head.data(), std::streamsize(head.size()));
+  head.resize(std::size_t(f.gcount()));
+  return head.find("<OGRVRTDataSource") != std::string::npos;
 }
 
 Fingerprint fingerprint_stat(const std::string& layer_path) {

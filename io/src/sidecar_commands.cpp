@@ -267,6 +267,9 @@ std::string check_sidecar(const std::string& arg) {
   if (!fresh && only_gdal_opens(layer))
     throw Error(path + ": intact, but " + layer +
                 " is a path only GDAL opens: nothing on disk tells whether it changed since");
+  if (!fresh && is_vrt(layer))
+    throw Error(path + ": intact, but not an index of " + layer +
+                " (a VRT is not indexed: its features live in its sources)");
   if (!fresh)
     throw Error(path + ": intact but stale, " + layer + " changed since it was indexed (" +
                 stale_reason(info.source, now) + "); run 'loci index " + layer + "'");
@@ -305,6 +308,12 @@ namespace {
     throw Error(path + ": an index of " + o.layer_path +
                 ", a path only GDAL opens, cannot be checked against it (nothing on disk tells "
                 "when it changes); query it without an index (loci query builds one in memory)" +
+                (o.index_path.empty() ? ", after removing " + path : std::string()));
+  // Nor is a VRT indexed: what stands beside it is an older loci's, or another file's.
+  if (is_vrt(o.layer_path))
+    throw Error(path + ": not an index of " + o.layer_path +
+                " (a VRT is not indexed: its features live in its sources); query it without "
+                "an index (loci query builds one in memory)" +
                 (o.index_path.empty() ? ", after removing " + path : std::string()));
   // A sidecar of another layer altogether says so, rather than "stale".
   std::string actual;

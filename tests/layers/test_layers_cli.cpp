@@ -2421,6 +2421,19 @@ TEST_F(LayersCli, RefusesToIndexAVrtWhoseSourcesItCannotWatch) {
   EXPECT_EQ(run_loci("query " + vrt + " --bbox 0,0,2,2").out, "1\n");
   std::ofstream(src) << "id,WKT\n1,\"POINT (9 9)\"\n2,\"POINT (1 1)\"\n";
   EXPECT_EQ(run_loci("query " + vrt + " --bbox 0,0,2,2").out, "2\n");
+  // A sidecar beside it (an older loci's, or another file's written with -o) is not offered
+  // to be rebuilt with the command that refuses VRTs.
+  ASSERT_EQ(run_loci("index -q " + src + " -o " + vrt + ".loci").status, 0);
+  for (const std::string& cmd : {"query " + vrt + " --bbox 0,0,2,2",
+                                 "query " + vrt + " --bbox 0,0,2,2 --index " + vrt + ".loci",
+                                 "check " + vrt, "check " + vrt + ".loci"}) {
+    const CliRun stale = run_loci(cmd);
+    EXPECT_EQ(stale.status, 1) << cmd;
+    EXPECT_NE(stale.err.find("not an index of " + vrt + " (a VRT is not indexed"),
+              std::string::npos)
+        << cmd << ": " << stale.err;
+    EXPECT_EQ(stale.err.find("loci index"), std::string::npos) << cmd << ": " << stale.err;
+  }
 }
 
 TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {

@@ -206,6 +206,10 @@ class StreamHash {
 // there for a fingerprint, so loci index refuses it.
 bool only_gdal_opens(const std::string& layer_path);
 
+// Whether `path` is an OGR VRT: a file describing layers whose features live in other files
+// or databases, which a fingerprint of the file does not see change; loci index refuses it.
+bool is_vrt(const std::string& path);
+
 // Whether the layer still holds what `was` was taken of: size, modification time and inode
 // equal (nothing is read), or else the same size and content hash. `now` receives what was
 // measured (for messages). Never for a path only GDAL opens.
