@@ -74,12 +74,27 @@ std::optional<std::string> copy_in_memory(const std::string& name) {
     throw CopyFailed(name + ": " + what + " (" + std::strerror(error) + ")");
   };
   char buf[1 << 16];
+  // A line longer than read_query_file takes is refused here already: memory files are
+  // outside the process's address-space limit, and an endless stream without a newline would
+  // fill the machine's memory.
+  std::size_t line = 1, length = 0;
   for (;;) {
     const ssize_t n = ::read(in, buf, sizeof buf);
     if (n == 0) break;
     if (n < 0) {
       if (errno == EINTR) continue;
       fail("cannot read the query file", errno);
+    }
+    for (const char* at = buf; at < buf + n;) {
+      const char* nl = static_cast<const char*>(std::memchr(at, '\n', std::size_t(buf + n - at)));
+      length += std::size_t((nl ? nl : buf + n) - at);
+      if (length > loci::io::kQueryLineLimit) {
+        ::close(in);
+        ::close(copy);
+        throw CopyFailed(loci::io::query_line_too_long(name, line));
+      }
+      if (!nl) break;
+      ++line, length = 0, at = nl + 1;
     }
     for (ssize_t at = 0; at < n;) {
       const ssize_t w = ::write(copy, buf + at, std::size_t(n - at));

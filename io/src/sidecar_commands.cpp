@@ -139,6 +139,11 @@ Query parse_within(const std::string& text) {
   return q;
 }
 
+std::string query_line_too_long(const std::string& path, std::size_t line) {
+  return path + ": line " + std::to_string(line) + ": longer than " +
+         std::to_string(kQueryLineLimit >> 20) + " MiB, not a line of a query file";
+}
+
 std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& path,
                                                            Query::Kind kind, std::size_t k) {
   std::error_code ec;
@@ -146,9 +151,22 @@ std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& pa
     throw Error(path + ": is a directory, not a query file");
   std::ifstream in(path);
   if (!in) throw Error(path + ": cannot read the query file");
+  // Read from the buffer directly rather than by std::getline, which takes a failure to grow
+  // its line (out of memory) for the end of the file and grows without bound on a stream with
+  // no newline: the first line longer than the limit is refused.
+  std::streambuf* const buf = in.rdbuf();
+  auto next = [&](std::string& line, std::size_t n) {
+    line.clear();
+    for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+      if (c == '\n') return true;
+      if (line.size() == kQueryLineLimit) throw Error(query_line_too_long(path, n));
+      line.push_back(char(c));
+    }
+    return !line.empty();
+  };
   std::vector<std::pair<std::size_t, Query>> out;
   std::string line;
-  for (std::size_t n = 1; std::getline(in, line); ++n) {
+  for (std::size_t n = 1; next(line, n); ++n) {
     // A UTF-8 byte order mark, as editors on some systems write it, is not part of the text.
     if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;

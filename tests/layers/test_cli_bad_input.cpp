@@ -707,6 +707,49 @@ TEST_F(BadInput, OutputNamesSayWhatTheyHold) {
 
 // A batch's CSV header is that of its kind of query, rows or none: an empty --nearest-file
 // lost its distance column.
+// A query file's line longer than 1 MiB (a binary file, a stream without newlines) is refused
+// before it fills memory, in one line, the old output kept: std::getline took running out of
+// memory for the end of the file and answered the queries before it, exit 0; /dev/zero grew
+// without bound. So too where the front copies a pipe into memory for loci-full.
+TEST_F(BadInput, AQueryFileLineLongerThanTheLimitIsRefused) {
+  const std::string l = lines_layer();
+  const std::string shp = path("lines.shp");
+  ASSERT_EQ(std::system(("ogr2ogr -q " + shell_quote(shp) + " " + shell_quote(l)).c_str()), 0)
+      << "ogr2ogr (gdal-bin, from scripts/install-deps.sh) could not make a shapefile";
+  ASSERT_EQ(run_loci("index -q --per feature " + shell_quote(shp)).status, 0);
+  const std::string q = path("long.txt");
+  {
+    std::ofstream out(q, std::ios::binary);
+    out << "0,0,9,9\n" << std::string((std::size_t(1) << 20) + 1, '\0') << "\n";
+  }
+  write("old.csv", "the old answer\n");
+  for (const std::string& layer : {l, shp}) {
+    const CliRun r = run_loci("query " + shell_quote(layer) + " --bbox-file " + shell_quote(q) +
+                              " -f csv -o " + shell_quote(path("old.csv")));
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("long.txt: line 2: longer than 1 MiB"), std::string::npos) << r.err;
+    EXPECT_EQ(read_text(path("old.csv")), "the old answer\n");
+    // From a pipe (the front copies it for loci-full on the shapefile), and endless.
+    const CliRun p = run_command("cat " + shell_quote(q) + " | " + std::string(LOCI_EXE) +
+                                 " query " + shell_quote(layer) + " --bbox-file -");
+    expect_one_line_error(p);
+    EXPECT_NE(p.err.find("line 2: longer than 1 MiB"), std::string::npos) << p.err;
+    EXPECT_EQ(p.out, "") << layer;
+    const CliRun z = run_command("timeout 60 " + std::string(LOCI_EXE) + " query " +
+                                 shell_quote(layer) + " --nearest-file /dev/zero");
+    expect_one_line_error(z);
+    EXPECT_NE(z.err.find("/dev/zero: line 1: longer than 1 MiB"), std::string::npos) << z.err;
+  }
+  // A line of exactly 1 MiB is read (and refused as the query it is not).
+  {
+    std::ofstream out(q, std::ios::binary);
+    out << "0,0,9,9\n" << std::string((std::size_t(1) << 20) - 1, ' ') << "1\n";
+  }
+  const CliRun edge = run_loci("query " + shell_quote(l) + " --bbox-file " + shell_quote(q));
+  expect_one_line_error(edge);
+  EXPECT_NE(edge.err.find("line 2: bad"), std::string::npos) << edge.err;
+}
+
 TEST_F(BadInput, EmptyQueryFilesGiveTheHeaderOfTheirKind) {
   const std::string l = lines_layer();
   const std::string empty = write("empty.txt", ""), one = write("one.txt", "0,0\n");

@@ -40,9 +40,14 @@ Query parse_within(const std::string& text);
 
 // One query per non-empty line (XMIN,YMIN,XMAX,YMAX for bbox, X,Y otherwise); blank lines
 // and lines starting with '#' are skipped but still counted, so answers name file lines.
-// Throws Error naming the file and line of a bad line.
+// Throws Error naming the file and line of a bad line, of a line longer than
+// kQueryLineLimit, or where reading fails (memory too: never a batch cut short).
 std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& path,
                                                            Query::Kind kind, std::size_t k);
+// A query file's lines are at most this long: a longer one (a binary file, an endless stream
+// without newlines) is refused before it fills memory, with this message.
+inline constexpr std::size_t kQueryLineLimit = std::size_t(1) << 20;
+std::string query_line_too_long(const std::string& path, std::size_t line);
 
 // Text as a message or a summary line shows it: control characters (a newline in a file or
 // layer name, an escape sequence meant for the terminal) as '?', so that it keeps to one line.
