@@ -118,7 +118,7 @@ void write_csv(const AnswerSource& src, std::span<const Answer> answers, bool nu
     line += "," + csv_quoted(name);
   std::fprintf(out, "%s\n", line.c_str());
   AnswerFeatures features(ol, src, answers, [&](std::int64_t fid) {
-    return OGRFeatureUniquePtr(ol.layer->GetFeature(fid));
+    return detail::read_feature(*ol.layer, fid, src.layer_path);
   });
   for (const auto& a : answers) {
     const OGRFeature* f = &features.at(a.fid);

@@ -51,6 +51,15 @@ void ReadCheck::feature(std::int64_t fid) const {
   fids_.push_back(fid);
 }
 
+OGRFeatureUniquePtr read_feature(OGRLayer& layer, std::int64_t fid, const std::string& path) {
+  CPLErrorReset();
+  OGRFeatureUniquePtr f(layer.GetFeature(fid));
+  if (read_failed())
+    throw Error(path + ": cannot read feature " + std::to_string(fid) + " (" +
+                CPLGetLastErrorMsg() + "): the file is damaged, or changed while loci read it");
+  return f;
+}
+
 void ReadCheck::finish() const {
   if (read_failed()) fail("");
   if (increasing_) return;

@@ -52,7 +52,7 @@ JoinLayer read_join_layer(const std::string& path, const std::string& name) {
     const OGRGeometry* g = f->GetGeometryRef();
     if (by_fid) {
       built = polygons.read(f->GetFID());
-      if (!built) whole.reset(by_fid->layer->GetFeature(f->GetFID()));
+      if (!built) whole = detail::read_feature(*by_fid->layer, f->GetFID(), path);
       g = built ? built.get() : whole ? whole->GetGeometryRef() : nullptr;
     }
     FlatGeometry flat = detail::flatten(g, detail::where(path, f->GetFID()));

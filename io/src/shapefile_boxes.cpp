@@ -255,7 +255,8 @@ namespace detail {
 
 using namespace shp;
 
-ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer) : layer_(&layer) {
+ShapefilePolygons::ShapefilePolygons(const std::string& path, OGRLayer& layer)
+    : path_(path), layer_(&layer) {
   // The rules followed are those of GDAL 3.6 (Debian 12's), checked against it by the tests;
   // other versions, and the options that change how GDAL sorts rings, leave it to GDAL.
   if (std::atoi(GDALVersionInfo("VERSION_NUM")) / 10000 != 306) return;
@@ -296,7 +297,7 @@ OGRFeatureUniquePtr ShapefilePolygons::fetch(std::int64_t fid) {
     if (layer_->SetIgnoredFields(g ? no_geometry : nullptr) != OGRERR_NONE) g.reset();
     geometry_ignored_ = bool(g);
   }
-  OGRFeatureUniquePtr f(layer_->GetFeature(fid));
+  OGRFeatureUniquePtr f = read_feature(*layer_, fid, path_);
   if (f && g) f->SetGeometryDirectly(g.release());
   return f;
 }

@@ -45,6 +45,7 @@ class ShapefilePolygons {
 
  private:
   std::unique_ptr<shp::RecordFiles> files_;
+  std::string path_;
   OGRLayer* layer_;
   OGRSpatialReference* srs_ = nullptr;
   bool geometry_ignored_ = false;

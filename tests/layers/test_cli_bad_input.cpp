@@ -750,6 +750,41 @@ TEST_F(BadInput, AQueryFileLineLongerThanTheLimitIsRefused) {
   EXPECT_NE(edge.err.find("line 2: bad"), std::string::npos) << edge.err;
 }
 
+// A feature GDAL reads only in part (its record out of the file: the .shx rewritten in place
+// with its time set back, as a file changed while a batch runs leaves it) is an error naming
+// it, not a feature silently left out of the answer (exit 0 without it, before).
+TEST_F(BadInput, AFeatureReadOnlyInPartIsAnErrorNotADrop) {
+  const std::string l = write("two.geojson", R"({"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"n":0},"geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1],[0,1],[0,0]]]}},
+{"type":"Feature","properties":{"n":1},"geometry":{"type":"Polygon","coordinates":[[[2,0],[4,0],[2,2],[2,0]]]}}]})");
+  const std::string shp = path("two.shp"), shx = path("two.shx");
+  ASSERT_EQ(std::system(("ogr2ogr -q " + shell_quote(shp) + " " + shell_quote(l)).c_str()), 0)
+      << "ogr2ogr (gdal-bin, from scripts/install-deps.sh) could not make a shapefile";
+  ASSERT_EQ(run_loci("index -q --per feature " + shell_quote(shp)).status, 0);
+  const std::string window = " --bbox 2.5,0.5,3,1";  // inside the triangle, FID 1
+  ASSERT_EQ(run_loci("query " + shell_quote(shp) + window).out, "1\n");
+  {
+    const auto time = fs::last_write_time(shx);
+    std::string bytes = read_text(shx);
+    ASSERT_GE(bytes.size(), 116u);
+    // The second record's offset, in 16-bit words, big-endian: far beyond the .shp's end.
+    const unsigned char far[4] = {0x7f, 0xff, 0xff, 0x00};
+    std::copy(far, far + 4, bytes.begin() + 108);
+    std::ofstream(shx, std::ios::binary | std::ios::in | std::ios::out) << bytes;
+    fs::last_write_time(shx, time);
+  }
+  for (const char* format : {"ids", "csv", "geojson"}) {
+    const CliRun r = run_loci("query " + shell_quote(shp) + window + " -f " + format);
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("two.shp: cannot read feature 1 ("), std::string::npos) << r.err;
+  }
+  // Without the index, the layer read whole says so too.
+  fs::remove(shp + ".loci");
+  const CliRun r = run_loci("query " + shell_quote(shp) + window);
+  expect_one_line_error(r);
+  EXPECT_NE(r.err.find("feature 1"), std::string::npos) << r.err;
+}
+
 TEST_F(BadInput, EmptyQueryFilesGiveTheHeaderOfTheirKind) {
   const std::string l = lines_layer();
   const std::string empty = write("empty.txt", ""), one = write("one.txt", "0,0\n");
