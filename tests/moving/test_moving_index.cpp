@@ -218,6 +218,43 @@ TYPED_TEST(MovingIndexTest, MatchesBruteForceOnEveryFleet) {
   }
 }
 
+// Windows at epoch-second times (an ulp of 1.7e9 is 2.4e-7 s): an object 1e-8 beyond an edge
+// at t1 and moving away leaves the window 1e-8 s before t1, which rounded onto t1 in absolute
+// time and held it (in the scan and a tree's leaves; not where a node's bounds pruned it).
+// The answers are known by hand; far objects give the trees inner nodes.
+TYPED_TEST(MovingIndexTest, EpochSecondWindowsHoldNoObjectMovingAway) {
+  const double t = 1.7e9;
+  TypeParam index;
+  std::vector<Id> want;
+  Id id = 1;
+  for (int k = 0; k <= 3; ++k) {
+    const double off = k * 1e-8;
+    // Away beyond each edge (on it when k == 0: inside, touching counts); towards it: inside.
+    const Motion2 away[] = {{t, {10 + off, 5}, {1, 0}},
+                            {t, {-off, 5}, {-1, 0}},
+                            {t, {5, 10 + off}, {0, 1}},
+                            {t, {5, -off}, {0, -1}}};
+    const Motion2 towards[] = {{t, {10 + off, 5}, {-1, 0}}, {t, {5, -off}, {0, 1}}};
+    for (const Motion2& m : away) {
+      if (k == 0) want.push_back(id);
+      index.insert(id++, m);
+    }
+    for (const Motion2& m : towards) {
+      want.push_back(id);
+      index.insert(id++, m);
+    }
+  }
+  for (int i = 0; i < 40; ++i)
+    index.insert(1000 + i, Motion2{t, {1000.0 + i, 1000.0 - i}, {0, 0}});
+  for (const MovingWindow<2>& w :
+       {MovingWindow<2>::during(Box2{{0, 0}, {10, 10}}, t, t + 10),
+        MovingWindow<2>{Box2{{0, 0}, {10, 10}}, Box2{{0, 0}, {10, 10}}, t, t + 0.5}}) {
+    std::vector<Id> got = index.query(w);
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, want);
+  }
+}
+
 TYPED_TEST(MovingIndexTest, UpdatesErasuresAndTicks) {
   const auto fleet = test::make_fleet(test::Fleet::uniform, 3000, 9);
   TypeParam index;

@@ -176,7 +176,11 @@ void check_window(const MovingWindow<D>& w) {
 template <int D>
 LinearSpan moving_box_meets(const Point<D>& lo, const Point<D>& vlo, const Point<D>& hi,
                             const Point<D>& vhi, double t, const MovingWindow<D>& w) {
-  LinearSpan span{w.t1, w.t2};
+  // Solved in time from t, the box's reference time, and only then placed in absolute time:
+  // a root a small fraction of an ulp of an epoch-second time from t (a point 1e-8 beyond the
+  // window's edge at t1, moving away, leaves it 1e-8 s before t1) rounded onto t1 in absolute
+  // time, and the point met a window it never enters.
+  LinearSpan span{w.t1 - t, w.t2 - t};
   const Point<D>& wvmin = w.vmin();
   const Point<D>& wvmax = w.vmax();
   for (int i = 0; i < D && !span.empty(); ++i) {
@@ -184,11 +188,14 @@ LinearSpan moving_box_meets(const Point<D>& lo, const Point<D>& vlo, const Point
     const double wlo = w.from.min[i] + wvmin[i] * (t - w.t1);
     const double whi = w.from.max[i] + wvmax[i] * (t - w.t1);
     // lo(s) <= whi(s):  (lo - whi) + (vlo - wvmax) (s - t) <= 0
-    span.keep(lo[i] - whi, vlo[i] - wvmax[i], t);
+    span.keep(lo[i] - whi, vlo[i] - wvmax[i], 0.0);
     // wlo(s) <= hi(s):  (wlo - hi) + (wvmin - vhi) (s - t) <= 0
-    span.keep(wlo - hi[i], wvmin[i] - vhi[i], t);
+    span.keep(wlo - hi[i], wvmin[i] - vhi[i], 0.0);
   }
-  return span;
+  if (span.empty())
+    return {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  // Rounding is monotonic and so is the clamp: a span that is not empty stays so.
+  return {std::clamp(t + span.lo, w.t1, w.t2), std::clamp(t + span.hi, w.t1, w.t2)};
 }
 
 // The times in [w.t1, w.t2] at which the moving point m lies in the window.
