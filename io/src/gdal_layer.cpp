@@ -54,7 +54,9 @@ void ReadCheck::feature(std::int64_t fid) const {
 OGRFeatureUniquePtr read_feature(OGRLayer& layer, std::int64_t fid, const std::string& path) {
   CPLErrorReset();
   OGRFeatureUniquePtr f(layer.GetFeature(fid));
-  if (read_failed())
+  // No feature at all (a deleted record, say, which GDAL also reports as a failure): the
+  // caller says that the layer has none.
+  if (f && read_failed())
     throw Error(path + ": cannot read feature " + std::to_string(fid) + " (" +
                 CPLGetLastErrorMsg() + "): the file is damaged, or changed while loci read it");
   return f;

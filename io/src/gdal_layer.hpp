@@ -135,8 +135,9 @@ class ReadCheck {
   mutable bool increasing_ = true;
 };
 
-// Feature `fid` of `layer` (nullptr when it has none), read by FID; throws loci::Error naming
-// the file at `path` and the feature when GDAL could read it only in part (the file truncated or
+// Feature `fid` of `layer` (nullptr when it has none, a deleted record too), read by FID;
+// throws loci::Error naming the file at `path` and the feature when GDAL could read it only in
+// part (the file truncated or
 // rewritten since it was opened: GDAL says so through its error state and hands the feature out
 // without its geometry, which would drop it from an answer unsaid).
 OGRFeatureUniquePtr read_feature(OGRLayer& layer, std::int64_t fid, const std::string& path);
