@@ -516,6 +516,33 @@ TEST(TprTreeBuild, RebuiltEveryTickAnswersLikeBruteForce) {
   check_rebuilds<3>();
 }
 
+// build() fills each node between the tree's minimum fill and M, whatever the count and the
+// fan-out: for M of 35 or more, kFill + 1 objects made two leaves of half that, below the
+// minimum fill (validate() refused the tree build() had made).
+template <class Tree>
+void check_build_fill(std::size_t most) {
+  for (std::size_t n = 1; n <= most; ++n) {
+    std::vector<Id> ids(n);
+    std::vector<Motion2> ms(n);
+    Objects objs;
+    for (std::size_t i = 0; i < n; ++i) {
+      ids[i] = Id(i);
+      ms[i] = Motion2{0, {double(i), double(i % 7)}, {1, 0}};
+      objs[ids[i]] = ms[i];
+    }
+    Tree tree;
+    tree.build(ids, ms);
+    ASSERT_NO_THROW(tree.validate()) << n;
+    if (n % 37 == 0) check_queries(tree, objs, 0, n, "fill " + std::to_string(n));
+  }
+}
+TEST(TprTreeBuild, NodesKeepTheMinimumFillForEveryFanOut) {
+  check_build_fill<TprTree<2, 4>>(200);
+  check_build_fill<TprTree<2, 40>>(300);
+  check_build_fill<TprTree<2, 63>>(400);
+  check_build_fill<StarTree<2, 63>>(400);
+}
+
 TEST(TprTreeBuild, RefusesBadInput) {
   TprTree<2> tree;
   const std::vector<Motion2> two{{0, {0, 0}, {1, 1}}, {0, {1, 1}, {0, 0}}};

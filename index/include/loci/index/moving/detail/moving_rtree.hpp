@@ -165,7 +165,13 @@ class MovingRTree {
       cells_[i] = {c, i};
     }
     constexpr std::size_t kFill = std::max<std::size_t>(kMinFill, M * 3 / 4);
-    const std::size_t leaves = (n + kFill - 1) / kFill;
+    // Nodes of `count` entries about kFill each, never below the minimum fill (two nodes of
+    // kFill + 1 halved are, for M of 35 or more), nor above M (kMinFill <= 2 M / 5).
+    const auto nodes_for = [](std::size_t count) {
+      return std::max<std::size_t>(
+          1, std::min((count + kFill - 1) / kFill, count / std::size_t(kMinFill)));
+    };
+    const std::size_t leaves = n == 0 ? 0 : nodes_for(n);
     if (n > 0) {
       std::vector<std::size_t> groups(leaves + 1);
       for (std::size_t g = 0; g <= leaves; ++g)
@@ -228,7 +234,7 @@ class MovingRTree {
     mag_ = mag, vmag_ = vmag;
     // Pack each level above into nodes of nearly equal counts, about 3/4 full.
     for (int height = 1; level.size() > 1; ++height) {
-      const std::size_t groups = (level.size() + kFill - 1) / kFill;
+      const std::size_t groups = nodes_for(level.size());
       std::vector<Item>& up = up_;
       up.resize(groups);
       for (std::size_t g = 0; g < groups; ++g) {
