@@ -762,9 +762,13 @@ class ConflictMonitor {
   // Kept pairs are those within keep_, a hair more than D (relative to the magnitudes seen),
   // so that a pair within D at a later `now` is never lost to rounding at the base time.
   void widen(const Motion<D>& m, double span) {
+    // The report's own magnitudes too: a position extrapolated from a report long before the
+    // base is rounded at the size of the report's position and travel, not of the result.
     const Point<D> p = position(m, base_);
+    const double age = std::abs(base_ - m.t);
     for (int a = 0; a < D; ++a)
-      scale_ = std::max(scale_, std::abs(p[a]) + std::abs(m.v[a]) * span);
+      scale_ =
+          std::max(scale_, std::abs(p[a]) + std::abs(m.p[a]) + std::abs(m.v[a]) * (span + age));
     keep_ = within_ * (1 + 1e-9) + 1e-9 * scale_;
     margin_ = 0.5 * (keep_ - within_);
   }
