@@ -29,8 +29,35 @@ namespace loci::io {
 
 std::string printable(std::string_view text) {
   std::string out(text);
-  for (char& c : out)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(out[i]); };
+  for (std::size_t i = 0; i < out.size();) {
+    const unsigned char c = byte(i);
+    if (c < 0x80) {
+      if (c < 0x20 || c == 0x7f) out[i] = '?';
+      ++i;
+      continue;
+    }
+    // A UTF-8 sequence is kept whole when it is well formed (no overlong form, surrogate or
+    // code point beyond U+10FFFF) and not a C1 control (U+0080 to U+009F, which terminals
+    // act on); any other byte above 0x7f, as a binary file holds them, is '?'.
+    const std::size_t n = c >= 0xc2 && c <= 0xdf   ? 2
+                          : c >= 0xe0 && c <= 0xef ? 3
+                          : c >= 0xf0 && c <= 0xf4 ? 4
+                                                   : 0;
+    bool ok = n > 0 && i + n <= out.size();
+    for (std::size_t k = 1; ok && k < n; ++k)
+      ok = (byte(i + k) & 0xc0) == 0x80;
+    if (ok && n == 2) ok = !(c == 0xc2 && byte(i + 1) < 0xa0);
+    if (ok && n == 3)
+      ok = !(c == 0xe0 && byte(i + 1) < 0xa0) && !(c == 0xed && byte(i + 1) >= 0xa0);
+    if (ok && n == 4)
+      ok = !(c == 0xf0 && byte(i + 1) < 0x90) && !(c == 0xf4 && byte(i + 1) >= 0x90);
+    if (!ok) {
+      out[i++] = '?';
+      continue;
+    }
+    i += n;
+  }
   return out;
 }
 

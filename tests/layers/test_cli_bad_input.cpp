@@ -964,4 +964,15 @@ TEST_F(BadInput, NamesWithNewlinesKeepMessagesToOneLine) {
                                 shell_quote(path("a\nb.csv")));
   ASSERT_EQ(wrote.status, 0) << wrote.err;
   EXPECT_EQ(lines(wrote.err).size(), 1u) << wrote.err;
+  // Bytes of a binary file are '?' too (a PNG's 0x89, a C1 control's UTF-8 form), and text in
+  // UTF-8 stays as it is.
+  write("binary.txt", "0,0,\x89PNG\xc2\x9b,1\n");
+  const CliRun binary = run_loci("query " + shell_quote(lines_layer()) + " --bbox-file " +
+                                 shell_quote(path("binary.txt")));
+  expect_one_line_error(binary);
+  EXPECT_NE(binary.err.find("'0,0,?PNG??,1'"), std::string::npos) << binary.err;
+  const CliRun accented =
+      run_loci("query " + shell_quote(path("caf\xc3\xa9.geojson")) + " --bbox 0,0,1,1");
+  expect_one_line_error(accented);
+  EXPECT_NE(accented.err.find("caf\xc3\xa9.geojson"), std::string::npos) << accented.err;
 }
