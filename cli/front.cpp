@@ -131,10 +131,12 @@ bool copy_query_files(const Command& c, const std::vector<std::string>& once) {
         std::find(once.begin(), once.end(), std::string(flag->name)) == once.end())
       continue;
     const std::string file = eq == std::string::npos ? g_args[at] : arg.substr(eq + 1);
-    const std::optional<std::string> copy = copy_in_memory(file == "-" ? "/dev/stdin" : file);
+    // `-` is stdin, named as loci-full names it (parse() reads it as /dev/stdin).
+    const std::string named = file == "-" ? "/dev/stdin" : file;
+    const std::optional<std::string> copy = copy_in_memory(named);
     copied = copy.has_value();
     if (!copied) break;
-    g_copies.emplace_back(*copy, file);
+    g_copies.emplace_back(*copy, named);
     g_args[at] = eq == std::string::npos ? *copy : name + "=" + *copy;
   }
   for (std::size_t i = 0; i < g_args.size(); ++i)
