@@ -9,6 +9,7 @@
 // -o onto a file that is there), is handed to loci-full with the same arguments (exec): it has
 // every command and GDAL, and says what is wrong with a command.
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #if defined(__linux__)
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <climits>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <optional>
@@ -78,12 +80,25 @@ std::optional<std::string> copy_in_memory(const std::string& name) {
   // outside the process's address-space limit, and an endless stream without a newline would
   // fill the machine's memory.
   std::size_t line = 1, length = 0;
+  // Nor does the copy grow past the process's address-space limit (ulimit -v), which loci-full
+  // reading it again would meet: an endless stream of good lines stops there, said so.
+  struct rlimit limit {};
+  const std::uint64_t most = ::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY
+                                 ? std::uint64_t(limit.rlim_cur)
+                                 : UINT64_MAX;
+  std::uint64_t total = 0;
   for (;;) {
     const ssize_t n = ::read(in, buf, sizeof buf);
     if (n == 0) break;
     if (n < 0) {
       if (errno == EINTR) continue;
       fail("cannot read the query file", errno);
+    }
+    total += std::uint64_t(n);
+    if (total > most) {
+      ::close(in);
+      ::close(copy);
+      throw CopyFailed(name + ": larger than the memory this process may use (ulimit -v)");
     }
     for (const char* at = buf; at < buf + n;) {
       const char* nl = static_cast<const char*>(std::memchr(at, '\n', std::size_t(buf + n - at)));

@@ -786,6 +786,29 @@ TEST_F(BadInput, AFeatureReadOnlyInPartIsAnErrorNotADrop) {
   EXPECT_NE(r.err.find("feature 1"), std::string::npos) << r.err;
 }
 
+// An endless stream of good query lines on a pipe, copied into memory by the front for
+// loci-full: the copy, outside the address-space limit, stops at it and says so (it grew until
+// the machine's memory ran out).
+TEST_F(BadInput, AQueryStreamLargerThanTheMemoryLimitIsRefused) {
+  if (std::system(("bash -c " + shell_quote("ulimit -v 200000; " + std::string(LOCI_EXE) +
+                                            " --version >/dev/null 2>&1"))
+                      .c_str()) != 0)
+    GTEST_SKIP() << "this build of loci does not start under ulimit -v (a sanitized build)";
+  const std::string shp = path("lines.shp");
+  ASSERT_EQ(
+      std::system(("ogr2ogr -q " + shell_quote(shp) + " " + shell_quote(lines_layer())).c_str()), 0)
+      << "ogr2ogr (gdal-bin, from scripts/install-deps.sh) could not make a shapefile";
+  ASSERT_EQ(run_loci("index -q --per feature " + shell_quote(shp)).status, 0);
+  const CliRun r =
+      run_command("bash -c " + shell_quote("ulimit -v 200000; yes 0.5,0.5 | head -c 300000000 | " +
+                                           std::string(LOCI_EXE) + " query " + shell_quote(shp) +
+                                           " --nearest-file - >/dev/null"));
+  expect_one_line_error(r);
+  EXPECT_NE(r.err.find("/dev/stdin: larger than the memory this process may use"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST_F(BadInput, EmptyQueryFilesGiveTheHeaderOfTheirKind) {
   const std::string l = lines_layer();
   const std::string empty = write("empty.txt", ""), one = write("one.txt", "0,0\n");
