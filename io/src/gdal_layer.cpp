@@ -55,8 +55,12 @@ OGRFeatureUniquePtr read_feature(OGRLayer& layer, std::int64_t fid, const std::s
   CPLErrorReset();
   OGRFeatureUniquePtr f(layer.GetFeature(fid));
   // No feature at all (a deleted record, say, which GDAL also reports as a failure): the
-  // caller says that the layer has none.
-  if (f && read_failed())
+  // caller says that the layer has none, and the failure is not left for the next read.
+  if (!f) {
+    CPLErrorReset();
+    return f;
+  }
+  if (read_failed())
     throw Error(path + ": cannot read feature " + std::to_string(fid) + " (" +
                 CPLGetLastErrorMsg() + "): the file is damaged, or changed while loci read it");
   return f;

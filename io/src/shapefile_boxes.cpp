@@ -242,7 +242,7 @@ std::optional<LayerItems> read_shapefile_segments(const std::string& path, const
           OGRLayer& gdal) {
         if (add_record_segments(c, file_type, fid, items)) return true;
         // Rings only GDAL sorts: that record's segments from GDAL's geometry.
-        const OGRFeatureUniquePtr f(gdal.GetFeature(fid));
+        const OGRFeatureUniquePtr f = detail::read_feature(gdal, fid, path);
         if (!f || !f->GetGeometryRef()) return false;
         detail::add_segments(f->GetGeometryRef(), fid, path, items);
         return true;

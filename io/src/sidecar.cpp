@@ -391,6 +391,13 @@ bool still_fresh(const std::string& layer_path, const Fingerprint& was, Fingerpr
     return false;
   }
   Fingerprint f = *stat;
+  // Nor is an index of a VRT: its features live in its sources, which its fingerprint does
+  // not see change (an older loci's index of one, the file unchanged, answered from sources
+  // edited since).
+  if (regular && is_vrt(layer_path)) {
+    if (now) *now = f;
+    return false;
+  }
   if (f.size == was.size && f.mtime_ns == was.mtime_ns && f.inode == was.inode) {
     if (now) *now = was;
     return true;

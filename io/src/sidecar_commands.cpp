@@ -12,6 +12,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <ios>
 #include <mutex>
 #include <string_view>
 #include <thread>
@@ -193,7 +194,17 @@ std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& pa
   };
   std::vector<std::pair<std::size_t, Query>> out;
   std::string line;
-  for (std::size_t n = 1; next(line, n); ++n) {
+  std::size_t n = 1;
+  // A failed read (the file's buffer throws std::ios_base::failure) names the file too.
+  const auto read_line = [&] {
+    try {
+      return next(line, n);
+    } catch (const std::ios_base::failure& e) {
+      throw Error(path + ": cannot read the query file (line " + std::to_string(n) + ": " +
+                  e.code().message() + ")");
+    }
+  };
+  for (; read_line(); ++n) {
     // A UTF-8 byte order mark, as editors on some systems write it, is not part of the text.
     if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;

@@ -741,6 +741,11 @@ TEST_F(BadInput, AQueryFileLineLongerThanTheLimitIsRefused) {
     expect_one_line_error(z);
     EXPECT_NE(z.err.find("/dev/zero: line 1: longer than 1 MiB"), std::string::npos) << z.err;
   }
+  // A read that fails names the file (it was the library's message alone).
+  const CliRun unreadable = run_loci("query " + shell_quote(l) + " --bbox-file /proc/self/mem");
+  expect_one_line_error(unreadable);
+  EXPECT_NE(unreadable.err.find("/proc/self/mem: cannot read the query file"), std::string::npos)
+      << unreadable.err;
   // A line of exactly 1 MiB is read (and refused as the query it is not).
   {
     std::ofstream out(q, std::ios::binary);

@@ -2434,6 +2434,27 @@ TEST_F(LayersCli, RefusesToIndexAVrtWhoseSourcesItCannotWatch) {
         << cmd << ": " << stale.err;
     EXPECT_EQ(stale.err.find("loci index"), std::string::npos) << cmd << ": " << stale.err;
   }
+  // Nor one that looks fresh: a file indexed as GeoJSON, then made a VRT in place with its
+  // size, inode and time kept (the sources it names then change unseen).
+  const std::string odd = path("w.vrt");
+  std::string geojson = R"({"type":"FeatureCollection","features":[{"type":"Feature",)"
+                        R"("properties":{},"geometry":{"type":"Point","coordinates":[5,5]}}]})";
+  geojson.resize(512, ' ');  // room for the VRT's text
+  std::ofstream(odd) << geojson;
+  ASSERT_EQ(run_loci("index -q " + odd).status, 0);
+  ASSERT_EQ(run_loci("query " + odd + " --bbox 4,4,6,6").out, "0\n");
+  const auto time = fs::last_write_time(odd);
+  std::string vrt_text = read_text(vrt);
+  ASSERT_LE(vrt_text.size(), geojson.size());
+  vrt_text.resize(geojson.size(), ' ');
+  std::ofstream(odd, std::ios::binary | std::ios::in | std::ios::out) << vrt_text;
+  fs::last_write_time(odd, time);
+  const CliRun fresh = run_loci("query " + odd + " --bbox 0,0,2,2");
+  EXPECT_EQ(fresh.status, 1) << fresh.out;
+  EXPECT_NE(fresh.err.find("not an index of " + odd + " (a VRT is not indexed"), std::string::npos)
+      << fresh.err;
+  fs::remove(odd + ".loci");
+  EXPECT_EQ(run_loci("query " + odd + " --bbox 0,0,2,2").out, "2\n");
 }
 
 TEST_F(LayersCli, RefusesASidecarOlderThanItsLayer) {

@@ -212,7 +212,7 @@ bool is_vrt(const std::string& path);
 
 // Whether the layer still holds what `was` was taken of: size, modification time and inode
 // equal (nothing is read), or else the same size and content hash. `now` receives what was
-// measured (for messages). Never for a path only GDAL opens.
+// measured (for messages). Never for a path only GDAL opens, nor for a VRT.
 bool still_fresh(const std::string& layer_path, const Fingerprint& was, Fingerprint* now = nullptr);
 
 // What changed between `was` and `now` (still_fresh's measure), as messages say it: "size A ->
