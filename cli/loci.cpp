@@ -105,9 +105,15 @@ int run_clip(const Args& a) {
   o.out_path = a.get("--output");
   const ClipResult r = clip_layer(o);
   // Values changed on the way are said even with --quiet.
-  for (const std::string& f : r.retyped)
-    std::fprintf(stderr, "loci: warning: field %s, the nearest type %s holds\n",
-                 printable(f).c_str(), printable(o.out_path).c_str());
+  for (const ClipResult::Retyped& f : r.retyped) {
+    const std::string out = printable(o.out_path), field = printable(f.field);
+    if (f.as.empty())
+      std::fprintf(stderr, "loci: warning: %s has no %s fields: GDAL converts field %s\n",
+                   out.c_str(), f.type.c_str(), field.c_str());
+    else
+      std::fprintf(stderr, "loci: warning: %s has no %s fields: field %s written as %s\n",
+                   out.c_str(), f.type.c_str(), field.c_str(), f.as.c_str());
+  }
   if (!a.has("--quiet")) {
     std::fprintf(stderr, "loci: %zu feature%s clipped into %s\n", r.written,
                  r.written == 1 ? "" : "s", printable(o.out_path).c_str());

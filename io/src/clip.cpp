@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include <cpl_string.h>
+
 #include "gdal_layer.hpp"
 #include "loci/geom/error.hpp"
 #include "loci/geom/predicates.hpp"
@@ -473,10 +475,20 @@ ClipResult clip_layer(const ClipOptions& options) {
                     ")");
       }
       fields[std::size_t(i)] = before;
+      // The types the driver says it creates (as ogr2ogr reads them), and the type it made:
+      // only some drivers (the shapefile's) show a conversion in the field they made.
       const OGRFieldDefn* made = layer->GetLayerDefn()->GetFieldDefn(before);
+      const std::string type = OGRFieldDefn::GetFieldTypeName(fd.GetType());
+      const char* listed = driver->GetMetadataItem(GDAL_DMD_CREATIONFIELDDATATYPES);
+      bool held = true;
+      if (listed) {
+        const CPLStringList types(CSLTokenizeString(listed));
+        held = types.FindString(type.c_str()) >= 0;
+      }
       if (made->GetType() != fd.GetType())
-        result.retyped.push_back(name + ": " + OGRFieldDefn::GetFieldTypeName(fd.GetType()) +
-                                 " written as " + OGRFieldDefn::GetFieldTypeName(made->GetType()));
+        result.retyped.push_back({name, type, OGRFieldDefn::GetFieldTypeName(made->GetType())});
+      else if (!held)
+        result.retyped.push_back({name, type, ""});
     }
     for (Piece& p : pieces) {
       std::unique_ptr<OGRGeometry> piece = std::move(p.geometry);

@@ -176,9 +176,13 @@ struct ClipOptions {
 struct ClipResult {
   std::size_t written = 0;  // features written
   std::size_t dropped = 0;  // cut pieces of a lower dimension than their feature left out
-  // Fields the output format made of another type than the layer's (a shapefile holds a
-  // DateTime as a Date, dropping the times of day): "NAME: DateTime written as Date".
-  std::vector<std::string> retyped;
+  // Fields whose type the output format does not hold, as ogr2ogr warns of them: made of
+  // another type (a shapefile's Date for a DateTime, dropping the times of day; `as` names it)
+  // or left for the driver to convert (`as` empty: the format lists no such type).
+  struct Retyped {
+    std::string field, type, as;
+  };
+  std::vector<Retyped> retyped;
 };
 ClipResult clip_layer(const ClipOptions& options);
 
