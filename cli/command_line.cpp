@@ -137,7 +137,7 @@ Format output_format(const Args& a, std::initializer_list<Format> choices, Forma
     ++i;
   }
   if (!chosen)
-    throw UsageError("--format: '" + printable(given.substr(0, 40)) +
+    throw UsageError("--format: '" + printable_prefix(given, 40) +
                      "' is not a format this command writes (choose " + listed + ")");
   const Format f = *chosen;
   if (!named.empty() && named != format_name(f))

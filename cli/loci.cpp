@@ -659,7 +659,7 @@ int main(int argc, char** argv) {
   }
   for (const auto& c : commands())
     if (c.name == name) return run_command(c, first, argc, argv, refuse_replacing_output);
-  const std::string shown = printable(name.substr(0, 40));
+  const std::string shown = printable_prefix(name, 40);
   const bool fleet = name.rfind("fleet ", 0) == 0;
   std::fprintf(stderr, "loci: error: unknown command '%s' (see loci %s--help)\n", shown.c_str(),
                fleet ? "fleet " : "");

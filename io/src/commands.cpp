@@ -8,6 +8,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -62,17 +63,34 @@ std::string listed(const std::string& name) {
   return q + "'";
 }
 // A word as a shell reads it back: as it is when it holds only characters the shell takes
-// literally, else in single quotes (a quote as '\'').
+// literally, else in single quotes (a quote as '\''), and a byte printable() would not show (a
+// newline, a Latin-1 letter) as $'\xNN', which bash, zsh and ksh read back as that byte.
 std::string shell_word(const std::string& word) {
-  const std::string text = printable(word);
-  if (!text.empty() &&
-      text.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-.,/:"
+  if (!word.empty() &&
+      word.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-.,/:"
                              "+=@%") == std::string::npos)
-    return text;
-  std::string q = "'";
-  for (const char c : text)
-    q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
+    return word;
+  std::string q;
+  bool open = false;
+  for (std::size_t i = 0; i < word.size();) {
+    const std::size_t n = printable_at(word, i);
+    if (n == 0) {
+      if (open) q += '\'', open = false;
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "$'\\x%02x'", static_cast<unsigned char>(word[i]));
+      q += hex;
+      ++i;
+      continue;
+    }
+    if (!open) q += '\'', open = true;
+    if (word[i] == '\'')
+      q += "'\\''";
+    else
+      q.append(word, i, n);
+    i += n;
+  }
+  if (open) q += '\'';
+  return q.empty() ? "''" : q;
 }
 
 }  // namespace

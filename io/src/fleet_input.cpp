@@ -26,7 +26,7 @@ constexpr double kKnot = 1852.0 / 3600.0;  // metres per second
 
 // The text as a message may quote it: at most 40 characters, printable.
 std::string quoted(std::string_view text) {
-  return "'" + printable(text.substr(0, 40)) + (text.size() > 40 ? "...'" : "'");
+  return "'" + printable_prefix(text, 40) + "'";
 }
 
 // RFC 4180 records, one at a time. A record's fields are views into the text, or into

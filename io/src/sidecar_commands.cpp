@@ -28,45 +28,65 @@
 
 namespace loci::io {
 
+std::size_t printable_at(std::string_view text, std::size_t at) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[at + k]); };
+  const unsigned char c = byte(0);
+  if (c < 0x80) return c < 0x20 || c == 0x7f ? 0 : 1;
+  // A well-formed UTF-8 sequence (no overlong form, surrogate or code point beyond U+10FFFF).
+  const std::size_t n = c >= 0xc2 && c <= 0xdf   ? 2
+                        : c >= 0xe0 && c <= 0xef ? 3
+                        : c >= 0xf0 && c <= 0xf4 ? 4
+                                                 : 0;
+  if (n == 0 || at + n > text.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if ((byte(k) & 0xc0) != 0x80) return 0;
+  if ((c == 0xe0 && byte(1) < 0xa0) || (c == 0xed && byte(1) >= 0xa0) ||
+      (c == 0xf0 && byte(1) < 0x90) || (c == 0xf4 && byte(1) >= 0x90))
+    return 0;
+  // Not a C1 control (U+0080 to U+009F, which terminals act on), the Arabic letter mark
+  // (U+061C), nor a mark of direction or a separator of lines (U+200E, U+200F, U+2028 to
+  // U+202E, U+2066 to U+2069).
+  if (c == 0xc2 && byte(1) < 0xa0) return 0;
+  if (c == 0xd8 && byte(1) == 0x9c) return 0;
+  if (c == 0xe2 && byte(1) == 0x80 &&
+      (byte(2) == 0x8e || byte(2) == 0x8f || (byte(2) >= 0xa8 && byte(2) <= 0xae)))
+    return 0;
+  if (c == 0xe2 && byte(1) == 0x81 && byte(2) >= 0xa6 && byte(2) <= 0xa9) return 0;
+  return n;
+}
+
 std::string printable(std::string_view text) {
-  std::string out(text);
-  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(out[i]); };
-  for (std::size_t i = 0; i < out.size();) {
-    const unsigned char c = byte(i);
-    if (c < 0x80) {
-      if (c < 0x20 || c == 0x7f) out[i] = '?';
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t n = printable_at(text, i);
+    if (n == 0) {
+      out += '?';
       ++i;
-      continue;
+    } else {
+      out.append(text.substr(i, n));
+      i += n;
     }
-    // A UTF-8 sequence is kept whole when it is well formed (no overlong form, surrogate or
-    // code point beyond U+10FFFF) and not a C1 control (U+0080 to U+009F, which terminals
-    // act on); any other byte above 0x7f, as a binary file holds them, is '?'.
-    const std::size_t n = c >= 0xc2 && c <= 0xdf   ? 2
-                          : c >= 0xe0 && c <= 0xef ? 3
-                          : c >= 0xf0 && c <= 0xf4 ? 4
-                                                   : 0;
-    bool ok = n > 0 && i + n <= out.size();
-    for (std::size_t k = 1; ok && k < n; ++k)
-      ok = (byte(i + k) & 0xc0) == 0x80;
-    if (ok && n == 2) ok = !(c == 0xc2 && byte(i + 1) < 0xa0);
-    if (ok && n == 3)
-      ok = !(c == 0xe0 && byte(i + 1) < 0xa0) && !(c == 0xed && byte(i + 1) >= 0xa0);
-    if (ok && n == 4)
-      ok = !(c == 0xf0 && byte(i + 1) < 0x90) && !(c == 0xf4 && byte(i + 1) >= 0x90);
-    if (!ok) {
-      out[i++] = '?';
-      continue;
-    }
-    i += n;
   }
   return out;
+}
+
+std::string printable_prefix(std::string_view text, std::size_t most) {
+  std::string out = printable(text);
+  if (out.size() <= most) return out;
+  // printable() keeps whole characters: a cut backs off to the start of one.
+  std::size_t cut = most;
+  while (cut > 0 && (static_cast<unsigned char>(out[cut]) & 0xc0) == 0x80)
+    --cut;
+  out.resize(cut);
+  return out + "...";
 }
 
 namespace {
 
 // The text as a message may quote it: at most 60 characters, printable.
 std::string quoted(const std::string& text) {
-  return "'" + printable(text.substr(0, 60)) + (text.size() > 60 ? "...'" : "'");
+  return "'" + printable_prefix(text, 60) + "'";
 }
 
 // Whether a decimal number that std::from_chars found out of a double's range is too large

@@ -705,8 +705,6 @@ TEST_F(BadInput, OutputNamesSayWhatTheyHold) {
   EXPECT_TRUE(temporaries().empty());
 }
 
-// A batch's CSV header is that of its kind of query, rows or none: an empty --nearest-file
-// lost its distance column.
 // A query file's line longer than 1 MiB (a binary file, a stream without newlines) is refused
 // before it fills memory, in one line, the old output kept: std::getline took running out of
 // memory for the end of the file and answered the queries before it, exit 0; /dev/zero grew
@@ -814,6 +812,8 @@ TEST_F(BadInput, AQueryStreamLargerThanTheMemoryLimitIsRefused) {
       << r.err;
 }
 
+// A batch's CSV header is that of its kind of query, rows or none: an empty --nearest-file
+// lost its distance column.
 TEST_F(BadInput, EmptyQueryFilesGiveTheHeaderOfTheirKind) {
   const std::string l = lines_layer();
   const std::string empty = write("empty.txt", ""), one = write("one.txt", "0,0\n");
@@ -985,10 +985,14 @@ TEST_F(BadInput, NamesWithNewlinesKeepMessagesToOneLine) {
   const CliRun in_dir = run_loci("info " + shell_quote(odd));
   ASSERT_EQ(in_dir.status, 0) << in_dir.err;
   EXPECT_EQ(lines(in_dir.out).size(), 7u) << in_dir.out;
-  EXPECT_NE(
-      in_dir.out.find("index:     none (loci index '" + path("nl?dir/x.geojson") + "' writes "),
-      std::string::npos)
+  // The command offered names it as a shell reads it back ($'\x0a' for the newline).
+  EXPECT_NE(in_dir.out.find("index:     none (loci index '" + path("nl") +
+                            "'$'\\x0a''dir/x.geojson' writes "),
+            std::string::npos)
       << in_dir.out;
+  const std::string offered = in_dir.out.substr(in_dir.out.find("loci index ") + 11);
+  const std::string word = offered.substr(0, offered.find(" writes "));
+  EXPECT_EQ(run_command("bash -c " + shell_quote("test -f " + word)).status, 0) << word;
   const CliRun wrote = run_loci("intersections " + shell_quote(lines_layer()) + " -o " +
                                 shell_quote(path("a\nb.csv")));
   ASSERT_EQ(wrote.status, 0) << wrote.err;
@@ -1004,4 +1008,29 @@ TEST_F(BadInput, NamesWithNewlinesKeepMessagesToOneLine) {
       run_loci("query " + shell_quote(path("caf\xc3\xa9.geojson")) + " --bbox 0,0,1,1");
   expect_one_line_error(accented);
   EXPECT_NE(accented.err.find("caf\xc3\xa9.geojson"), std::string::npos) << accented.err;
+  // A line cut for the message is cut between characters; a mark turning the text's
+  // direction (U+202E) or a line separator (U+2028) is '?'.
+  std::string long_line = "a";
+  for (int i = 0; i < 40; ++i)
+    long_line += "\xc3\xa9";
+  write("accents.txt", long_line + "\n");
+  const CliRun cut = run_loci("query " + shell_quote(lines_layer()) + " --bbox-file " +
+                              shell_quote(path("accents.txt")));
+  expect_one_line_error(cut);
+  EXPECT_NE(cut.err.find("a" + long_line.substr(1, 58) + "...'"), std::string::npos) << cut.err;
+  write("marks.txt",
+        "1,\xe2\x80\xae"
+        "2,\xe2\x80\xa8"
+        "3,4\n");
+  const CliRun marks = run_loci("query " + shell_quote(lines_layer()) + " --bbox-file " +
+                                shell_quote(path("marks.txt")));
+  expect_one_line_error(marks);
+  EXPECT_NE(marks.err.find("'1,???2,???3,4'"), std::string::npos) << marks.err;
+  // A Latin-1 name (not UTF-8) is '?' in messages, and offered as the shell reads it back.
+  const std::string latin = path("caf\xe9.geojson");
+  fs::copy_file(lines_layer(), latin, fs::copy_options::overwrite_existing);
+  const CliRun info_latin = run_loci("info " + shell_quote(latin));
+  ASSERT_EQ(info_latin.status, 0) << info_latin.err;
+  EXPECT_NE(info_latin.out.find("'$'\\xe9''.geojson' writes "), std::string::npos)
+      << info_latin.out;
 }

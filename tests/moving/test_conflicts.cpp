@@ -668,7 +668,7 @@ TEST(ConflictMonitor, WindowEndsAtEpochSecondsAsClosestApproachDecides) {
 // Reports long before the base (1e12 s): their positions are extrapolated with rounding at the
 // size of their travel, which the monitor's margin for kept pairs now counts. Two objects
 // moving alongside, about D apart: the monitor gave a pair at 11.996 that a computation from
-// scratch puts at 12.00036, and missed others (381 of 20,000 differed before).
+// scratch puts at 12.00036, and missed others (381 of 20,000 such cases differed before).
 TEST(ConflictMonitor, OldReportsAnswerAsAComputationFromScratch) {
   const double within = 12, horizon = 30, slack = 5;
   std::mt19937_64 rng(1);

@@ -517,7 +517,7 @@ TEST(TprTreeBuild, RebuiltEveryTickAnswersLikeBruteForce) {
 }
 
 // build() fills each node between the tree's minimum fill and M, whatever the count and the
-// fan-out: for M of 35 or more, kFill + 1 objects made two leaves of half that, below the
+// fan-out: for some M of 25 or more, kFill + 1 objects made two leaves of half that, below the
 // minimum fill (validate() refused the tree build() had made).
 template <class Tree>
 void check_build_fill(std::size_t most) {

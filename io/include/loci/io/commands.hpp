@@ -50,8 +50,14 @@ inline constexpr std::size_t kQueryLineLimit = std::size_t(1) << 20;
 std::string query_line_too_long(const std::string& path, std::size_t line);
 
 // Text as a message or a summary line shows it: control characters (a newline in a file or
-// layer name, an escape sequence meant for the terminal) as '?', so that it keeps to one line.
+// layer name, an escape sequence meant for the terminal), bytes that are not UTF-8 text, and
+// the characters that break a line or turn its direction (U+2028, U+202E, ...) as '?', so that
+// it keeps to one line and reads as written.
 std::string printable(std::string_view text);
+// The length in bytes of the character at `at` when printable() keeps it, else 0.
+std::size_t printable_at(std::string_view text, std::size_t at);
+// printable(text) cut to at most `most` bytes at a character's boundary, "..." after a cut.
+std::string printable_prefix(std::string_view text, std::size_t most);
 
 std::string describe_layer(const std::string& layer_path, const std::string& layer_name,
                            const Progress& progress = {});

@@ -166,7 +166,7 @@ class MovingRTree {
     }
     constexpr std::size_t kFill = std::max<std::size_t>(kMinFill, M * 3 / 4);
     // Nodes of `count` entries about kFill each, never below the minimum fill (two nodes of
-    // kFill + 1 halved are, for M of 35 or more), nor above M (kMinFill <= 2 M / 5).
+    // kFill + 1 halved are, for some M of 25 or more), nor above M (kMinFill <= 2 M / 5).
     const auto nodes_for = [](std::size_t count) {
       return std::max<std::size_t>(
           1, std::min((count + kFill - 1) / kFill, count / std::size_t(kMinFill)));
