@@ -444,6 +444,9 @@ ClipResult clip_layer(const ClipOptions& options) {
     // Fields the format gives every layer (KML's Name and Description) take the values of the
     // source's fields of those names.
     const int own = layer->GetLayerDefn()->GetFieldCount();
+    // The types the driver says it creates (as ogr2ogr reads them); none listed holds every type.
+    const char* listed = driver->GetMetadataItem(GDAL_DMD_CREATIONFIELDDATATYPES);
+    const CPLStringList creatable(listed ? CSLTokenizeString(listed) : nullptr);
     for (int i = 0; i < defn->GetFieldCount(); ++i) {
       OGRFieldDefn fd(defn->GetFieldDefn(i));
       // A CSV source shows its geometry column as a field too: a CSV output's WKT replaces it.
@@ -475,16 +478,11 @@ ClipResult clip_layer(const ClipOptions& options) {
                     ")");
       }
       fields[std::size_t(i)] = before;
-      // The types the driver says it creates (as ogr2ogr reads them), and the type it made:
-      // only some drivers (the shapefile's) show a conversion in the field they made.
+      // The type made, and whether the driver lists it: only some drivers (the shapefile's)
+      // show a conversion in the field they made.
       const OGRFieldDefn* made = layer->GetLayerDefn()->GetFieldDefn(before);
       const std::string type = OGRFieldDefn::GetFieldTypeName(fd.GetType());
-      const char* listed = driver->GetMetadataItem(GDAL_DMD_CREATIONFIELDDATATYPES);
-      bool held = true;
-      if (listed) {
-        const CPLStringList types(CSLTokenizeString(listed));
-        held = types.FindString(type.c_str()) >= 0;
-      }
+      const bool held = !listed || creatable.FindString(type.c_str()) >= 0;
       if (made->GetType() != fd.GetType())
         result.retyped.push_back({name, type, OGRFieldDefn::GetFieldTypeName(made->GetType())});
       else if (!held)

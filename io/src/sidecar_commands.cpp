@@ -203,26 +203,23 @@ std::vector<std::pair<std::size_t, Query>> read_query_file(const std::string& pa
   // its line (out of memory) for the end of the file and grows without bound on a stream with
   // no newline: the first line longer than the limit is refused.
   std::streambuf* const buf = in.rdbuf();
-  auto next = [&](std::string& line, std::size_t n) {
-    line.clear();
-    for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
-      if (c == '\n') return true;
-      if (line.size() == kQueryLineLimit) throw Error(query_line_too_long(path, n));
-      line.push_back(char(c));
-    }
-    return !line.empty();
-  };
   std::vector<std::pair<std::size_t, Query>> out;
   std::string line;
   std::size_t n = 1;
   // A failed read (the file's buffer throws std::ios_base::failure) names the file too.
   const auto read_line = [&] {
+    line.clear();
     try {
-      return next(line, n);
+      for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+        if (c == '\n') return true;
+        if (line.size() == kQueryLineLimit) throw Error(query_line_too_long(path, n));
+        line.push_back(char(c));
+      }
     } catch (const std::ios_base::failure& e) {
       throw Error(path + ": cannot read the query file (line " + std::to_string(n) + ": " +
                   e.code().message() + ")");
     }
+    return !line.empty();
   };
   for (; read_line(); ++n) {
     // A UTF-8 byte order mark, as editors on some systems write it, is not part of the text.

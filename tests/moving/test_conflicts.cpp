@@ -625,6 +625,27 @@ TEST(ConflictMonitor, MatchesComputationFromScratch) {
   }
 }
 
+// Two objects reported to a monitor that is refreshed at base and then at now: the pairs it
+// holds, how many of its refreshes were incremental, and the pairs a computation from scratch
+// gives at now.
+struct TwoObjects {
+  std::vector<Conflict> monitored, from_scratch;
+  std::size_t incremental_refreshes;
+};
+
+TwoObjects two_objects(const Motion2& a, const Motion2& b, double within, double horizon,
+                       double slack, double base, double now) {
+  ConflictMonitor<2> monitor(within, horizon, slack);
+  monitor.report(1, a);
+  monitor.report(2, b);
+  monitor.refresh(base);
+  monitor.refresh(now);
+  const std::vector<Id> ids{1, 2};
+  const std::vector<Motion2> objects{a, b};
+  return {monitor.conflicts(), find_conflicts<2>(ids, objects, within, now, horizon),
+          monitor.incremental_refreshes()};
+}
+
 // At epoch-second times now + H rounds to a step of 2^-22 s; a pair that comes within D in the
 // last instants of the window is still found, by the search and by the monitor, as
 // closest_approach (which measures the window from now) decides it. One vessel lies still,
@@ -642,18 +663,11 @@ TEST(ConflictMonitor, WindowEndsAtEpochSecondsAsClosestApproachDecides) {
           const double x = within + 20 * (step + horizon) + k * 1e-7;
           const Motion2 a{base, {0, 0}, {0, 0}}, b{base, {x, 0}, {-20, 0}};
           const bool want = closest_approach(a, b, now, horizon, within).has_value();
-          ConflictMonitor<2> monitor(within, horizon, slack);
-          monitor.report(1, a);
-          monitor.report(2, b);
-          monitor.refresh(base);
-          monitor.refresh(now);
-          const std::vector<Id> ids{1, 2};
-          const std::vector<Motion2> objects{a, b};
+          const TwoObjects two = two_objects(a, b, within, horizon, slack, base, now);
           const std::string at = "horizon " + std::to_string(horizon) + " step " +
                                  std::to_string(step) + " offset " + std::to_string(k);
-          EXPECT_EQ(find_conflicts<2>(ids, objects, within, now, horizon).size(), want ? 1u : 0u)
-              << at;
-          EXPECT_EQ(monitor.conflicts().size(), want ? 1u : 0u) << at;
+          EXPECT_EQ(two.from_scratch.size(), want ? 1u : 0u) << at;
+          EXPECT_EQ(two.monitored.size(), want ? 1u : 0u) << at;
           found += want;
           ++tried;
         }
@@ -679,15 +693,8 @@ TEST(ConflictMonitor, OldReportsAnswerAsAComputationFromScratch) {
     const double age = 1e12 * (1 + u(rng)), v = 10 + 20 * u(rng);
     const double x = within + (u(rng) - 0.5) * 0.02;
     const Motion2 a{base, {0, 0}, {v, 0}}, b{base - age, {x - v * age, 0}, {v, 0}};
-    ConflictMonitor<2> monitor(within, horizon, slack);
-    monitor.report(1, a);
-    monitor.report(2, b);
-    monitor.refresh(base);
-    monitor.refresh(now);
-    const std::vector<Id> ids{1, 2};
-    const std::vector<Motion2> objects{a, b};
-    const auto want = find_conflicts<2>(ids, objects, within, now, horizon);
-    const auto got = monitor.conflicts();
+    const TwoObjects two = two_objects(a, b, within, horizon, slack, base, now);
+    const auto &want = two.from_scratch, &got = two.monitored;
     ASSERT_EQ(got.size(), want.size()) << trial;
     expect_close(got, want, within, "trial " + std::to_string(trial));
     pairs += int(want.size());
@@ -717,16 +724,9 @@ TEST(ConflictMonitor, ClampedTimesAreTheWindowsEnds) {
   };
   const double within = 12, horizon = 30.1;
   for (const Case& c : cases) {
-    ConflictMonitor<2> monitor(within, horizon, c.slack);
-    monitor.report(1, c.a);
-    monitor.report(2, c.b);
-    monitor.refresh(c.base);
-    monitor.refresh(c.now);
-    ASSERT_EQ(monitor.incremental_refreshes(), 1u);
-    const std::vector<Id> ids{1, 2};
-    const std::vector<Motion2> objects{c.a, c.b};
-    const auto want = find_conflicts<2>(ids, objects, within, c.now, horizon);
-    const auto got = monitor.conflicts();
+    const TwoObjects two = two_objects(c.a, c.b, within, horizon, c.slack, c.base, c.now);
+    ASSERT_EQ(two.incremental_refreshes, 1u);
+    const auto &want = two.from_scratch, &got = two.monitored;
     ASSERT_EQ(got.size(), 1u);
     ASSERT_EQ(want.size(), 1u);
     const Approach &g = got[0].approach, &w = want[0].approach;
