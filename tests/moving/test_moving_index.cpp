@@ -255,6 +255,60 @@ TYPED_TEST(MovingIndexTest, EpochSecondWindowsHoldNoObjectMovingAway) {
   }
 }
 
+// Reports long before the others at extreme magnitudes: an object reported 2e6 s before the
+// tree's first report, 2e12 away and closing at 1e6 units a second, lies near the others at
+// the epoch; its bounds there, p + v (epoch - t), round at the size of p and of its travel
+// (2.4e-4), which the trees' pruning allowance counted only at the bounds' own size. Windows
+// with an edge on such an object's position at the query time hold it (touching counts), and
+// nearest queries just off it find it.
+TYPED_TEST(MovingIndexTest, AncientReportsOnTheWindowsEdgesAreFound) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0, 1000), sign(-1, 1);
+  TypeParam index;
+  Objects objs;
+  Id id = 1;
+  for (int i = 0; i < 200; ++i) {
+    const Motion2 m{0, {u(rng), u(rng)}, {sign(rng), sign(rng)}};
+    index.insert(id, m);
+    objs[id++] = m;
+  }
+  std::vector<Motion2> ancient;
+  for (int i = 0; i < 50; ++i) {
+    const double t = -2e6 - 1e4 * u(rng);
+    const Point2 v{1e6 * sign(rng), 1e6 * sign(rng)}, at{u(rng), u(rng)};
+    const Motion2 m{t, {at[0] - v[0] * (0 - t), at[1] - v[1] * (0 - t)}, v};
+    index.insert(id, m);
+    objs[id++] = m;
+    ancient.push_back(m);
+  }
+  int held = 0;
+  for (std::size_t i = 0; i < ancient.size(); ++i) {
+    const double s = 1e-6 * u(rng);
+    const Point2 p = position(ancient[i], s);
+    // The object's position is a corner of the window, on one side or the other.
+    const double wx = 10 * sign(rng), wy = 10 * sign(rng);
+    const Box2 b{{std::min(p[0], p[0] + wx), std::min(p[1], p[1] + wy)},
+                 {std::max(p[0], p[0] + wx), std::max(p[1], p[1] + wy)}};
+    // A timeslice, or an interval from s (the object may leave the window at once).
+    const MovingWindow<2> w =
+        i % 2 ? MovingWindow<2>::during(b, s, s + 1e-9) : MovingWindow<2>::at(b, s);
+    std::vector<Id> got = index.query(w);
+    std::sort(got.begin(), got.end());
+    const std::vector<Id> want = brute_window(objs, w);
+    ASSERT_EQ(got, want) << "window " << i;
+    held += int(want.size());
+    // Nearest to a point just off the object's position: the object, or one as near.
+    const Point2 q{p[0] + 1e-3 * wx, p[1] + 1e-3 * wy};
+    const auto near = index.nearest(q, s, 3);
+    const auto brute = brute_nearest(objs, q, s, 3);
+    ASSERT_EQ(near.size(), brute.size());
+    for (std::size_t r = 0; r < near.size(); ++r)
+      ASSERT_DOUBLE_EQ(near[r].distance, brute[r]) << "nearest " << i << " rank " << r;
+  }
+  // Every timeslice holds its object (an interval may lose one that leaves it at once).
+  EXPECT_GE(held, 25);
+}
+
 TYPED_TEST(MovingIndexTest, UpdatesErasuresAndTicks) {
   const auto fleet = test::make_fleet(test::Fleet::uniform, 3000, 9);
   TypeParam index;

@@ -222,7 +222,7 @@ class MovingRTree {
         const std::uint32_t i = cells_[k].index;
         const Box_ b = Box_::of(motion[i], epoch);
         for (int a = 0; a < D; ++a) {
-          mag = std::max(mag, std::abs(b.lo[a]));
+          mag = std::max({mag, std::abs(b.lo[a]), std::abs(motion[i].p[a])});
           vmag = std::max(vmag, std::abs(b.vlo[a]));
         }
         put(nd, int(k - first), {b, i, motion[i], obj_id_[i]});
@@ -313,7 +313,7 @@ class MovingRTree {
           boxes_meet(n, grown, r, in);
         else
           for (int e = 0; e < n.count; ++e)
-            in[e] = detail::tpbr_meets(n.box[e], epoch_, w);
+            in[e] = detail::tpbr_meets(n.box[e], epoch_, w, report_slack());
         for (int e = 0; e < n.count; ++e)
           if (in[e]) stack.push_back(n.child[e]);
       }
@@ -394,7 +394,7 @@ class MovingRTree {
             [&](int e) { return n.id[e]; });
       } else {
         for (int e = 0; e < n.count; ++e)
-          d2[e] = prune ? detail::tpbr_distance2(n.box[e], r, q) : 0.0;
+          d2[e] = prune ? detail::tpbr_distance2(n.box[e], r, q, report_slack()) : 0.0;
         sink.push_subtrees(d2, n.count, [&](int e) { return std::uint64_t(n.child[e]); });
       }
       return n.count;
@@ -503,6 +503,9 @@ class MovingRTree {
   double tolerance(double r) const {
     return 1e-12 * (4 * mag_ + 4 * vmag_ * (std::abs(r) + std::abs(rel_clock()))) + 1e-300;
   }
+  // What the bounds' own slack (tpbr.hpp) leaves out: the rounding of an entry's bounds at the
+  // size of its report, whose position and travel to the epoch can cancel.
+  double report_slack() const { return 4e-12 * mag_; }
 
   // Vectorized timeslice tests of all entries of a node. in[e]: the entry's box at relative
   // time r meets `grown` (the window grown by the tolerance).
@@ -759,7 +762,7 @@ class MovingRTree {
     }
     const Box_ b = Box_::of(m, epoch_);
     for (int i = 0; i < D; ++i) {
-      mag_ = std::max(mag_, std::abs(b.lo[i]));
+      mag_ = std::max({mag_, std::abs(b.lo[i]), std::abs(m.p[i])});
       vmag_ = std::max(vmag_, std::abs(b.vlo[i]));
     }
     std::uint32_t reinserted = 0;
@@ -1087,7 +1090,7 @@ class MovingRTree {
     }
     clock_ = clock;
     for (int i = 0; i < D; ++i) {
-      mag_ = std::max(mag_, std::abs(b.lo[i]));
+      mag_ = std::max({mag_, std::abs(b.lo[i]), std::abs(m.p[i])});
       vmag_ = std::max(vmag_, std::abs(b.vlo[i]));
     }
     Node& node = nodes_[leaf];
@@ -1301,7 +1304,7 @@ class MovingRTree {
   double clock_ = -std::numeric_limits<double>::infinity();
   std::size_t max_choose_nodes_ = 0;
   std::size_t regroups_ = 0;
-  double mag_ = 0;   // largest |coordinate| of an object's entry at the epoch
+  double mag_ = 0;   // largest |coordinate| of an object's report or entry at the epoch
   double vmag_ = 0;  // largest |velocity| component
 };
 

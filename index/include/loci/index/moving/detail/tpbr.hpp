@@ -102,17 +102,18 @@ double swept_cost(const Tpbr<D>& b, double c, double horizon, const Point<D>& ex
 
 // The times of the window w (absolute times, epoch given) at which b may hold a point in it:
 // empty means no point b bounds from relative time c on meets w, when w.t1 >= epoch + c.
+// `extra` widens the rounding slack (the owner's allowance for what b's magnitudes miss).
 template <int D>
-bool tpbr_meets(const Tpbr<D>& b, double epoch, const MovingWindow<D>& w) {
+bool tpbr_meets(const Tpbr<D>& b, double epoch, const MovingWindow<D>& w, double extra = 0) {
   const double r1 = w.t1 - epoch, r2 = w.t2 - epoch;
   const Point<D>& wvmin = w.vmin();
   const Point<D>& wvmax = w.vmax();
   LinearSpan span{r1, r2};
   const double reach = std::max(std::abs(r1), std::abs(r2));
   for (int i = 0; i < D; ++i) {
-    const double tol =
-        b.slack(i, reach) + 1e-12 * (std::abs(w.from.min[i]) + std::abs(w.from.max[i]) +
-                                     std::abs(w.to.min[i]) + std::abs(w.to.max[i]));
+    const double tol = b.slack(i, reach) + extra +
+                       1e-12 * (std::abs(w.from.min[i]) + std::abs(w.from.max[i]) +
+                                std::abs(w.to.min[i]) + std::abs(w.to.max[i]));
     // lo(r) <= whi(r) and wlo(r) <= hi(r), at r = r1 + u.
     span.keep(b.lo_at(i, r1) - w.from.max[i] - tol, b.vlo[i] - wvmax[i], r1);
     span.keep(w.from.min[i] - b.hi_at(i, r1) - tol, wvmin[i] - b.vhi[i], r1);
@@ -121,12 +122,13 @@ bool tpbr_meets(const Tpbr<D>& b, double epoch, const MovingWindow<D>& w) {
   return true;
 }
 
-// Squared distance from q to the box b spans at relative time r, less the rounding slack.
+// Squared distance from q to the box b spans at relative time r, less the rounding slack
+// (widened by `extra`, as for tpbr_meets).
 template <int D>
-double tpbr_distance2(const Tpbr<D>& b, double r, const Point<D>& q) {
+double tpbr_distance2(const Tpbr<D>& b, double r, const Point<D>& q, double extra = 0) {
   double d2 = 0;
   for (int i = 0; i < D; ++i) {
-    const double tol = b.slack(i, r);
+    const double tol = b.slack(i, r) + extra;
     const double lo = b.lo_at(i, r) - tol, hi = b.hi_at(i, r) + tol;
     const double d = q[i] < lo ? lo - q[i] : q[i] > hi ? q[i] - hi : 0;
     d2 += d * d;
