@@ -160,6 +160,7 @@ int x_destroy(sqlite3_vtab* v) {
 struct Cursor : sqlite3_vtab_cursor {
   std::vector<FleetReport> rows;
   std::size_t at = 0;
+  std::uint64_t changes = 0;  // the table's count of changes when the rows were taken
 };
 
 int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
@@ -190,9 +191,11 @@ int x_best_index(sqlite3_vtab* v, sqlite3_index_info* info) {
 int x_filter(sqlite3_vtab_cursor* cur, int plan, const char*, int argc, sqlite3_value** argv) {
   Cursor& c = *static_cast<Cursor*>(cur);
   return guarded(cur->pVtab, [&] {
-    FleetState& state = table_of(cur->pVtab).current();
+    FleetTable& t = table_of(cur->pVtab);
+    FleetState& state = t.current();
     c.rows.clear();
     c.at = 0;
+    c.changes = t.changes;
     FleetId id = 0;
     if (plan == plan_id && argc == 1 && row_id(argv[0], id)) {
       if (const Motion2* m = state.find(id)) c.rows.push_back({id, *m});
@@ -204,8 +207,21 @@ int x_filter(sqlite3_vtab_cursor* cur, int plan, const char*, int argc, sqlite3_
 }
 
 int x_next(sqlite3_vtab_cursor* cur) {
-  ++static_cast<Cursor*>(cur)->at;
-  return SQLITE_OK;
+  Cursor& c = *static_cast<Cursor*>(cur);
+  ++c.at;
+  FleetTable& t = table_of(cur->pVtab);
+  if (c.changes == t.changes || c.at >= c.rows.size()) return SQLITE_OK;
+  // Written to since the rows were taken (a loop over the table writing to it): the rows
+  // still to come are read as they are now, those removed skipped, as a rowid table does.
+  return guarded(cur->pVtab, [&] {
+    FleetState& state = t.current();
+    for (; c.at < c.rows.size(); ++c.at)
+      if (const Motion2* m = state.find(c.rows[c.at].first)) {
+        c.rows[c.at].second = *m;
+        break;
+      }
+    return SQLITE_OK;
+  });
 }
 int x_eof(sqlite3_vtab_cursor* cur) {
   const Cursor& c = *static_cast<Cursor*>(cur);
@@ -231,6 +247,7 @@ int x_rowid(sqlite3_vtab_cursor* cur, sqlite_int64* id) {
 
 int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_rowid) {
   FleetTable& t = table_of(v);
+  ++t.changes;
   return guarded(v, [&] {
     t.current();
     const bool has_old = sqlite3_value_type(argv[0]) != SQLITE_NULL;

@@ -88,6 +88,9 @@ struct FleetTable : ShadowTable {
 
   std::optional<FleetState> state;  // empty until read
   bool wrote = false;               // this transaction wrote: bump 'generation' at commit
+  // Writes through the table and rollbacks, counted: an open cursor compares it with the
+  // count it started at.
+  std::uint64_t changes = 0;
 
   Statement put_report, drop_report, drop_history, latest_report, read_history, put_current,
       drop_current, read_current, find_report;
@@ -97,6 +100,7 @@ struct FleetTable : ShadowTable {
   FleetState& current();
   void forget() {
     state.reset();
+    ++changes;
     forget_version();
   }
 

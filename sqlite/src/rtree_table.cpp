@@ -402,7 +402,8 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
       return SQLITE_OK;
     }
     // argv[1] the new rowid, argv[2] the id column, argv[3..6] the box, then the aux values.
-    // The id column is the rowid, as in an INTEGER PRIMARY KEY: a NULL id takes a new one.
+    // The id column is the rowid, as in an INTEGER PRIMARY KEY: a NULL id inserted takes a new
+    // one, and an UPDATE to a NULL id (or rowid) is refused as a rowid table refuses it.
     RowId id = 0;
     sqlite3_value* given = argv[2];
     if (has_old && sqlite3_value_type(argv[1]) != SQLITE_NULL &&
@@ -410,6 +411,12 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
       given = argv[1];  // UPDATE ... SET rowid = ...
     else if (!has_old && sqlite3_value_type(argv[2]) == SQLITE_NULL)
       given = argv[1];  // INSERT INTO t(rowid, ...)
+    if (has_old &&
+        (sqlite3_value_type(given) == SQLITE_NULL || sqlite3_value_type(argv[1]) == SQLITE_NULL))
+      throw SqlError{SQLITE_MISMATCH,
+                     format_sql("loci_rtree %s: datatype mismatch (an UPDATE cannot set the id "
+                                "of id %lld to NULL)",
+                                t.name.c_str(), (long long)old_id)};
     if (sqlite3_value_type(given) != SQLITE_NULL) {
       if (!row_id(given, id))
         throw SqlError{SQLITE_MISMATCH,

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -262,6 +263,51 @@ TEST(SqliteFleetSql, ReportsReplaceByTimeAndUpdateDeleteFollowTheirRules) {
   EXPECT_EQ(db.rows("SELECT id_a, id_b, t_enter FROM loci_conflicts('f', 1, 100, 10)"),
             (std::vector<Row>{{"3", "4", "10"}}));
   EXPECT_TRUE(db.rows("SELECT * FROM loci_conflicts('f', 1, 100, -1)").empty());
+}
+
+// Writes on the same connection while a scan's cursor is still stepped: each row it still
+// returns is the object's current report then (never an object deleted meanwhile, nor a
+// report since replaced), at most once, as a rowid table holding the current reports gives
+// it; also across a ROLLBACK TO.
+TEST(SqliteFleetSql, ACursorSteppedAcrossWritesReturnsReportsAsTheyAre) {
+  for (const bool rollback : {false, true}) {
+    Db db;
+    db.exec("CREATE VIRTUAL TABLE f USING loci_fleet(id, t, x, y, vx, vy)");
+    db.exec("CREATE TABLE m(id INTEGER PRIMARY KEY, t REAL, x REAL, y REAL, vx REAL, vy REAL)");
+    std::mt19937_64 rng(rollback ? 51 : 50);
+    for (int i = 1; i <= 200; ++i)
+      db.exec_on({"f", "m"}, "INSERT INTO $T VALUES(" + std::to_string(i) + ", 10, " +
+                                 std::to_string(rng() % 100) + ", " + std::to_string(rng() % 100) +
+                                 ", 1, 0)");
+    if (rollback) db.exec("BEGIN; SAVEPOINT s");
+    sqlite3_stmt* q = nullptr;
+    ASSERT_EQ(sqlite3_prepare_v2(db.get(), "SELECT id, t, x, y FROM f", -1, &q, nullptr),
+              SQLITE_OK);
+    std::set<std::string> seen;
+    int returned = 0;
+    while (sqlite3_step(q) == SQLITE_ROW) {
+      Row got;
+      for (int c = 0; c < 4; ++c)
+        got.push_back(Db::text(q, c));
+      ASSERT_TRUE(seen.insert(got[0]).second) << "id " << got[0] << " returned twice";
+      EXPECT_EQ(db.rows("SELECT id, t, x, y FROM m WHERE id = " + got[0]), (std::vector<Row>{got}));
+      ++returned;
+      for (int w = 0; w < 2; ++w) {
+        const std::string id = std::to_string(1 + rng() % 200), x = std::to_string(rng() % 100);
+        if (rng() % 2)
+          db.exec_on({"f", "m"}, "DELETE FROM $T WHERE id = " + id);
+        else
+          db.exec_on({"f", "m"}, "UPDATE $T SET x = " + x + " WHERE id = " + id);
+      }
+      if (rollback && returned % 5 == 0) db.exec("ROLLBACK TO s");
+    }
+    sqlite3_finalize(q);
+    if (rollback) db.exec("COMMIT");
+    EXPECT_GT(returned, 20);
+    EXPECT_EQ(db.rows("SELECT id, t, x, y FROM f ORDER BY id"),
+              db.rows("SELECT id, t, x, y FROM m ORDER BY id"));
+    EXPECT_EQ(db.value("SELECT loci_check('f')"), "ok");
+  }
 }
 
 TEST(SqliteFleetSql, RandomWritesFollowRollbackAndSavepoints) {

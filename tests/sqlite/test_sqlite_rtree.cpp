@@ -295,6 +295,31 @@ TEST(SqliteRtreeSql, AuxColumnsTravelWithTheirRows) {
   EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
 }
 
+// An UPDATE that sets the id (or the rowid) to NULL is refused, as a rowid table refuses it
+// (datatype mismatch), rather than moving the row to a new id: a remapping by a subquery that
+// finds no row for some id leaves the table as it was.
+TEST(SqliteRtreeSql, UpdateToANullIdIsRefused) {
+  Db db;
+  db.exec("CREATE VIRTUAL TABLE t USING loci_rtree(id, x0, x1, y0, y1, +name)");
+  db.exec("CREATE TABLE plain(id INTEGER PRIMARY KEY, name)");
+  db.exec("CREATE TABLE remap(old INTEGER, new INTEGER)");
+  db.exec("INSERT INTO t VALUES (1, 0, 1, 0, 1, 'a'), (2, 2, 3, 2, 3, 'b'), (3, 4, 5, 4, 5, 'c')");
+  db.exec("INSERT INTO plain VALUES (1, 'a'), (2, 'b'), (3, 'c')");
+  db.exec("INSERT INTO remap VALUES (1, 11), (2, 12)");
+  const std::vector<Row> before{{"1", "a"}, {"2", "b"}, {"3", "c"}};
+  for (const char* table : {"plain", "t"}) {
+    const std::string name = table;
+    EXPECT_NE(db.error_of("UPDATE " + name +
+                          " SET id = (SELECT new FROM remap WHERE old = " + name + ".id)"),
+              "")
+        << table;
+    EXPECT_NE(db.error_of("UPDATE " + name + " SET id = NULL WHERE id = 2"), "") << table;
+    EXPECT_NE(db.error_of("UPDATE " + name + " SET rowid = NULL WHERE id = 3"), "") << table;
+    EXPECT_EQ(db.rows("SELECT id, name FROM " + name + " ORDER BY id"), before) << table;
+  }
+  EXPECT_EQ(db.value("SELECT loci_check('t')"), "ok");
+}
+
 // A NULL id takes one more than the largest live id, as in a rowid table: the top id erased is
 // not remembered, negative ids count, an empty table starts at 1. Checked in the packed base
 // (after a commit reloads it), in the unpacked rows, and after a rollback.
