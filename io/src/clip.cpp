@@ -2,12 +2,13 @@
 // (through OGR), written to a new dataset whose format follows the output's extension.
 //
 // Clip answers for the features query reports. An invalid polygon (a bowtie) is made valid
-// before it is cut. A feature that only touches the window keeps its piece of lower dimension
-// (a polygon sharing an edge leaves a line, a corner a point) in formats whose layers hold mixed
-// geometry (GeoJSON, GeoPackage, ...); a shapefile holds one geometry type, so there such
-// pieces are dropped and counted. A cut that has parts of the feature's dimension keeps only
-// those (the two arms of a U cut off from its bar, without the line where the window's edge
-// touches the notch), and the parts left out are counted too.
+// before it is cut, by the even-odd rule over its rings as the queries read it; one whose
+// rings meet the window where its area does not is cut as its rings. A feature that only touches
+// the window keeps its piece of lower dimension (a polygon sharing an edge leaves a line, a corner
+// a point) in formats whose layers hold mixed geometry (GeoJSON, GeoPackage, ...); a shapefile
+// holds one geometry type, so there such pieces are dropped and counted. A cut that has parts of
+// the feature's dimension keeps only those (the two arms of a U cut off from its bar, without the
+// line where the window's edge touches the notch), and the parts left out are counted too.
 //
 // A polygonal window (--wkt, or the union of a layer's polygons with --window-layer) is the
 // windowing problem with a non-rectangular window: the index gives the features meeting the
@@ -36,25 +37,69 @@ bool polygonal(const OGRGeometry& g) {
   return t == wkbPolygon || t == wkbMultiPolygon;
 }
 
+// Adds the polygons of v (a repair's result) to `out`, leaving out what it collapsed to lines
+// or points.
+void add_polygons_of(const OGRGeometry& v, OGRMultiPolygon& out) {
+  const auto vt = wkbFlatten(v.getGeometryType());
+  if (vt == wkbPolygon) {
+    out.addGeometry(&v);
+  } else if (vt == wkbMultiPolygon || vt == wkbGeometryCollection) {
+    for (const OGRGeometry* part : *v.toGeometryCollection())
+      add_polygons_of(*part, out);
+  }
+}
+
+// An invalid polygon's area as the queries read it, by the even-odd rule over its rings: each
+// ring made valid by itself (a ring that crosses itself encloses what it winds around an odd
+// number of times), the rings' areas then combined by symmetric difference. Repairing the
+// whole polygon at once dissolves the edges two rings share first: a hole sharing an edge
+// with its shell, or repeating it, came out filled. Null when a ring cannot be repaired.
+std::unique_ptr<OGRGeometry> even_odd(const OGRPolygon& p) {
+  std::unique_ptr<OGRGeometry> acc = std::make_unique<OGRMultiPolygon>();
+  for (const OGRLinearRing* ring : p) {
+    OGRPolygon one;
+    one.addRingDirectly(ring->clone());
+    one.closeRings();
+    const std::unique_ptr<OGRGeometry> v(one.IsValid() ? one.clone() : one.MakeValid());
+    if (!v) return nullptr;
+    OGRMultiPolygon parts;
+    add_polygons_of(*v, parts);
+    if (parts.IsEmpty()) continue;
+    acc.reset(acc->IsEmpty() ? parts.clone() : acc->SymDifference(&parts));
+    if (!acc) return nullptr;
+  }
+  return acc;
+}
+
+// Adds the rings of the polygons of g (a polygon, or a multi-polygon or collection of
+// polygons, at any depth) to `out` as lines; false when g holds anything else.
+bool add_rings(const OGRGeometry& g, OGRMultiLineString& out) {
+  const auto t = wkbFlatten(g.getGeometryType());
+  if (t == wkbPolygon) {
+    for (const OGRLinearRing* ring : *g.toPolygon()) {
+      OGRLineString line;
+      line.addSubLineString(ring);
+      out.addGeometry(&line);
+    }
+    return true;
+  }
+  if (t != wkbMultiPolygon && t != wkbGeometryCollection) return false;
+  for (const OGRGeometry* part : *g.toGeometryCollection())
+    if (!add_rings(*part, out)) return false;
+  return true;
+}
+
 // Adds the polygons of g (a polygon, or a multi-polygon or collection of polygons, at any
-// depth) to `out`, each made valid by itself; false when g holds anything else or a polygon
-// cannot be repaired. What a repair collapses to lines or points is left out.
+// depth) to `out`, each made valid by itself (by the even-odd rule over its rings); false
+// when g holds anything else or a polygon cannot be repaired. What a repair collapses to lines
+// or points is left out.
 bool add_valid_polygons(const OGRGeometry& g, OGRMultiPolygon& out) {
   const auto t = wkbFlatten(g.getGeometryType());
   if (t == wkbPolygon) {
-    const std::unique_ptr<OGRGeometry> v(g.IsValid() ? g.clone() : g.MakeValid());
+    const std::unique_ptr<OGRGeometry> v =
+        g.IsValid() ? std::unique_ptr<OGRGeometry>(g.clone()) : even_odd(*g.toPolygon());
     if (!v) return false;
-    const auto vt = wkbFlatten(v->getGeometryType());
-    if (vt == wkbPolygon) {
-      out.addGeometry(v.get());
-    } else if (vt == wkbMultiPolygon || vt == wkbGeometryCollection) {
-      for (const OGRGeometry* part : *v->toGeometryCollection())
-        if (wkbFlatten(part->getGeometryType()) == wkbPolygon)
-          out.addGeometry(part);
-        else if (wkbFlatten(part->getGeometryType()) == wkbMultiPolygon)
-          for (const OGRPolygon* q : *part->toMultiPolygon())
-            out.addGeometry(q);
-    }
+    add_polygons_of(*v, out);
     return true;
   }
   if (t != wkbMultiPolygon && t != wkbGeometryCollection) return false;
@@ -363,6 +408,7 @@ ClipResult clip_layer(const ClipOptions& options) {
       // Polygons of one feature that overlap keep their overlap, as queries count it: an
       // invalid multi-polygon, and a collection of polygons (valid however they overlap, and
       // cut by GEOS as if the overlap were outside), are cut as the union of their polygons.
+      const OGRGeometry* const unrepaired = g;
       std::unique_ptr<OGRGeometry> valid;
       const bool invalid = !g->IsValid();
       if (invalid || wkbFlatten(g->getGeometryType()) == wkbGeometryCollection) {
@@ -377,6 +423,15 @@ ClipResult clip_layer(const ClipOptions& options) {
       if (!piece)
         throw Error(options.load.layer_path + ": feature " + std::to_string(a.fid) +
                     " cannot be cut to the window (" + CPLGetLastErrorMsg() + ")");
+      // A polygonal feature the queries found meeting the window whose cut has nothing: its
+      // rings meet the window where its area does not reach it (holes sharing an edge, a hole
+      // repeating its shell, a polygon without area, a repair moving an edge by a rounding),
+      // and the cut of the rings is its piece, as for a feature that only touches the window.
+      OGRMultiLineString rings;
+      if (piece->IsEmpty() && add_rings(*unrepaired, rings)) {
+        std::unique_ptr<OGRGeometry> lines(rings.Intersection(window.get()));
+        if (lines && !lines->IsEmpty()) piece = std::move(lines);
+      }
       if (piece->IsEmpty()) continue;
       // Measures are not carried through the cut (GEOS keeps x, y and z): none, rather than
       // a made-up 0 at every vertex.
