@@ -55,20 +55,34 @@ void add_polygons_of(const OGRGeometry& v, OGRMultiPolygon& out) {
 // whole polygon at once dissolves the edges two rings share first: a hole sharing an edge
 // with its shell, or repeating it, came out filled. Null when a ring cannot be repaired.
 std::unique_ptr<OGRGeometry> even_odd(const OGRPolygon& p) {
-  std::unique_ptr<OGRGeometry> acc = std::make_unique<OGRMultiPolygon>();
+  std::vector<std::unique_ptr<OGRGeometry>> areas;
   for (const OGRLinearRing* ring : p) {
     OGRPolygon one;
     one.addRingDirectly(ring->clone());
     one.closeRings();
     const std::unique_ptr<OGRGeometry> v(one.IsValid() ? one.clone() : one.MakeValid());
     if (!v) return nullptr;
-    OGRMultiPolygon parts;
-    add_polygons_of(*v, parts);
-    if (parts.IsEmpty()) continue;
-    acc.reset(acc->IsEmpty() ? parts.clone() : acc->SymDifference(&parts));
-    if (!acc) return nullptr;
+    auto parts = std::make_unique<OGRMultiPolygon>();
+    add_polygons_of(*v, *parts);
+    if (!parts->IsEmpty()) areas.push_back(std::move(parts));
   }
-  return acc;
+  if (areas.empty()) return std::make_unique<OGRMultiPolygon>();
+  // Combined in pairs, then pairs of pairs: each ring's area takes part in O(log rings)
+  // differences, not one each against everything combined so far.
+  while (areas.size() > 1) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < areas.size(); i += 2) {
+      if (i + 1 < areas.size()) {
+        areas[n].reset(areas[i]->SymDifference(areas[i + 1].get()));
+        if (!areas[n]) return nullptr;
+      } else {
+        areas[n] = std::move(areas[i]);
+      }
+      ++n;
+    }
+    areas.resize(n);
+  }
+  return std::move(areas.front());
 }
 
 // Adds the rings of the polygons of g (a polygon, or a multi-polygon or collection of
