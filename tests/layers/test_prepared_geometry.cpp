@@ -7,9 +7,11 @@
 // definitions through brute-force point tests on lattice points.
 #include <gmpxx.h>
 #include <gtest/gtest.h>
+#include <cstdio>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <utility>
 #include <vector>
@@ -351,6 +353,46 @@ TEST(PreparedGeometry, CoversAlongLongCollinearLines) {
     add_ring(below, {at(0.5, 0.7), at(n / 2.0, -9), at(n - 0.5, 0.7)}, 0);
     below.polygons = 1;
     EXPECT_FALSE(covers(PreparedGeometry(square), PreparedGeometry(below))) << axis;
+  }
+}
+
+// covers() at any scale: the parameters of the points where edges meet came from squared
+// lengths, which underflow below about 1e-154 (a line across a square's hole was covered at
+// 1e-170 and below) and overflow above 1e154. The same shapes, scaled, answer the same.
+TEST(PreparedGeometry, CoversAtTinyAndHugeScales) {
+  for (const double s :
+       {1.0, 1e-150, 1e-170, 1e-200, 1e-250, 1e-300, 1e-310, 1e100, 1e150, 1e200, 1e290}) {
+    const auto at = [s](double x, double y) { return Point2{x * s, y * s}; };
+    FlatGeometry a;  // a square with a hole
+    add_ring(a, {at(0, 0), at(10, 0), at(10, 10), at(0, 10)}, 0);
+    add_ring(a, {at(4, 4), at(6, 4), at(6, 6), at(4, 6)}, 0, true);
+    a.polygons = 1;
+    auto line = [](Point2 p, Point2 q) {
+      FlatGeometry g;
+      g.points = {p, q};
+      g.parts.push_back({0, 2, PartKind::line, 0});
+      return g;
+    };
+    auto polygon = [](std::vector<Point2> ring) {
+      FlatGeometry g;
+      add_ring(g, std::move(ring), 0);
+      g.polygons = 1;
+      return g;
+    };
+    const PreparedGeometry pa(a);
+    char at_scale[32];
+    std::snprintf(at_scale, sizeof at_scale, "scale %g", s);
+    // Across the hole (at 9/16 of the way, (5.5, 4.375)), and below it.
+    EXPECT_FALSE(covers(pa, PreparedGeometry(line(at(1, 1), at(9, 7))))) << at_scale;
+    EXPECT_TRUE(covers(pa, PreparedGeometry(line(at(1, 1), at(9, 2))))) << at_scale;
+    // Along the hole's side, and from a corner of the square to one of the hole.
+    EXPECT_TRUE(covers(pa, PreparedGeometry(line(at(3, 4), at(7, 4))))) << at_scale;
+    EXPECT_TRUE(covers(pa, PreparedGeometry(line(at(0, 0), at(4, 4))))) << at_scale;
+    // A triangle around the hole, and one beside it touching its side.
+    EXPECT_FALSE(covers(pa, PreparedGeometry(polygon({at(1, 1), at(9, 1), at(5, 9)})))) << at_scale;
+    EXPECT_TRUE(covers(pa, PreparedGeometry(polygon({at(1, 1), at(9, 1), at(5, 4)})))) << at_scale;
+    EXPECT_FALSE(covers(pa, PreparedGeometry(polygon({at(1, 1), at(9, 1), at(5, 4.5)}))))
+        << at_scale;
   }
 }
 
