@@ -473,8 +473,20 @@ Point2 shown(const Loaded& l, const Point2& p) {
   return l.ais() ? l.data.frame->to_lonlat(p) : p;
 }
 
-void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, Format format,
-                std::FILE* out) {
+// The positions hits are shown at, each converted before anything is written: a position
+// with no lon/lat (beyond the far side of the earth from the frame's centre) is an error
+// before the first row, not after a block of them has reached stdout.
+std::vector<Point2> shown_positions(const Loaded& l, const std::vector<Hit>& hits, Format format) {
+  std::vector<Point2> shown_at;
+  if (format == Format::ids) return shown_at;
+  shown_at.reserve(hits.size());
+  for (const Hit& h : hits)
+    shown_at.push_back(h.lonlat ? *h.lonlat : shown(l, h.p));
+  return shown_at;
+}
+
+void write_hits(const Loaded& l, const std::vector<Hit>& hits, const std::vector<Point2>& shown_at,
+                bool nearest, Format format, std::FILE* out) {
   const bool ais = l.ais();
   detail::BlockWriter w(out);
   std::string& row = w.buf();
@@ -501,7 +513,7 @@ void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, For
       row += ',';
       detail::append_num(row, h.t);
       if (ais) row += "," + format_utc(h.t);
-      const Point2 p = h.lonlat ? *h.lonlat : shown(l, h.p);
+      const Point2 p = shown_at[std::size_t(&h - hits.data())];
       row += ',';
       detail::append_nums(row, {p[0], p[1]});
       row += '\n';
@@ -513,7 +525,7 @@ void write_hits(const Loaded& l, const std::vector<Hit>& hits, bool nearest, For
   row += "{\"type\":\"FeatureCollection\",\"features\":[";
   for (std::size_t i = 0; i < hits.size(); ++i) {
     const Hit& h = hits[i];
-    const Point2 p = h.lonlat ? *h.lonlat : shown(l, h.p);
+    const Point2 p = shown_at[i];
     row += i ? ",\n{\"type\":\"Feature\",\"properties\":{\"id\":"
              : "\n{\"type\":\"Feature\",\"properties\":{\"id\":";
     detail::append_int(row, h.id);
@@ -547,8 +559,9 @@ FleetRun fleet_query(const FleetQueryOptions& o, std::FILE* fallback) {
     hits = nearest_hits(l, o);
   else
     hits = window_hits(l, o);
+  const std::vector<Point2> shown_at = shown_positions(l, hits, o.format);
   OutputFile out(o.out_path, fallback);
-  write_hits(l, hits, o.kind == FleetQueryOptions::Kind::nearest, o.format, out.stream());
+  write_hits(l, hits, shown_at, o.kind == FleetQueryOptions::Kind::nearest, o.format, out.stream());
   out.commit();
   FleetRun r = run_of(l);
   r.answers = hits.size();
@@ -563,6 +576,16 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   const Loaded l = load(o.path, o.at);
   const std::vector<FoundConflict> found = conflicts_of(l, o.within, o.horizon);
   const bool ais = l.ais();
+  // The two positions of each pair, converted before anything is written (as for queries).
+  std::vector<std::pair<Point2, Point2>> at_tcpa;
+  at_tcpa.reserve(found.size());
+  auto at = [&](Id id, const Motion2& m, double t) {
+    const std::optional<Point2> reported = reported_lonlat(l, id, m, t);
+    return reported ? *reported : shown(l, position(m, t));
+  };
+  for (const FoundConflict& fc : found)
+    at_tcpa.emplace_back(at(fc.c.a, fc.ma, fc.c.approach.tcpa),
+                         at(fc.c.b, fc.mb, fc.c.approach.tcpa));
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
   const bool csv = o.format == Format::csv;
@@ -577,10 +600,7 @@ FleetRun fleet_conflicts(const FleetConflictOptions& o, std::FILE* fallback) {
   for (std::size_t i = 0; i < found.size(); ++i) {
     const Conflict& c = found[i].c;
     const Approach& ap = c.approach;
-    const Point2 a = reported_lonlat(l, c.a, found[i].ma, ap.tcpa)
-                         .value_or(shown(l, position(found[i].ma, ap.tcpa)));
-    const Point2 b = reported_lonlat(l, c.b, found[i].mb, ap.tcpa)
-                         .value_or(shown(l, position(found[i].mb, ap.tcpa)));
+    const auto& [a, b] = at_tcpa[i];
     if (!csv)
       row += i ? ",\n{\"type\":\"Feature\",\"properties\":{"
                : "\n{\"type\":\"Feature\",\"properties\":{";

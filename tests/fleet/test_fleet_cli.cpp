@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -1009,6 +1010,40 @@ TEST_F(FleetCli, FailuresLeaveNothingWritten) {
                              " --within 10 --horizon 10 -q -o " + shell_quote(kept));
   ASSERT_EQ(ok.status, 0) << ok.err;
   EXPECT_EQ(lines(read_text(kept)).size(), 2u);
+}
+
+// A position with no lon/lat (beyond the far side of the earth from the frame's centre: a
+// pair at 50 knots asked about 11.6 days after its reports) is an error before anything
+// reaches stdout, however many rows come before it (a block of 64 KiB of them did).
+TEST_F(FleetCli, AnAisPositionWithoutLonLatWritesNothingToStdout) {
+  std::string text = "MMSI,BaseDateTime,LAT,LON,SOG,COG\n";
+  char row[96];
+  for (int i = 0; i < 1500; ++i) {
+    const double lat = 54 + i * 0.002;
+    std::snprintf(row, sizeof row,
+                  "%d,2023-01-01T00:00:00,%.4f,10,5,90\n%d,2023-01-01T00:00:00,%.4f,10,5,90\n",
+                  210000000 + 2 * i, lat, 210000000 + 2 * i + 1, lat + 0.0005);
+    text += row;
+  }
+  text +=
+      "219000003,2023-01-01T00:00:00,55,11,50,90\n219000004,2023-01-01T00:00:00,55.001,11,50,90\n";
+  const std::string f = write("far.csv", text);
+  for (const std::string& args :
+       {"fleet conflicts " + shell_quote(f) + " --within 200 --horizon 10 --at 1673531200",
+        "fleet conflicts " + shell_quote(f) +
+            " --within 200 --horizon 10 --at 1673531200 -f geojson",
+        "fleet query " + shell_quote(f) + " --nearest 10,55 -k 3002 --at 1673531200 -f geojson",
+        "fleet query " + shell_quote(f) + " --nearest 10,55 -k 3002 --at 1673531200 -f csv"}) {
+    const CliRun r = run_loci(args);
+    expect_one_line_error(r);
+    EXPECT_NE(r.err.find("far side of the earth"), std::string::npos) << args << r.err;
+    EXPECT_EQ(r.out, "") << args;
+  }
+  // Ids need no lon/lat, and the pairs of the slow vessels alone are written whole.
+  const CliRun ids = run_loci("fleet query " + shell_quote(f) +
+                              " --nearest 10,55 -k 3002 --at 1673531200 -f ids -q");
+  ASSERT_EQ(ids.status, 0) << ids.err;
+  EXPECT_EQ(lines(ids.out).size(), 3002u);
 }
 
 TEST_F(FleetCli, TheInputIsNeverOverwritten) {
