@@ -108,18 +108,20 @@ bool meets(const FlatGeometry& g, const Segment2& s) {
 }
 
 namespace {
-// The parameter of point x on the line of s, clamped to [0, 1] (x lies on s). The differences
-// are scaled by a power of two (exactly) to about 1 first: the squares of a segment's
-// coordinates below about 1e-154 underflow (at 1e-200 they were 0, and the parameter NaN or
-// off by far), and those above 1e154 overflow.
+// The parameter of point x on the line of s, clamped to [0, 1] (x lies on s). Differences far
+// from 1 are scaled by a power of two first (exactly, to the same quotient): the squares of a
+// segment's coordinates below about 1e-154 underflow (at 1e-200 they were 0, and the
+// parameter NaN or far off), and those above 1e154 overflow.
 double parameter(const Segment2& s, const Point2& x) {
   double dx = s.b[0] - s.a[0], dy = s.b[1] - s.a[1];
   double wx = x[0] - s.a[0], wy = x[1] - s.a[1];
   const double m = std::max(std::fabs(dx), std::fabs(dy));
   if (m == 0) return 0;
-  const int e = std::ilogb(m);
-  dx = std::ldexp(dx, -e), dy = std::ldexp(dy, -e), wx = std::ldexp(wx, -e),
-  wy = std::ldexp(wy, -e);
+  if (m < 0x1p-400 || m > 0x1p400) {  // else the squares neither underflow nor overflow
+    const int e = std::ilogb(m);
+    dx = std::ldexp(dx, -e), dy = std::ldexp(dy, -e);
+    wx = std::ldexp(wx, -e), wy = std::ldexp(wy, -e);
+  }
   const double t = (wx * dx + wy * dy) / (dx * dx + dy * dy);
   return std::clamp(t, 0.0, 1.0);
 }
