@@ -403,6 +403,16 @@ ClipResult clip_layer(const ClipOptions& options) {
       if (!rectangle &&
           !meets(detail::flatten(g, detail::where(options.load.layer_path, a.fid)), window_flat))
         continue;
+      // Curves are cut as the queries read them, linearised as GDAL does by default (so that
+      // an invalid curve polygon is repaired by the even-odd rule below too).
+      std::unique_ptr<OGRGeometry> linear;
+      if (g->hasCurveGeometry()) {
+        linear.reset(g->getLinearGeometry());
+        if (!linear)
+          throw Error(options.load.layer_path + ": feature " + std::to_string(a.fid) +
+                      " has curves GDAL cannot linearise");
+        g = linear.get();
+      }
       // Triangles, TINs and polyhedral surfaces are cut as the polygons of their faces (GEOS
       // takes no other surface).
       std::unique_ptr<OGRGeometry> faces;

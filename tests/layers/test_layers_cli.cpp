@@ -571,20 +571,27 @@ TEST_F(LayersCli, ClipCutsInvalidPolygonsAsTheQueriesReadThem) {
                                          "[[4,1],[7,1],[7,7],[4,7],[4,1]]")
                        // 5: no area, its ring along y = 3
                        << feature(5, "[[3,3],[6,3],[3,3],[3,3]]") << "]}";
+  // Curve polygons too, read linearised as the queries read them (FIDs 1 and 2 of a CSV).
+  const std::string curves = path("invalid-curves.csv");
+  std::ofstream(curves)
+      << "i,WKT\n1,\"CURVEPOLYGON((0 0,8 0,8 8,0 8,0 0),(0 0,8 0,8 8,0 8,0 0))\"\n"
+         "2,\"CURVEPOLYGON((0 0,8 0,8 8,0 8,0 0),(0 2,8 2,8 4,0 4,0 2))\"\n";
   struct Case {
+    const std::string& layer;
     const char* bbox;
     std::map<int, double> want;  // by feature: the piece's area, or its length for a line
   };
   const Case cases[] = {
-      {"3.5,5.2,5.5,5.8", {{0, 0.3}, {2, 1.2}, {3, 1.2}, {4, 0.6}}},
-      {"-1,-1,9,9", {{0, 4}, {1, 32}, {2, 48}, {3, 60}, {4, 28}, {5, 3}}},
-      {"3.5,2.5,4.5,3.5", {{3, 1}, {4, 1}, {5, 1}}},
-      {"2,2.5,5,5", {{0, 2}, {2, 3}, {3, 7.5}, {4, 2.5}, {5, 2}}},
+      {layer, "3.5,5.2,5.5,5.8", {{0, 0.3}, {2, 1.2}, {3, 1.2}, {4, 0.6}}},
+      {layer, "-1,-1,9,9", {{0, 4}, {1, 32}, {2, 48}, {3, 60}, {4, 28}, {5, 3}}},
+      {layer, "3.5,2.5,4.5,3.5", {{3, 1}, {4, 1}, {5, 1}}},
+      {layer, "2,2.5,5,5", {{0, 2}, {2, 3}, {3, 7.5}, {4, 2.5}, {5, 2}}},
+      {curves, "-1,-1,9,9", {{1, 32}, {2, 48}}},
   };
   for (const Case& c : cases) {
     const std::string out = path("invalid-holes-clip.geojson");
     fs::remove(out);
-    const CliRun r = run_loci("clip " + layer + " --bbox " + c.bbox + " -q -o " + out);
+    const CliRun r = run_loci("clip " + c.layer + " --bbox " + c.bbox + " -q -o " + out);
     ASSERT_EQ(r.status, 0) << c.bbox << r.err;
     GDALDatasetUniquePtr ds(GDALDataset::Open(out.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
     ASSERT_TRUE(ds) << c.bbox;
@@ -599,7 +606,7 @@ TEST_F(LayersCli, ClipCutsInvalidPolygonsAsTheQueriesReadThem) {
                      : 0.0;
     }
     // The features the query lists, each with the measure worked out by hand.
-    std::istringstream ids(run_loci("query " + layer + " --bbox " + c.bbox).out);
+    std::istringstream ids(run_loci("query " + c.layer + " --bbox " + c.bbox).out);
     std::vector<int> listed;
     for (int id; ids >> id;)
       listed.push_back(id);
