@@ -905,6 +905,28 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
   std::sort(rows.begin(), rows.end(),
             [](const Out& a, const Out& b) { return a.t != b.t ? a.t < b.t : a.id < b.id; });
 
+  // Each report's lon/lat and course, before anything is written: one beyond the far side of
+  // the earth from the frame's centre (fast courses over long intervals) is an error before
+  // the first row reaches stdout.
+  struct Shown {
+    Point2 ll;
+    double speed, cog;
+  };
+  std::vector<Shown> shown_as;
+  if (ais) {
+    shown_as.reserve(rows.size());
+    try {
+      for (const Out& r : rows) {
+        const auto [speed, cog] = frame->course(r.p, r.v);
+        shown_as.push_back({frame->to_lonlat(r.p), speed, cog});
+      }
+    } catch (const Error&) {
+      throw InvalidArgument(
+          "a generated course reaches beyond the far side of the earth from the box's centre, "
+          "where it has no longitude and latitude: ask for a lower --speed, fewer --reports or "
+          "a shorter --interval");
+    }
+  }
   OutputFile out(o.out_path, fallback);
   std::FILE* f = out.stream();
   std::size_t written = 0;
@@ -912,11 +934,12 @@ std::size_t fleet_generate(const FleetGenerateOptions& o, std::FILE* fallback) {
     std::fprintf(f,
                  "MMSI,BaseDateTime,LAT,LON,SOG,COG,Heading,VesselName,IMO,CallSign,VesselType,"
                  "Status,Length,Width,Draft,Cargo,TransceiverClass\n");
-    for (const Out& r : rows) {
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const Out& r = rows[k];
       ticker.tick(double(o.count + ++written));
-      const Point2 ll = frame->to_lonlat(r.p);
-      auto [speed, cog] = frame->course(r.p, r.v);
-      cog = std::round(cog * 10) / 10;
+      const Point2 ll = shown_as[k].ll;
+      const double speed = shown_as[k].speed;
+      double cog = std::round(shown_as[k].cog * 10) / 10;
       if (cog >= 360) cog -= 360;
       std::fprintf(f, "%llu,%s,%.5f,%.5f,%.1f,%.1f,%d,SYNTHETIC %llu,,,70,0,120,20,7.5,70,A\n",
                    static_cast<unsigned long long>(r.id), format_utc(r.t).substr(0, 19).c_str(),

@@ -1039,7 +1039,13 @@ TEST_F(FleetCli, AnAisPositionWithoutLonLatWritesNothingToStdout) {
     EXPECT_NE(r.err.find("far side of the earth"), std::string::npos) << args << r.err;
     EXPECT_EQ(r.out, "") << args;
   }
-  // Ids need no lon/lat, and the pairs of the slow vessels alone are written whole.
+  // Generated courses that reach that far are refused before the first row, saying why.
+  const CliRun g =
+      run_loci("fleet generate --count 2000 -f ais --speed 1,35 --reports 2 --interval 1200000 -q");
+  expect_one_line_error(g);
+  EXPECT_NE(g.err.find("lower --speed"), std::string::npos) << g.err;
+  EXPECT_EQ(g.out, "");
+  // Ids need no lon/lat: a nearest query as ids is answered whole.
   const CliRun ids = run_loci("fleet query " + shell_quote(f) +
                               " --nearest 10,55 -k 3002 --at 1673531200 -f ids -q");
   ASSERT_EQ(ids.status, 0) << ids.err;
