@@ -264,6 +264,12 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
     else if (!has_old && sqlite3_value_type(argv[2]) == SQLITE_NULL)
       given = argv[1];  // INSERT INTO f(rowid, ...)
     FleetId id = 0;
+    if (has_old &&
+        (sqlite3_value_type(given) == SQLITE_NULL || sqlite3_value_type(argv[1]) == SQLITE_NULL))
+      throw SqlError{SQLITE_MISMATCH,
+                     format_sql("loci_fleet %s: datatype mismatch (an UPDATE cannot set the id "
+                                "of id %lld to NULL)",
+                                t.name.c_str(), (long long)old_id)};
     if (sqlite3_value_type(given) == SQLITE_NULL)
       throw SqlError{
           SQLITE_CONSTRAINT,

@@ -249,6 +249,10 @@ TEST(SqliteFleetSql, ReportsReplaceByTimeAndUpdateDeleteFollowTheirRules) {
   EXPECT_EQ(db.value("SELECT count(*) FROM f_report WHERE id = 1"), "3");
   db.exec("UPDATE f SET id = 3 WHERE id = 2");
   EXPECT_EQ(db.rows("SELECT id FROM f"), (std::vector<Row>{{"1"}, {"3"}}));
+  // An UPDATE to a NULL id or rowid is refused, as on a rowid table, and changes nothing.
+  EXPECT_NE(db.error_of("UPDATE f SET id = NULL WHERE id = 3"), "");
+  EXPECT_NE(db.error_of("UPDATE f SET rowid = NULL WHERE id = 3"), "");
+  EXPECT_EQ(db.rows("SELECT id FROM f"), (std::vector<Row>{{"1"}, {"3"}}));
   // DELETE removes the object and its history.
   db.exec("DELETE FROM f WHERE id = 1");
   EXPECT_EQ(db.value("SELECT count(*) FROM f_report WHERE id = 1"), "0");
