@@ -260,7 +260,7 @@ TYPED_TEST(MovingIndexTest, EpochSecondWindowsHoldNoObjectMovingAway) {
 // the epoch; its bounds there, p + v (epoch - t), round at the size of p and of its travel
 // (2.4e-4), which the trees' pruning allowance counted only at the bounds' own size. Windows
 // with an edge on such an object's position at the query time hold it (touching counts), and
-// nearest queries just off it find it.
+// a nearest query at that position finds it before another object 1e-4 away.
 TYPED_TEST(MovingIndexTest, AncientReportsOnTheWindowsEdgesAreFound) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0, 1000), sign(-1, 1);
@@ -297,13 +297,19 @@ TYPED_TEST(MovingIndexTest, AncientReportsOnTheWindowsEdgesAreFound) {
     const std::vector<Id> want = brute_window(objs, w);
     ASSERT_EQ(got, want) << "window " << i;
     held += int(want.size());
-    // Nearest to a point just off the object's position: the object, or one as near.
-    const Point2 q{p[0] + 1e-3 * wx, p[1] + 1e-3 * wy};
-    const auto near = index.nearest(q, s, 3);
-    const auto brute = brute_nearest(objs, q, s, 3);
-    ASSERT_EQ(near.size(), brute.size());
-    for (std::size_t r = 0; r < near.size(); ++r)
-      ASSERT_DOUBLE_EQ(near[r].distance, brute[r]) << "nearest " << i << " rank " << r;
+  }
+  // Nearest to each such object's position, with another object standing 1e-4 from it: the
+  // first is at distance 0 (pruning its bounds by the old allowance gave the other).
+  for (std::size_t i = 0; i < ancient.size(); ++i) {
+    const double s = 1e-6 * u(rng);
+    const Point2 p = position(ancient[i], s);
+    const Motion2 near_it{0, {p[0] + 1e-4 * sign(rng), p[1] + 1e-4 * sign(rng)}, {0, 0}};
+    index.insert(id, near_it);
+    objs[id++] = near_it;
+    const auto near = index.nearest(p, s, 1);
+    ASSERT_EQ(near.size(), 1u);
+    EXPECT_EQ(near[0].distance, brute_nearest(objs, p, s, 1)[0]) << "nearest " << i;
+    EXPECT_EQ(near[0].distance, 0.0) << "nearest " << i;
   }
   // Every timeslice holds its object (an interval may lose one that leaves it at once).
   EXPECT_GE(held, 25);
