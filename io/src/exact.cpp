@@ -110,8 +110,8 @@ bool meets(const FlatGeometry& g, const Segment2& s) {
 namespace {
 // The parameter of point x on the line of s, clamped to [0, 1] (x lies on s). Differences far
 // from 1 are scaled by a power of two first (exactly, to the same quotient): the squares of a
-// segment's coordinates below about 1e-154 underflow (at 1e-200 they were 0, and the
-// parameter NaN or far off), and those above 1e154 overflow.
+// segment's coordinates below about 1e-154 underflow (at 1e-200 the squared length was 0 and
+// every parameter 0), and those above 1e154 overflow (inf / inf).
 double parameter(const Segment2& s, const Point2& x) {
   double dx = s.b[0] - s.a[0], dy = s.b[1] - s.a[1];
   double wx = x[0] - s.a[0], wy = x[1] - s.a[1];

@@ -7,7 +7,6 @@
 // definitions through brute-force point tests on lattice points.
 #include <gmpxx.h>
 #include <gtest/gtest.h>
-#include <cstdio>
 
 #include <algorithm>
 #include <cmath>
