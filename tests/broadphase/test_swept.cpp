@@ -1,5 +1,6 @@
 // Contact intervals of moving boxes and spheres: exact hand cases, and random cases against a
 // fine-step simulation.
+#include <gmpxx.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -157,6 +158,39 @@ TEST(SweptBox, ContainsTheMotion) {
   EXPECT_EQ(s, box(2, -3, 7, 1));
   for (double t = 1; t <= 3; t += 0.125)
     EXPECT_TRUE(contains(s, moved_box(b, v, t)));
+}
+
+// The swept box holds the exact motion where x + v t is not a double: rounded to nearest, a
+// box touching another exactly at t1 had a swept box an ulp short of it (0.09 + 0.35 x 0.75
+// is 0.35249999999999998 and a fraction, rounded to 0.35249999999999992). Checked against
+// exact rationals on random motions, with bounds no further out than the rounding needs.
+TEST(SweptBox, BoundsAreRoundedOutward) {
+  const Box2 a = box(0.09 - 1, 0, 0.09, 1), b = box(0.35249999999999998, 0, 1.35249999999999998, 1);
+  const Point2 v{0.35, 0}, still{0, 0};
+  EXPECT_TRUE(intersects(swept_box(a, v, 0.0, 0.75), swept_box(b, still, 0.0, 0.75)));
+  EXPECT_FALSE(box_contact(a, v, b, still, 0.0, 0.75).empty());
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-10, 10);
+  int widened = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double x = u(rng), w = std::ldexp(u(rng), int(rng() % 40) - 20), t = u(rng) + 10;
+    const Box2 one{{x, 0}, {x, 0}};
+    const Box2 s = swept_box(one, Point2{w, 0}, 0.0, t);
+    ASSERT_EQ(s.min[1], 0.0);
+    ASSERT_EQ(s.max[1], 0.0);
+    const mpq_class exact = mpq_class(x) + mpq_class(w) * mpq_class(t);
+    const mpq_class lo = exact < mpq_class(x) ? exact : mpq_class(x);
+    const mpq_class hi = exact < mpq_class(x) ? mpq_class(x) : exact;
+    ASSERT_LE(mpq_class(s.min[0]), lo) << trial;
+    ASSERT_GE(mpq_class(s.max[0]), hi) << trial;
+    // No further out than the rounding needs: a few ulps of the terms.
+    const double moved = exact < mpq_class(x) ? s.min[0] : s.max[0];
+    EXPECT_LE(std::abs(mpq_class(moved - exact).get_d()),
+              0x1p-50 * (std::abs(w * t) + std::abs(x)) + 0x1p-1070)
+        << trial;
+    widened += s.max[0] != std::max(x, x + w * t) || s.min[0] != std::min(x, x + w * t);
+  }
+  EXPECT_GT(widened, 1000);
 }
 
 // Against a fine-step simulation: every sampled time in contact lies in the interval, every
