@@ -257,19 +257,8 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
       return SQLITE_OK;
     }
     // argv[1] the new rowid, argv[2] the id column, argv[3..7] t, x, y, vx, vy.
-    sqlite3_value* given = argv[2];
-    if (has_old && sqlite3_value_type(argv[1]) != SQLITE_NULL &&
-        sqlite3_value_int64(argv[1]) != old_id)
-      given = argv[1];  // UPDATE ... SET rowid = ...
-    else if (!has_old && sqlite3_value_type(argv[2]) == SQLITE_NULL)
-      given = argv[1];  // INSERT INTO f(rowid, ...)
+    sqlite3_value* const given = given_id(argv, has_old, old_id, "loci_fleet", t.name);
     FleetId id = 0;
-    if (has_old &&
-        (sqlite3_value_type(given) == SQLITE_NULL || sqlite3_value_type(argv[1]) == SQLITE_NULL))
-      throw SqlError{SQLITE_MISMATCH,
-                     format_sql("loci_fleet %s: datatype mismatch (an UPDATE cannot set the id "
-                                "of id %lld to NULL)",
-                                t.name.c_str(), (long long)old_id)};
     if (sqlite3_value_type(given) == SQLITE_NULL)
       throw SqlError{
           SQLITE_CONSTRAINT,

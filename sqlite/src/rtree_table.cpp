@@ -405,18 +405,7 @@ int x_update(sqlite3_vtab* v, int argc, sqlite3_value** argv, sqlite_int64* new_
     // The id column is the rowid, as in an INTEGER PRIMARY KEY: a NULL id inserted takes a new
     // one, and an UPDATE to a NULL id (or rowid) is refused as a rowid table refuses it.
     RowId id = 0;
-    sqlite3_value* given = argv[2];
-    if (has_old && sqlite3_value_type(argv[1]) != SQLITE_NULL &&
-        sqlite3_value_int64(argv[1]) != old_id)
-      given = argv[1];  // UPDATE ... SET rowid = ...
-    else if (!has_old && sqlite3_value_type(argv[2]) == SQLITE_NULL)
-      given = argv[1];  // INSERT INTO t(rowid, ...)
-    if (has_old &&
-        (sqlite3_value_type(given) == SQLITE_NULL || sqlite3_value_type(argv[1]) == SQLITE_NULL))
-      throw SqlError{SQLITE_MISMATCH,
-                     format_sql("loci_rtree %s: datatype mismatch (an UPDATE cannot set the id "
-                                "of id %lld to NULL)",
-                                t.name.c_str(), (long long)old_id)};
+    sqlite3_value* const given = given_id(argv, has_old, old_id, "loci_rtree", t.name);
     if (sqlite3_value_type(given) != SQLITE_NULL) {
       if (!row_id(given, id))
         throw SqlError{SQLITE_MISMATCH,

@@ -139,6 +139,28 @@ T& table_named(sqlite3* db, const Registry& registry, const char* name, const ch
   throw SqlError{SQLITE_ERROR, format_sql("%s: %s is not a %s table", function, name, T::kModule)};
 }
 
+// The value an xUpdate gives for the id of a table whose id column is its rowid (argv[1] the
+// new rowid, argv[2] the id column): the rowid where an UPDATE sets it, or an INSERT names it
+// instead of the id; NULL for an INSERT that names neither. An UPDATE to a NULL id or rowid
+// is refused as datatype mismatch, as a rowid table refuses it. Throws SqlError naming
+// `module` and `table`.
+inline sqlite3_value* given_id(sqlite3_value** argv, bool has_old, sqlite3_int64 old_id,
+                               const char* module, const std::string& table) {
+  sqlite3_value* given = argv[2];
+  if (has_old && sqlite3_value_type(argv[1]) != SQLITE_NULL &&
+      sqlite3_value_int64(argv[1]) != old_id)
+    given = argv[1];  // UPDATE ... SET rowid = ...
+  else if (!has_old && sqlite3_value_type(argv[2]) == SQLITE_NULL)
+    given = argv[1];  // INSERT INTO t(rowid, ...)
+  if (has_old &&
+      (sqlite3_value_type(given) == SQLITE_NULL || sqlite3_value_type(argv[1]) == SQLITE_NULL))
+    throw SqlError{SQLITE_MISMATCH,
+                   format_sql("%s %s: datatype mismatch (an UPDATE cannot set the id of id %lld "
+                              "to NULL)",
+                              module, table.c_str(), (long long)old_id)};
+  return given;
+}
+
 // The column arguments of CREATE VIRTUAL TABLE (argv[3..]), with blanks around them removed;
 // throws SqlError naming `module` for an empty one.
 std::vector<std::string> column_arguments(int argc, const char* const* argv, const char* module);
