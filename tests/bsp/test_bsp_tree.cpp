@@ -838,5 +838,89 @@ TEST(BspTree, RejectsBadInput) {
   EXPECT_TRUE(tree.overlaps({5, 5}, BspConvex{{{-4.5, -4.9}, {-4.4, -4.9}, {-4.4, -4.8}}}));
 }
 
+// Polygons whose edges cross, or run along each other over a stretch, are refused, with the
+// polygon and rings named: the inside changes sides along such an edge at a point no double
+// holds. Before, the edges were taken to have the inside on their left and regions far from
+// every polygon were called solid (a hole along part of its outer ring's side made
+// solid(-100, 3) true).
+TEST(BspTree, RefusesEdgesThatCrossOrRunAlongEachOther) {
+  using V = std::vector<BspPolygon>;
+  using R = std::vector<Point2>;
+  const R square{{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  auto refused = [](const V& layer, const char* says) {
+    try {
+      BspTree::build(layer);
+    } catch (const InvalidGeometry& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+      return true;
+    }
+    return false;
+  };
+  // A hole along part of the outer ring's side (a notch), a ring doubling back along itself.
+  EXPECT_TRUE(refused(V{{square, {R{{0, 2}, {3, 4}, {0, 6}}}}},
+                      "the outer ring and hole 0 of polygon 0 run along each other"));
+  EXPECT_TRUE(refused(V{{R{{0, 0}, {10, 0}, {5, 0}, {5, 5}}, {}}}, "runs along itself"));
+  // A bow-tie outer ring, a hole crossing its outer ring, two holes crossing.
+  EXPECT_TRUE(refused(V{{R{{0, 0}, {4, 4}, {4, 0}, {0, 6}}, {}}}, "crosses itself"));
+  EXPECT_TRUE(refused(V{{square, {R{{8, 4}, {12, 4}, {12, 6}, {8, 6}}}}}, "cross"));
+  EXPECT_TRUE(refused(V{{square, {R{{2, 2}, {5, 2}, {5, 5}}, R{{4, 1}, {6, 1}, {6, 4}, {4, 4}}}}},
+                      "hole 0 and hole 1 of polygon 0 cross"));
+  // The polygon is named by its index; polygons may cross one another.
+  EXPECT_TRUE(refused(V{{square, {}}, {square, {R{{8, 4}, {12, 4}, {12, 6}, {8, 6}}}}},
+                      "of polygon 1 cross"));
+  EXPECT_NO_THROW(BspTree::build(V{{square, {}}, {R{{8, 4}, {12, 4}, {12, 6}, {8, 6}}, {}}}));
+}
+
+// Rings that touch at points, holes outside their outer ring or inside other holes, rings
+// winding twice, edges given twice: each polygon is what the even-odd rule over its rings
+// encloses, as the layer queries read it (a hole outside its outer ring is an island, a ring
+// winding twice round a region leaves a lake, an edge given twice cancels). Points of a
+// quarter-step grid through every vertex are classified as crossing parity classifies them.
+TEST(BspTree, PolygonsAreWhatTheEvenOddRuleEncloses) {
+  using V = std::vector<BspPolygon>;
+  using R = std::vector<Point2>;
+  const R square{{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  const std::vector<V> layers{
+      // A hole touching its outer ring's side; an outer ring touching itself round a hole.
+      V{{square, {R{{0, 5}, {4, 3}, {4, 7}}}}},
+      V{{R{{0, 0}, {10, 0}, {10, 10}, {5, 10}, {7, 5}, {3, 5}, {5, 10}, {0, 10}}, {}}},
+      // Holes touching each other.
+      V{{square, {R{{2, 2}, {4, 2}, {4, 4}, {2, 4}}, R{{4, 4}, {6, 4}, {6, 6}, {4, 6}}}}},
+      V{{square, {R{{2, 2}, {4, 2}, {4, 4}}, R{{4, 4}, {8, 8}, {4, 8}}}}},
+      // Holes outside the outer ring, apart and touching it: islands.
+      V{{square, {R{{12, 0}, {14, 0}, {14, 2}}}}}, V{{square, {R{{10, 5}, {12, 4}, {12, 6}}}}},
+      // A hole inside another hole: an island in the lake.
+      V{{square, {R{{1, 1}, {9, 1}, {9, 9}, {1, 9}}, R{{3, 3}, {7, 3}, {7, 7}}}}},
+      // An outer ring winding twice round a region through a shared vertex: a lake.
+      V{{R{{0, 0}, {10, 0}, {10, 10}, {0, 10}, {0, 0}, {2, 1}, {8, 1}, {8, 8}, {1, 8}}, {}}},
+      // Overlapping polygons, one with a hole.
+      V{{square, {}}, {R{{5, 5}, {15, 5}, {15, 15}, {5, 15}}, {R{{6, 6}, {9, 6}, {9, 9}}}}}};
+  for (std::size_t k = 0; k < layers.size(); ++k) {
+    BspTree tree;
+    ASSERT_NO_THROW(tree = BspTree::build(layers[k])) << k;
+    tree.validate();
+    for (int i = -4; i <= 64; ++i)
+      for (int j = -4; j <= 64; ++j) {
+        const Point2 p{i * 0.25, j * 0.25};
+        ASSERT_EQ(tree.solid(p), test::in_solid(layers[k], p)) << k << ": " << p[0] << "," << p[1];
+      }
+  }
+  EXPECT_TRUE(BspTree::build(layers[4]).solid({13.5, 0.5}));
+  EXPECT_FALSE(BspTree::build(layers[7]).solid({5, 5}));
+  // A hole sharing a side with the outer ring, an edge given twice: they cancel, and the solid
+  // is the rest.
+  const BspTree notch = BspTree::build(V{{square, {R{{0, 0}, {0, 10}, {5, 5}}}}});
+  EXPECT_FALSE(notch.solid({1, 5}));
+  EXPECT_FALSE(notch.solid({-100, 3}));
+  EXPECT_TRUE(notch.solid({1, 0.5}));
+  EXPECT_TRUE(notch.solid({6, 5}));
+  const BspTree twice =
+      BspTree::build(V{{R{{0, 0}, {10, 0}, {10, 10}, {0, 0}, {10, 0}, {5, -5}}, {}}});
+  EXPECT_TRUE(twice.solid({5, 0}));
+  EXPECT_TRUE(twice.solid({9, 1}));
+  EXPECT_TRUE(twice.solid({5, -1}));
+  EXPECT_FALSE(twice.solid({20, 0}));
+}
+
 }  // namespace
 }  // namespace loci

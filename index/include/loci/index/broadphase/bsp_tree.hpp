@@ -104,6 +104,7 @@
 #include "loci/geom/predicates.hpp"
 #include "loci/geom/segment.hpp"
 #include "loci/geom/segment_intersection.hpp"
+#include "loci/index/detail/even_odd_edges.hpp"
 #include "loci/index/detail/scratch.hpp"
 #include "loci/index/detail/y_bands.hpp"
 #include "loci/index/query.hpp"
@@ -192,8 +193,10 @@ class BspTree {
 
   // The tree of the union of `polygons`. Throws InvalidGeometry on a coordinate that is NaN,
   // infinite or beyond kMaxCoordinate (1e150: the root cell's margin and the exact tests'
-  // areas stay finite), or a ring with fewer than three distinct vertices or no area,
-  // InvalidArgument on bad parameters.
+  // areas stay finite), a ring with fewer than three distinct vertices or no area, or a
+  // polygon two of whose edges cross or run along each other (rings may touch at points;
+  // detail/even_odd_edges.hpp), InvalidArgument on bad parameters. A polygon is what the
+  // even-odd rule over its rings encloses; polygons may overlap one another.
   static BspTree build(std::span<const BspPolygon> polygons, const BspParams& params = {});
 
   // First impact of `shape` moving from `from` to `to` (straight, at constant speed). Throws
@@ -813,28 +816,33 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
   using detail::BspEdge;
   using detail::BspPiece;
 
-  // Edges, the solid on their left.
-  std::vector<BspEdge> edges;
+  // Edges, the solid on their left: the inside of each polygon by the even-odd rule over its
+  // rings (a hole outside its outer ring is an island, a hole in a hole too), as the layer
+  // queries read polygons; edges a polygon has twice cancel.
   Box2 bounds = Box2::empty();
-  std::uint32_t polygon = 0;
-  auto add_ring = [&](const std::vector<Point2>& ring, bool ccw, const std::string& what) {
-    const std::vector<Point2> r = detail::bsp_ring(ring, ccw, what);
-    for (std::size_t i = 0; i < r.size(); ++i) {
-      const Point2& a = r[i];
-      const Point2& b = r[(i + 1) % r.size()];
-      bounds.expand(a);
-      const double dx = b[0] - a[0], dy = b[1] - a[1];
-      const double len = std::hypot(dx, dy);
-      const double nx = dy / len, ny = -dx / len;
-      edges.push_back({a, b, nx, ny, nx * a[0] + ny * a[1], polygon});
-    }
+  std::vector<std::vector<Point2>> rings;
+  std::vector<detail::PolygonRing> of;
+  auto add_ring = [&](const std::vector<Point2>& ring, const std::string& what, std::size_t polygon,
+                      std::size_t index) {
+    rings.push_back(detail::bsp_ring(ring, true, what));
+    for (const Point2& p : rings.back())
+      bounds.expand(p);
+    of.push_back({{}, static_cast<std::uint32_t>(polygon), static_cast<std::uint32_t>(index)});
   };
   for (std::size_t i = 0; i < polygons.size(); ++i) {
     const std::string what = "polygon " + std::to_string(i);
-    add_ring(polygons[i].outer, true, what + " outer ring");
+    add_ring(polygons[i].outer, what + " outer ring", i, 0);
     for (std::size_t h = 0; h < polygons[i].holes.size(); ++h)
-      add_ring(polygons[i].holes[h], false, what + " hole " + std::to_string(h));
-    ++polygon;
+      add_ring(polygons[i].holes[h], what + " hole " + std::to_string(h), i, h + 1);
+  }
+  for (std::size_t i = 0; i < of.size(); ++i)
+    of[i].vertices = rings[i];
+  std::vector<BspEdge> edges;
+  for (const detail::PolygonEdge& e : detail::even_odd_edges(of)) {
+    const double dx = e.b[0] - e.a[0], dy = e.b[1] - e.a[1];
+    const double len = std::hypot(dx, dy);
+    const double nx = dy / len, ny = -dx / len;
+    edges.push_back({e.a, e.b, nx, ny, nx * e.a[0] + ny * e.a[1], e.polygon});
   }
   // Every edge, for locating points against the polygons.
   const std::vector<BspEdge> all_edges = edges;
@@ -879,7 +887,7 @@ inline BspTree BspTree::build(std::span<const BspPolygon> polygons, const BspPar
   tree.edges_ = edges.size();
   if (edges.empty()) return tree;
   tree.reach_ = magnitude(bounds);
-  detail::BspPointLocator locator(all_edges, polygon, bounds);
+  detail::BspPointLocator locator(all_edges, static_cast<std::uint32_t>(polygons.size()), bounds);
 
   // The root cell: the layer's bounds with a wide margin (solid cells never reach it).
   const double margin =
