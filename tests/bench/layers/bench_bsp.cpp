@@ -65,6 +65,10 @@ struct Move {
   int radius;  // index into kRadii
 };
 
+// Buffered polygons left out because Boost.Geometry's buffer made them invalid (edges crossing,
+// which BspTree refuses), over all radii.
+std::size_t invalid_buffers = 0;
+
 // The polygons grown by r (each one on its own; BspTree takes overlapping polygons).
 std::vector<BspPolygon> buffered(const std::vector<BspPolygon>& polys, double r) {
   std::vector<BspPolygon> out;
@@ -86,6 +90,10 @@ std::vector<BspPolygon> buffered(const std::vector<BspPolygon>& polys, double r)
     BMulti grown;
     bg::buffer(bp, grown, dist, side, join, end, circle);
     for (const BPolygon& g : grown) {
+      if (!bg::is_valid(g)) {
+        ++invalid_buffers;
+        continue;
+      }
       BspPolygon q;
       for (const BPoint& v : g.outer())
         q.outer.push_back({v.x(), v.y()});
@@ -236,7 +244,10 @@ int main(int argc, char** argv) {
   std::printf("\nnodes visited per move: plane shifting %.1f, offset trees %.1f\n",
               static_cast<double>(ps_stats.nodes_visited) / static_cast<double>(n),
               static_cast<double>(off_stats.nodes_visited) / static_cast<double>(n));
-  std::printf("offset trees: buffering %.3f s, building %.3f s\n", buffer_s, build_off);
+  std::printf(
+      "offset trees: buffering %.3f s, building %.3f s (%zu invalid buffered polygons left "
+      "out)\n",
+      buffer_s, build_off, invalid_buffers);
   std::printf(
       "checked against brute force on %zu moves (%zu hits): plane shifting outside the "
       "bevel bound %zu; offset trees differing %zu (worst |dt| %.2e, from the polygonal "
