@@ -19,6 +19,20 @@ namespace {
 
 const std::string kSample = std::string(LOCI_DATASETS_DIR) + "/samples/coastline-denmark.geojson";
 
+// The rings of p, closed, added to the OGR polygon g (for GEOS's answers).
+void add_ogr_rings(const BspPolygon& p, OGRPolygon& g) {
+  auto ring = [](const std::vector<Point2>& r) {
+    auto* lr = new OGRLinearRing;
+    for (const Point2& v : r)
+      lr->addPoint(v[0], v[1]);
+    lr->closeRings();
+    return lr;
+  };
+  g.addRingDirectly(ring(p.outer));
+  for (const auto& h : p.holes)
+    g.addRingDirectly(ring(h));
+}
+
 TEST(BspLayer, PointsAsGeosSays) {
   const auto polys = test::read_polygons(kSample);
   ASSERT_GT(polys.size(), 100u);
@@ -27,17 +41,7 @@ TEST(BspLayer, PointsAsGeosSays) {
   // GEOS through OGR: some polygon contains the point (boundary included).
   std::vector<OGRPolygon> all;
   for (const BspPolygon& p : polys) {
-    OGRPolygon& g = all.emplace_back();
-    auto ring = [](const std::vector<Point2>& r) {
-      auto* lr = new OGRLinearRing;
-      for (const Point2& v : r)
-        lr->addPoint(v[0], v[1]);
-      lr->closeRings();
-      return lr;
-    };
-    g.addRingDirectly(ring(p.outer));
-    for (const auto& h : p.holes)
-      g.addRingDirectly(ring(h));
+    add_ogr_rings(p, all.emplace_back());
   }
   std::mt19937_64 rng(42);
   std::uniform_real_distribution<double> lon(7, 16), lat(53.5, 58.5);
@@ -99,13 +103,6 @@ TEST(BspLayer, RandomPolygonsBuiltWhenValidAndAnsweredExactly) {
       r.push_back({static_cast<double>(coord(rng)), static_cast<double>(coord(rng))});
     return r;
   };
-  auto ogr_ring = [](const std::vector<Point2>& r) {
-    auto* lr = new OGRLinearRing;
-    for (const Point2& v : r)
-      lr->addPoint(v[0], v[1]);
-    lr->closeRings();
-    return lr;
-  };
   int valid = 0, built = 0, built_invalid = 0;
   CPLPushErrorHandler(CPLQuietErrorHandler);  // GEOS's complaints about rings of two points
   for (int q = 0; q < 4000; ++q) {
@@ -114,9 +111,7 @@ TEST(BspLayer, RandomPolygonsBuiltWhenValidAndAnsweredExactly) {
       poly.holes.push_back(ring(count(rng) - 1));
     const std::vector<BspPolygon> layer{poly};
     OGRPolygon g;
-    g.addRingDirectly(ogr_ring(poly.outer));
-    for (const auto& h : poly.holes)
-      g.addRingDirectly(ogr_ring(h));
+    add_ogr_rings(poly, g);
     const bool geos_valid = g.IsValid();
     BspTree tree;
     bool ok = true;

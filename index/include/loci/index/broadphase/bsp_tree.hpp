@@ -9,8 +9,9 @@
 // along the wall it hit, as navigation does. overlaps() asks whether an object at rest meets
 // the solid. One tree serves every object size: nothing is built per radius.
 //
-// The tree. Built from the polygons' edges, oriented so that the solid lies on their left
-// (outer rings counter-clockwise, holes clockwise). Each node's plane is the line of one edge
+// The tree. Built from the polygons' edges, each turned so that the solid lies on its left,
+// the solid of a polygon being what the even-odd rule over its rings encloses
+// (detail/even_odd_edges.hpp). Each node's plane is the line of one edge
 // (an autopartition); its normal points out of the solid ("front", f(x) = n.x - d > 0). The
 // splitter is the best of a few candidates by (3 x edges cut + imbalance). Edges are kept as
 // pieces [s0, s1] of their original edge, and the side of an edge is decided by the exact
